@@ -1,0 +1,72 @@
+# Boticelli: thin wrapper over CMake presets (like PX4's Makefile). `make help` lists targets.
+.DEFAULT_GOAL := help
+SHELL := /bin/bash
+MAKEFLAGS += --no-print-directory
+JOBS ?= $(shell nproc)
+WORLD ?= boards/sim/worlds/thesis_room.sdf
+ARGS ?=
+SUITE ?= all
+
+.PHONY: help deps deps-cross deps-armhf deps-bench run test check bench format format-check \
+        sim asan rpi4 armhf test-sim test-asan test-rpi4 clean
+
+help:
+	@echo "make run       install deps, build the sim preset, run the firmware on the sim board"
+	@echo "make test      install deps, build and test the sim, asan and rpi4 (qemu) presets"
+	@echo "make check     build and test the sim preset only (fast iteration)"
+	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
+	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
+	@echo "make format    clang-format every C++ file; make format-check only reports"
+
+deps:
+	@toolchain/install-deps.sh
+deps-cross:
+	@toolchain/install-deps.sh --cross
+deps-armhf:
+	@toolchain/install-deps.sh --armhf
+deps-bench:
+	@toolchain/install-deps.sh --bench
+
+# configure+build one preset: $(call build,PRESET)
+define build
+	cmake --preset $(1) >/dev/null
+	cmake --build --preset $(1) -j $(JOBS)
+endef
+
+sim: deps
+	$(call build,sim)
+asan: deps
+	$(call build,asan)
+rpi4: deps-cross
+	$(call build,rpi4)
+armhf: deps-armhf
+	$(call build,armhf)
+
+run: sim
+	build/sim/bin/boticelli --world $(WORLD) $(ARGS)
+
+test-sim: sim
+	ctest --preset sim -j $(JOBS)
+test-asan: asan
+	ctest --preset asan -j $(JOBS)
+test-rpi4: rpi4
+	ctest --preset rpi4 -j $(JOBS)
+	@file -L build/rpi4/bin/boticelli | grep -q 'ARM aarch64' \
+	  || { echo "build/rpi4/bin/boticelli is not an aarch64 binary" >&2; exit 1; }
+
+test: test-sim test-asan test-rpi4
+	@echo "make test: sim, asan and rpi4 (qemu-aarch64) presets passed"
+
+check: test-sim
+
+bench: deps-bench
+	$(call build,sim)
+	build/sim/bin/boticelli-bench $(SUITE) --json
+
+format:
+	@git ls-files '*.h' '*.hpp' '*.cpp' | xargs clang-format -i
+format-check:
+	@git ls-files '*.h' '*.hpp' '*.cpp' | xargs clang-format --dry-run --Werror
+
+clean:
+	rm -rf build

@@ -1,0 +1,57 @@
+# Build conventions shared by every module: warnings, sanitizers, subfolder discovery, tests.
+
+# The warning set (documented in docs/architecture.md). -Werror via BOTICELLI_WERROR.
+set(BOTICELLI_WARNINGS
+  -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow
+  -Wnon-virtual-dtor -Wold-style-cast -Woverloaded-virtual -Wnull-dereference
+  -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
+if(BOTICELLI_WERROR)
+  list(APPEND BOTICELLI_WARNINGS -Werror)
+endif()
+
+if(BOTICELLI_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+# boticelli_target_defaults(TARGET): the project's warnings on one of its own targets.
+function(boticelli_target_defaults target)
+  get_target_property(type ${target} TYPE)
+  if(type STREQUAL "INTERFACE_LIBRARY")
+    return()
+  endif()
+  target_compile_options(${target} PRIVATE ${BOTICELLI_WARNINGS})
+endfunction()
+
+# boticelli_add_subdirectories([EXCLUDE dir...]): add every direct subfolder that has a
+# CMakeLists.txt, so a new module (algo/<stage>, tests/<module>, ...) is picked up without
+# editing its parent.
+function(boticelli_add_subdirectories)
+  cmake_parse_arguments(S "" "" "EXCLUDE" ${ARGN})
+  file(GLOB children LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR}
+       CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*)
+  list(SORT children)
+  foreach(child IN LISTS children)
+    if(child IN_LIST S_EXCLUDE)
+      continue()
+    endif()
+    if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${child}
+       AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${child}/CMakeLists.txt)
+      add_subdirectory(${child})
+    endif()
+  endforeach()
+endfunction()
+
+# boticelli_add_test(NAME SOURCES src... [LIBS lib...])
+#   One CppUTest binary per module, registered with a plain add_test (CppUTest 4.0 has no
+#   test discovery). Its main (tests/support/test_main.cpp) installs MockSupportPlugin;
+#   the allocation guard is in boticelli_test_support. Under a cross preset ctest runs it
+#   through CMAKE_CROSSCOMPILING_EMULATOR (qemu-aarch64).
+function(boticelli_add_test name)
+  cmake_parse_arguments(T "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${T_SOURCES})
+  boticelli_target_defaults(${name})
+  target_link_libraries(${name} PRIVATE boticelli_test_support ${T_LIBS})
+  add_test(NAME ${name} COMMAND ${name})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 600)
+endfunction()

@@ -1,0 +1,37 @@
+// Options: the firmware's command line (DESIGN.md "Contracts"), parsed without allocation or exceptions.
+#pragma once
+
+#include <cstdint>
+
+namespace boticelli::firmware {
+
+enum class ConsoleKind : std::uint8_t { kStdio, kPty, kPath };
+
+struct Options {
+  const char* world_file = nullptr;  // --world FILE (sim board only)
+  std::uint64_t seed = 1;            // --seed N
+  std::uint64_t max_cycles = 0;      // --max-cycles N; 0 = no limit
+  const char* snapshots_dir = nullptr;  // --snapshots DIR
+  const char* trace_file = nullptr;     // --trace FILE
+  ConsoleKind console = ConsoleKind::kStdio;  // --console stdio|pty|PATH
+  const char* console_path = nullptr;         // the PATH of --console PATH
+  const char* state_dir = nullptr;            // --state DIR
+  bool resume = false;                        // --resume
+  bool show_help = false;                     // --help
+  bool show_version = false;                  // --version
+};
+
+struct ParseResult {
+  bool ok = false;
+  // When !ok: what was wrong, e.g. "unknown option '--foo'". Points into a static buffer
+  // or a literal; valid until the next parse.
+  const char* error = "";
+};
+
+// Parses argv[1..argc). `simulated` is false on hardware boards, where --world is refused.
+ParseResult parse_options(int argc, const char* const* argv, bool simulated, Options& out);
+
+// The usage text printed by --help and after a usage error.
+const char* usage_text();
+
+}  // namespace boticelli::firmware

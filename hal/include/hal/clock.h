@@ -1,0 +1,20 @@
+// Clock: the board's monotonic time; on the sim board it is simulated and advances in lockstep.
+#pragma once
+
+#include <cstdint>
+
+#include "hal/noncopyable.h"
+
+namespace boticelli::hal {
+
+class Clock : private NonCopyable {
+ public:
+  virtual ~Clock() = default;
+  // Monotonic time [µs] since an arbitrary epoch.
+  virtual std::uint64_t now_us() = 0;
+  // Waits until now_us() ≥ deadline_us (clock_nanosleep TIMER_ABSTIME on Linux; the sim
+  // board advances simulated time to the deadline instead). Returns at once if past.
+  virtual void sleep_until_us(std::uint64_t deadline_us) = 0;
+};
+
+}  // namespace boticelli::hal

@@ -1,0 +1,106 @@
+#!/usr/bin/env bash
+# Installs, from Debian's packages only, what Boticelli's build, tests and benchmarks need.
+#
+#   toolchain/install-deps.sh            host build and tests (sim, asan presets)
+#   toolchain/install-deps.sh --cross    also the aarch64 cross compiler, qemu-user and the
+#                                        :arm64 libraries (rpi4 preset)
+#   toolchain/install-deps.sh --armhf    also the 32-bit arm-linux-gnueabihf compiler and
+#                                        the :armhf libraries (armhf preset)
+#   toolchain/install-deps.sh --bench    also the peers the benchmarks compare against
+#                                        (OpenCV, OctoMap); never needed by the firmware
+#
+# Idempotent: when everything is present it prints nothing and exits 0.
+set -euo pipefail
+
+want_cross=0
+want_bench=0
+want_armhf=0
+for arg in "$@"; do
+  case "$arg" in
+    --cross) want_cross=1 ;;
+    --bench) want_bench=1 ;;
+    --armhf) want_armhf=1 ;;
+    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "install-deps: unknown option '$arg' (try --help)" >&2; exit 2 ;;
+  esac
+done
+
+host_pkgs=(
+  g++ make cmake pkg-config clang-format file
+  libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
+)
+cross_pkgs=(
+  g++-aarch64-linux-gnu qemu-user
+  libcpputest-dev:arm64 libgpiod-dev:arm64 libtinyxml2-dev:arm64 libpng-dev:arm64
+)
+armhf_pkgs=(
+  g++-arm-linux-gnueabihf
+  libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf libpng-dev:armhf
+)
+bench_pkgs=(libopencv-dev liboctomap-dev)
+
+pkgs=("${host_pkgs[@]}")
+[ "$want_cross" = 1 ] && pkgs+=("${cross_pkgs[@]}")
+[ "$want_armhf" = 1 ] && pkgs+=("${armhf_pkgs[@]}")
+[ "$want_bench" = 1 ] && pkgs+=("${bench_pkgs[@]}")
+
+if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
+  echo "install-deps: this script needs a Debian-based system (dpkg and apt-get); install by hand: ${pkgs[*]}" >&2
+  exit 1
+fi
+
+native=$(dpkg --print-architecture)
+missing=()
+for p in "${pkgs[@]}"; do
+  q=$p
+  case "$p" in *:*) ;; *) q="$p:$native" ;; esac
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$q" 2>/dev/null || true)
+  # Architecture-independent packages (e.g. Eigen) are known by their plain name.
+  [ -n "$status" ] || status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  [ "$status" = "installed" ] || missing+=("$p")
+done
+[ "${#missing[@]}" = 0 ] && exit 0
+
+sudo=()
+if [ "$(id -u)" != 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then
+    sudo=(sudo)
+  else
+    echo "install-deps: missing packages (${missing[*]}) and not root, and sudo is not available" >&2
+    exit 1
+  fi
+fi
+
+echo "install-deps: installing ${missing[*]}"
+needs_arch() {
+  local arch=$1
+  printf '%s\n' "${missing[@]}" | grep -q ":$arch\$" || return 1
+  dpkg --print-foreign-architectures | grep -qx "$arch" && return 1
+  return 0
+}
+for arch in arm64 armhf; do
+  if needs_arch "$arch"; then
+    "${sudo[@]}" dpkg --add-architecture "$arch"
+  fi
+done
+
+export DEBIAN_FRONTEND=noninteractive
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+# A mirror in mid-sync can fail one index file; retry, then go on with the lists apt has
+# (the install below still fails clearly if a package cannot be had).
+updated=0
+for attempt in 1 2 3; do
+  if "${sudo[@]}" apt-get update -qq >"$log" 2>&1; then updated=1; break; fi
+  sleep $((attempt * 5))
+done
+if [ "$updated" = 0 ]; then
+  grep -E '^(E|W):' "$log" | head -n 5 >&2 || true
+  echo "install-deps: warning: 'apt-get update' reported errors; trying the install with the package lists apt has" >&2
+fi
+if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >"$log" 2>&1; then
+  tail -n 30 "$log" >&2
+  echo "install-deps: could not install: ${missing[*]}" >&2
+  exit 1
+fi
+echo "install-deps: done"
