@@ -7,9 +7,10 @@
 
 namespace boticelli::firmware {
 
-int firmware_main(int argc, const char* const* argv, const BoardInfo& board) {
+int firmware_main(int argc, const char* const* argv, Board& board) {
+  const BoardInfo& info = board.info();
   Options options;
-  const ParseResult parsed = parse_options(argc, argv, board.simulated, options);
+  const ParseResult parsed = parse_options(argc, argv, info.simulated, options);
   if (!parsed.ok) {
     std::fprintf(stderr, "boticelli: %s\n%s", parsed.error, usage_text());
     return 2;
@@ -18,7 +19,7 @@ int firmware_main(int argc, const char* const* argv, const BoardInfo& board) {
     std::fputs(usage_text(), stdout);
     return 0;
   }
-  std::printf("boticelli %s board=%s (%s)\n", BOTICELLI_VERSION, board.name, board.description);
+  std::printf("boticelli %s board=%s (%s)\n", BOTICELLI_VERSION, info.name, info.description);
   return 0;
 }
 

@@ -1,0 +1,60 @@
+// Board: what a board folder hands the firmware — its description, its config and its HAL bag.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "firmware/options.h"
+#include "hal/hal.h"
+
+namespace boticelli::firmware {
+
+struct BoardInfo {
+  const char* name;         // folder in boards/, e.g. "sim"
+  const char* description;  // one line for --version
+  bool simulated;           // true for the sim board (accepts --world)
+};
+
+// Declarative description of the robot a board drives. Values are the board's own (see
+// boards/<board>/board_config.cpp); units are in the names. The thesis's reference robot
+// (§3.4, App. A): 640x480 camera averaged to 160x120 with F = 150 px there, L = 21 cm,
+// tilt step Φ = 7.7°.
+struct BoardConfig {
+  // Camera at full resolution (what the driver delivers).
+  std::uint32_t camera_width_px = 640;
+  std::uint32_t camera_height_px = 480;
+  float focal_px = 600.0F;          // focal length at full resolution [px]
+  float principal_x_px = 320.0F;    // principal point [px]
+  float principal_y_px = 240.0F;
+  float radial_k1 = 0.0F;           // radial distortion, normalised coordinates
+  // Pan-tilt unit and the L-shaped camera support (App. A).
+  float ptu_height_m = 0.6F;        // PTU centre (pan and tilt axes) above the floor [m]
+  float lever_m = 0.21F;            // tilt axis to camera optical centre, L [m]
+  float support_angle_rad = 0.0F;   // angle Ω of the L-support between lever and optical axis [rad]
+  float tilt_step_rad = 0.134390352F;  // tilt between the two stereo frames, Φ = 7.7° [rad]
+  // Base.
+  float robot_radius_m = 0.25F;     // radius of the cylinder that contains the robot [m]
+  float robot_height_m = 0.8F;      // height of that cylinder [m]
+  float wheel_radius_m = 0.08F;     // [m]
+  float track_width_m = 0.40F;      // distance between the wheels [m]
+  float max_speed_m_s = 0.3F;       // forward speed limit [m/s]
+  float max_turn_rate_rad_s = 0.8F; // yaw rate limit [rad/s]
+  // Executive and console.
+  std::uint32_t minor_frame_us = 10000;   // executive minor frame [µs]
+  std::uint32_t console_baud = 115200;
+  std::uint32_t telemetry_period_ms = 1000;
+};
+
+class Board {
+ public:
+  virtual ~Board() = default;
+  virtual const BoardInfo& info() const = 0;
+  virtual const BoardConfig& config() const = 0;
+  // Creates and opens the devices for these options (the sim board loads --world). On
+  // failure returns false and writes a one-line reason into `error`.
+  virtual bool init(const Options& options, char* error, std::size_t error_size) = 0;
+  // The devices; valid after a successful init().
+  virtual hal::Hal& hal() = 0;
+};
+
+}  // namespace boticelli::firmware
