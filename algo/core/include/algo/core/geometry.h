@@ -1,0 +1,39 @@
+// Small plane geometry shared by mapping, planning and persistence: points and poses in the world frame.
+#pragma once
+
+#include <cmath>
+
+namespace boticelli::core {
+
+// A point on the floor plane [m] (world or robot frame, as the owner says).
+struct Point2 {
+  float x_m = 0.0F;
+  float y_m = 0.0F;
+};
+
+// The robot's pose on the floor: position [m] and heading [rad], counter-clockwise from +x.
+struct Pose2 {
+  float x_m = 0.0F;
+  float y_m = 0.0F;
+  float yaw_rad = 0.0F;
+};
+
+inline float distance_m(Point2 a, Point2 b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+
+// Robot frame → world frame.
+inline Point2 to_world(const Pose2& pose, Point2 p) {
+  const float c = std::cos(pose.yaw_rad);
+  const float s = std::sin(pose.yaw_rad);
+  return {pose.x_m + c * p.x_m - s * p.y_m, pose.y_m + s * p.x_m + c * p.y_m};
+}
+
+// World frame → robot frame.
+inline Point2 to_robot(const Pose2& pose, Point2 p) {
+  const float c = std::cos(pose.yaw_rad);
+  const float s = std::sin(pose.yaw_rad);
+  const float dx = p.x_m - pose.x_m;
+  const float dy = p.y_m - pose.y_m;
+  return {c * dx + s * dy, -s * dx + c * dy};
+}
+
+}  // namespace boticelli::core
