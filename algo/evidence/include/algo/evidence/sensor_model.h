@@ -21,6 +21,8 @@ inline float range_error_m(float r_m, float baseline_m, float focal_px) {
 }
 
 // The thesis's sensor model (§3.7.3) uses the simpler δr = 0.1 r.
-inline float model_range_error_m(float r_m) { return 0.1F * r_m; }
+inline float model_range_error_m(float r_m) {
+  return 0.1F * r_m;
+}
 
 }  // namespace boticelli::evidence

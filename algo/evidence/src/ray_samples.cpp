@@ -1,0 +1,193 @@
+// Ray samples of the visual sensor model: placement along the ray, seam copies and pads.
+#include "algo/evidence/ray_samples.h"
+
+#include <array>
+#include <cmath>
+
+#include "algo/core/angles.h"
+
+namespace boticelli::evidence {
+namespace {
+
+bool valid(const RaySampleParams& params) {
+  return params.samples_per_reading >= 3 && params.samples_per_reading <= kMaxSamplesPerReading &&
+         params.delta_r_fraction > 0.0F && params.ramp_length_delta_r > 0.0F;
+}
+
+// A sample on the reading's ray of view at distance s [m] (height scales with s/r).
+RaySample on_ray(const Reading& reading, float s_m, float occupancy) {
+  const float h_m = reading.r_m > 0.0F ? reading.h_m * (s_m / reading.r_m) : 0.0F;
+  return {reading.alpha_rad, h_m, s_m, occupancy};
+}
+
+// Appends the plausibility samples; the caller has checked the room.
+void put_plausibility(const Reading& reading, const RaySampleParams& params, RaySampleBuffer& out) {
+  const float r = reading.r_m;
+  const float dr = params.delta_r_fraction * r;  // δr = 0.1 r (§3.7.3)
+  const std::size_t k = params.samples_per_reading - 3;
+  // Two plateau samples at evidence m: the range error of Eq 3.7 around the point.
+  (void)out.push_back(on_ray(reading, r + dr, reading.m));
+  (void)out.push_back(on_ray(reading, r - dr, reading.m));
+  // Lower samples towards the camera: occupancy falls gradually (Fig 3.8b).
+  const float kf = static_cast<float>(k);
+  for (std::size_t j = 1; j <= k; ++j) {
+    const float jf = static_cast<float>(j);
+    const float s = r - (1.0F + jf * params.ramp_length_delta_r / kf) * dr;
+    const float m = reading.m * (1.0F - jf / (kf + 1.0F));
+    (void)out.push_back(on_ray(reading, s > 0.0F ? s : 0.0F, m));
+  }
+  // The robot centre is empty (Fig 4.2b).
+  (void)out.push_back({reading.alpha_rad, 0.0F, 0.0F, 0.0F});
+}
+
+}  // namespace
+
+std::size_t append_plausibility_samples(const Reading& reading, const RaySampleParams& params,
+                                        RaySampleBuffer& out) {
+  if (!valid(params) || !(reading.r_m > 0.0F) ||
+      out.capacity() - out.size() < params.samples_per_reading) {
+    return 0;
+  }
+  put_plausibility(reading, params, out);
+  return params.samples_per_reading;
+}
+
+std::size_t append_belief_samples(const Reading& reading, const RaySampleParams& params,
+                                  RaySampleBuffer& out) {
+  const std::size_t n = belief_samples_per_reading(params);
+  if (!valid(params) || !(reading.r_m > 0.0F) || out.capacity() - out.size() < n) {
+    return 0;
+  }
+  put_plausibility(reading, params, out);
+  const float r = reading.r_m;
+  const float dr = params.delta_r_fraction * r;
+  const std::size_t k = params.samples_per_reading - 3;
+  const float kf = static_cast<float>(k);
+  // Behind the point the evidence falls back to zero (§3.7.3): the ramp mirrored.
+  for (std::size_t j = 1; j <= k; ++j) {
+    const float jf = static_cast<float>(j);
+    const float s = r + (1.0F + jf * params.ramp_length_delta_r / kf) * dr;
+    (void)out.push_back(on_ray(reading, s, reading.m * (1.0F - jf / (kf + 1.0F))));
+  }
+  const float s_zero = r + (1.0F + params.ramp_length_delta_r * (kf + 1.0F) / kf) * dr;
+  (void)out.push_back(on_ray(reading, s_zero, 0.0F));
+  return n;
+}
+
+std::size_t append_ray_samples(std::span<const Reading> readings, const RaySampleParams& params,
+                               OccupancyBound bound, RaySampleBuffer& out) {
+  std::size_t fitted = 0;
+  for (const Reading& reading : readings) {
+    const std::size_t added = bound == OccupancyBound::kPlausibility
+                                  ? append_plausibility_samples(reading, params, out)
+                                  : append_belief_samples(reading, params, out);
+    if (added > 0) {
+      ++fitted;
+    }
+  }
+  return fitted;
+}
+
+std::size_t append_seam_copies(RaySampleBuffer& samples, float margin_rad) {
+  constexpr float kTwoPi = core::kTwoPi<float>;
+  const std::size_t original = samples.size();
+  std::size_t copies = 0;
+  for (std::size_t i = 0; i < original; ++i) {
+    const RaySample s = samples[i];
+    if (s.alpha_rad < margin_rad) {
+      RaySample c = s;
+      c.alpha_rad += kTwoPi;
+      if (!samples.push_back(c)) {
+        return copies;
+      }
+      ++copies;
+    }
+    if (s.alpha_rad > kTwoPi - margin_rad) {
+      RaySample c = s;
+      c.alpha_rad -= kTwoPi;
+      if (!samples.push_back(c)) {
+        return copies;
+      }
+      ++copies;
+    }
+  }
+  return copies;
+}
+
+float PadRandom::uniform() {
+  // xorshift32 (Marsaglia 2003); state never becomes zero from a non-zero seed.
+  if (state == 0U) {
+    state = 0x9E3779B9U;
+  }
+  state ^= state << 13U;
+  state ^= state >> 17U;
+  state ^= state << 5U;
+  return static_cast<float>(state >> 8U) * (1.0F / 16777216.0F);
+}
+
+namespace {
+float lerp(float a, float b, float t) {
+  return a + (b - a) * t;
+}
+}  // namespace
+
+std::size_t append_zero_pads(const PadRegion& region, std::size_t count, PadRandom& random,
+                             RaySampleBuffer& out) {
+  std::size_t added = 0;
+  for (; added < count; ++added) {
+    const float a = lerp(region.alpha_min_rad, region.alpha_max_rad, random.uniform());
+    const float h = lerp(region.h_min_m, region.h_max_m, random.uniform());
+    const float r = lerp(region.r_min_m, region.r_max_m, random.uniform());
+    if (!out.push_back({a, h, r, 0.0F})) {
+      break;
+    }
+  }
+  return added;
+}
+
+std::size_t append_featureless_pads(std::span<const Reading> readings, const PadRegion& region,
+                                    const FeaturelessPadParams& params, PadRandom& random,
+                                    RaySampleBuffer& out) {
+  const std::size_t na = params.alpha_bins;
+  const std::size_t nh = params.h_bins;
+  const float alpha_span = region.alpha_max_rad - region.alpha_min_rad;
+  const float h_span = region.h_max_m - region.h_min_m;
+  if (na == 0 || nh == 0 || na > kMaxPadBins || nh > kMaxPadBins || !(alpha_span > 0.0F) ||
+      !(h_span > 0.0F)) {
+    return 0;
+  }
+  std::array<bool, kMaxPadBins * kMaxPadBins> seen{};
+  const float naf = static_cast<float>(na);
+  const float nhf = static_cast<float>(nh);
+  for (const Reading& reading : readings) {
+    const float ta = (reading.alpha_rad - region.alpha_min_rad) / alpha_span;
+    const float th = (reading.h_m - region.h_min_m) / h_span;
+    if (ta < 0.0F || ta >= 1.0F || th < 0.0F || th >= 1.0F) {
+      continue;
+    }
+    const auto ia = static_cast<std::size_t>(ta * naf);
+    const auto ih = static_cast<std::size_t>(th * nhf);
+    seen[(ia < na ? ia : na - 1) * nh + (ih < nh ? ih : nh - 1)] = true;
+  }
+  std::size_t added = 0;
+  for (std::size_t ia = 0; ia < na; ++ia) {
+    for (std::size_t ih = 0; ih < nh; ++ih) {
+      if (seen[ia * nh + ih]) {
+        continue;
+      }
+      for (std::size_t p = 0; p < params.pads_per_empty_cell; ++p) {
+        const float a =
+            region.alpha_min_rad + alpha_span * (static_cast<float>(ia) + random.uniform()) / naf;
+        const float h = region.h_min_m + h_span * (static_cast<float>(ih) + random.uniform()) / nhf;
+        const float r = lerp(region.r_min_m, region.r_max_m, random.uniform());
+        if (!out.push_back({a, h, r, 0.0F})) {
+          return added;
+        }
+        ++added;
+      }
+    }
+  }
+  return added;
+}
+
+}  // namespace boticelli::evidence

@@ -1,0 +1,155 @@
+// Tests of the ray samples of the visual sensor model (Fig 4.2b), seam copies and pads (§4.9.1).
+#include <cmath>
+#include <cstddef>
+
+#include "algo/core/angles.h"
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/ray_samples.h"
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+using namespace boticelli;
+using namespace boticelli::evidence;
+
+TEST_GROUP(RaySamples) {
+  core::FixedVector<RaySample, 256> samples;
+  RaySampleParams params;
+  const Reading reading{1.0F, 0.6F, 3.0F, 0.9F};  // α = 1 rad, h = 0.6 m, r = 3 m, m = 0.9
+};
+
+TEST(RaySamples, DefaultReadingExpandsIntoFiveSamplesPlacedAsTheThesisSays) {
+  LONGS_EQUAL(5, append_plausibility_samples(reading, params, samples));
+  LONGS_EQUAL(5, samples.size());
+  // Plateau at evidence m around r ± δr, δr = 0.3 m.
+  DOUBLES_EQUAL(3.3, samples[0].r_m, 1e-5);
+  DOUBLES_EQUAL(0.9, samples[0].occupancy, 1e-6);
+  DOUBLES_EQUAL(2.7, samples[1].r_m, 1e-5);
+  DOUBLES_EQUAL(0.9, samples[1].occupancy, 1e-6);
+  // Two lower samples towards the camera: 2/3 m at r − 2δr, 1/3 m at r − 3δr.
+  DOUBLES_EQUAL(2.4, samples[2].r_m, 1e-5);
+  DOUBLES_EQUAL(0.6, samples[2].occupancy, 1e-6);
+  DOUBLES_EQUAL(2.1, samples[3].r_m, 1e-5);
+  DOUBLES_EQUAL(0.3, samples[3].occupancy, 1e-6);
+  // The robot centre, empty.
+  DOUBLES_EQUAL(0.0, samples[4].r_m, 1e-9);
+  DOUBLES_EQUAL(0.0, samples[4].h_m, 1e-9);
+  DOUBLES_EQUAL(0.0, samples[4].occupancy, 1e-9);
+}
+
+TEST(RaySamples, SamplesLieOnTheRayOfViewSoHeightScalesWithDistance) {
+  (void)append_plausibility_samples(reading, params, samples);
+  for (const RaySample& s : samples) {
+    DOUBLES_EQUAL(1.0, s.alpha_rad, 1e-9);
+    DOUBLES_EQUAL(0.2 * static_cast<double>(s.r_m), s.h_m, 1e-5);
+  }
+}
+
+TEST(RaySamples, PlausibilitySamplesNeverDecreaseAwayFromTheCamera) {
+  params.samples_per_reading = 9;
+  LONGS_EQUAL(9, append_plausibility_samples(reading, params, samples));
+  // Sort-free check: for every pair, the farther sample has at least the occupancy.
+  for (const RaySample& a : samples) {
+    for (const RaySample& b : samples) {
+      if (b.r_m > a.r_m) {
+        CHECK(b.occupancy >= a.occupancy - 1e-6F);
+      }
+    }
+  }
+}
+
+TEST(RaySamples, BeliefSamplesFallBackToZeroBehindThePoint) {
+  const std::size_t n = append_belief_samples(reading, params, samples);
+  LONGS_EQUAL(8, n);
+  LONGS_EQUAL(belief_samples_per_reading(params), n);
+  float far_r = 0.0F;
+  float far_occ = 1.0F;
+  float max_occ = 0.0F;
+  for (const RaySample& s : samples) {
+    if (s.r_m > far_r) {
+      far_r = s.r_m;
+      far_occ = s.occupancy;
+    }
+    max_occ = std::fmax(max_occ, s.occupancy);
+  }
+  DOUBLES_EQUAL(0.0, far_occ, 1e-9);
+  CHECK(far_r > 3.3F);
+  DOUBLES_EQUAL(0.9, max_occ, 1e-6);
+  // The first five are the plausibility samples, so Bel ≤ Pl holds sample by sample.
+  core::FixedVector<RaySample, 16> pl;
+  (void)append_plausibility_samples(reading, params, pl);
+  for (std::size_t i = 0; i < pl.size(); ++i) {
+    DOUBLES_EQUAL(pl[i].r_m, samples[i].r_m, 1e-9);
+  }
+}
+
+TEST(RaySamples, AFullBufferTakesNoPartOfAReading) {
+  core::FixedVector<RaySample, 7> small;
+  LONGS_EQUAL(5, append_plausibility_samples(reading, params, small));
+  LONGS_EQUAL(0, append_plausibility_samples(reading, params, small));
+  LONGS_EQUAL(5, small.size());
+}
+
+TEST(RaySamples, InvalidParametersOrRangesGiveNoSamples) {
+  params.samples_per_reading = 2;
+  LONGS_EQUAL(0, append_plausibility_samples(reading, params, samples));
+  params.samples_per_reading = 5;
+  LONGS_EQUAL(0, append_plausibility_samples({0.0F, 0.0F, 0.0F, 0.9F}, params, samples));
+  CHECK(samples.empty());
+}
+
+TEST(RaySamples, ManyReadingsExpandWithoutAllocating) {
+  core::FixedVector<Reading, 32> readings;
+  for (int i = 0; i < 32; ++i) {
+    (void)readings.push_back({0.2F * static_cast<float>(i), 0.1F, 2.0F, 0.8F});
+  }
+  std::size_t fitted = 0;
+  CHECK_NO_ALLOCATION(
+      fitted = append_ray_samples(readings.span(), params, OccupancyBound::kPlausibility, samples));
+  LONGS_EQUAL(32, fitted);
+  LONGS_EQUAL(160, samples.size());
+}
+
+TEST(RaySamples, SeamCopiesMirrorSamplesNearZeroAndTwoPi) {
+  const float two_pi = core::kTwoPi<float>;
+  (void)samples.push_back({0.1F, 0.0F, 1.0F, 0.9F});
+  (void)samples.push_back({3.0F, 0.0F, 1.0F, 0.9F});
+  (void)samples.push_back({two_pi - 0.2F, 0.0F, 1.0F, 0.5F});
+  LONGS_EQUAL(2, append_seam_copies(samples, 0.5F));
+  LONGS_EQUAL(5, samples.size());
+  DOUBLES_EQUAL(0.1 + 2.0 * 3.14159265, samples[3].alpha_rad, 1e-5);
+  DOUBLES_EQUAL(-0.2, samples[4].alpha_rad, 1e-5);
+  DOUBLES_EQUAL(0.5, samples[4].occupancy, 1e-9);
+}
+
+TEST(RaySamples, ZeroPadsStayInTheirRegionAndRepeatForTheSameSeed) {
+  PadRegion region{0.0F, 1.0F, -0.5F, 0.5F, 1.0F, 2.0F};
+  PadRandom a{42U};
+  LONGS_EQUAL(100, append_zero_pads(region, 100, a, samples));
+  for (const RaySample& s : samples) {
+    CHECK(s.alpha_rad >= 0.0F && s.alpha_rad <= 1.0F);
+    CHECK(s.h_m >= -0.5F && s.h_m <= 0.5F);
+    CHECK(s.r_m >= 1.0F && s.r_m <= 2.0F);
+    DOUBLES_EQUAL(0.0, s.occupancy, 1e-12);
+  }
+  core::FixedVector<RaySample, 256> again;
+  PadRandom b{42U};
+  (void)append_zero_pads(region, 100, b, again);
+  DOUBLES_EQUAL(samples[57].r_m, again[57].r_m, 0.0);
+}
+
+TEST(RaySamples, FeaturelessPadsGoOnlyWhereNoReadingWasSeen) {
+  // Readings cover α ∈ [0, π) only; the other half is featureless.
+  core::FixedVector<Reading, 64> readings;
+  for (int i = 0; i < 64; ++i) {
+    const float a = 3.1F * static_cast<float>(i) / 64.0F;
+    (void)readings.push_back({a, -0.9F + 1.8F * static_cast<float>(i % 8) / 8.0F, 2.0F, 0.9F});
+  }
+  PadRegion region{};
+  FeaturelessPadParams pads{8, 1, 5};
+  PadRandom random{7U};
+  const std::size_t added = append_featureless_pads(readings.span(), region, pads, random, samples);
+  LONGS_EQUAL(4 * 5, added);
+  for (const RaySample& s : samples) {
+    CHECK(s.alpha_rad >= core::kPi<float> - 1e-4F);
+  }
+}
