@@ -1,13 +1,51 @@
-// Firmware entry: parse options, report version and board (the mission comes in a later stage).
+// Firmware entry: options, board init, executive with the device tasks and the console, MISSION line.
 #include "firmware/firmware_main.h"
 
+#include <csignal>
 #include <cstdio>
+#include <ctime>
 
+#include "firmware/console.h"
+#include "firmware/device_tasks.h"
+#include "firmware/executive.h"
+#include "firmware/idle_mission.h"
+#include "firmware/mission_state.h"
 #include "firmware/options.h"
+#include "firmware/parameters.h"
+#include "firmware/persistence.h"
+#include "firmware/realtime.h"
+#include "firmware/safety.h"
+#include "firmware/service_notify.h"
+#include "firmware/task_table.h"
 
 namespace boticelli::firmware {
+namespace {
+
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_signal(int signal) { g_signal = signal; }
+
+double wall_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+// Static storage: nothing on the cyclic path allocates, and the large buffers (state, file
+// image, console ring) stay off the stack.
+MissionState g_state;
+StateStore g_store;
+ParameterTable g_parameters;
+
+int fail(const char* what, const char* why) {
+  std::fprintf(stderr, "boticelli: %s%s%s\n", what, why[0] != '\0' ? ": " : "", why);
+  return 1;
+}
+
+}  // namespace
 
 int firmware_main(int argc, const char* const* argv, Board& board) {
+  const double wall_start_s = wall_seconds();
   const BoardInfo& info = board.info();
   Options options;
   const ParseResult parsed = parse_options(argc, argv, info.simulated, options);
@@ -20,7 +58,136 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
     return 0;
   }
   std::printf("boticelli %s board=%s (%s)\n", BOTICELLI_VERSION, info.name, info.description);
-  return 0;
+  std::fflush(stdout);
+  if (options.show_version) return 0;
+
+  char error[256] = "";
+  if (!board.init(options, error, sizeof error)) return fail(error, "");
+  const BoardConfig& config = board.config();
+  hal::Hal& hal = board.hal();
+
+  // Mission state: fresh, or resumed from --state DIR.
+  StateStore* store = nullptr;
+  if (options.state_dir != nullptr) {
+    if (!g_store.open(options.state_dir, error, sizeof error)) return fail(error, "");
+    store = &g_store;
+  }
+  g_state.clear();
+  g_state.seed = options.seed;
+  if (options.resume) {
+    const LoadResult loaded = g_store.load(g_state, error, sizeof error);
+    if (loaded != LoadResult::kLoaded) return fail("cannot resume", error);
+    std::fprintf(stderr, "boticelli: resumed from %s at cycle %llu\n", g_store.path(),
+                 static_cast<unsigned long long>(g_state.cycle));
+  }
+
+  // Devices.
+  if (!hal.console.open()) return fail("console", hal.console.error());
+  if (!hal.base.init()) return fail("base", hal.base.error());
+  if (!hal.pan_tilt.init()) return fail("pan-tilt unit", hal.pan_tilt.error());
+  if (!hal.camera.init()) return fail("camera", hal.camera.error());
+  bool watchdog_armed = false;
+  if (config.watchdog_timeout_ms != 0) {
+    watchdog_armed = hal.watchdog.start(config.watchdog_timeout_ms);
+    if (!watchdog_armed) {
+      std::fprintf(stderr, "boticelli: watchdog not armed (%s)\n", hal.watchdog.error());
+    }
+  }
+  static ServiceNotifier notifier;
+  if (!notifier.open()) std::fprintf(stderr, "boticelli: %s\n", notifier.error());
+
+  // The executive and its tasks.
+  static Executive executive(hal.clock);
+  static Safety safety(hal.estop, hal.bumper, hal.base);
+  static IdleMission mission(hal.base, hal.pan_tilt, hal.clock, g_state, store,
+                             config.checkpoint_period_ms * 1000U);
+  static Console console(hal.console, executive, safety, mission, g_parameters);
+  static EstopTask estop_task(safety);
+  static BaseTask base_task(hal.base, safety);
+  static PanTiltTask ptu_task(hal.pan_tilt);
+  static CameraTask camera_task(hal.camera);
+  static ConsoleTask console_task(console);
+  static WatchdogTask watchdog_task(executive, hal.watchdog, notifier, hal.status_led);
+  Task* const tasks[kTaskCount] = {&estop_task,  &base_task,    &ptu_task,
+                                   &camera_task, &console_task, &watchdog_task};
+  const char* why = "";
+  for (std::size_t i = 0; i < kTaskCount; ++i) {
+    if (!executive.add_task(kTaskTable[i], *tasks[i], &why)) return fail("executive", why);
+  }
+  executive.set_background(&mission);
+  console.set_telemetry_ms(static_cast<float>(config.telemetry_period_ms));
+  float background_slice_us = 0.0F;
+  if (!console.register_parameters() ||
+      !g_parameters.add({"bg_slice_us", &background_slice_us, 0.0F,
+                         static_cast<float>(config.minor_frame_us), true,
+                         "longest background slice [us], 0 = rest of the frame"})) {
+    return fail("console parameters", "table full");
+  }
+
+  if (config.realtime) {
+    RealtimeConfig rt;
+    rt.fifo_priority = config.fifo_priority;
+    const RealtimeReport report = prepare_realtime(rt);
+    std::fprintf(stderr, "boticelli: %s\n", report.message);
+  }
+
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+
+  ExecutiveConfig exec_config;
+  exec_config.frame_us = config.minor_frame_us;
+  exec_config.background_units_per_slice = config.background_units_per_slice;
+  if (!executive.start(exec_config, &why)) return fail("executive", why);
+  const std::uint64_t start_us = hal.clock.now_us();
+  mission.start(start_us);
+  console.log(LogLevel::kInfo, "boticelli %s on %s: ready", BOTICELLI_VERSION, info.name);
+  notifier.ready();
+
+  const char* stop_reason = "";
+  for (;;) {
+    executive.set_background_max_slice_us(static_cast<std::uint32_t>(background_slice_us));
+    executive.run_frame();
+    if (g_signal != 0) {
+      stop_reason = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
+      break;
+    }
+    if (console.shutdown_requested()) {
+      stop_reason = "console shutdown";
+      break;
+    }
+    if (options.max_cycles != 0 && mission.cycles_this_run() >= options.max_cycles) {
+      stop_reason = "max cycles";
+      break;
+    }
+  }
+
+  // Orderly stop: base and PTU halted, watchdog disarmed, console drained (bounded).
+  notifier.stopping();
+  hal.base.stop();
+  hal.pan_tilt.halt();
+  if (watchdog_armed) hal.watchdog.stop();
+  console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
+  for (int i = 0; i < 50 && console.pending_output() > 0 && console.healthy(); ++i) {
+    console.service(hal.clock.now_us());
+    hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);
+  }
+  if (mission.save_failures() > 0) {
+    std::fprintf(stderr, "boticelli: %llu state saves failed, last: %s\n",
+                 static_cast<unsigned long long>(mission.save_failures()), mission.last_error());
+  }
+  const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
+  // No mission yet: the run ends aborted (never found), with no target estimate.
+  std::printf(
+      "MISSION result=aborted cycles=%llu collisions=%llu sim_time_s=%.3f wall_time_s=%.3f "
+      "target_error_m=nan\n",
+      static_cast<unsigned long long>(g_state.cycle),
+      static_cast<unsigned long long>(safety.collisions()), sim_time_s,
+      wall_seconds() - wall_start_s);
+  std::fflush(stdout);
+  return kExitNotFound;
 }
 
 }  // namespace boticelli::firmware

@@ -43,6 +43,15 @@ struct BoardConfig {
   std::uint32_t minor_frame_us = 10000;   // executive minor frame [µs]
   std::uint32_t console_baud = 115200;
   std::uint32_t telemetry_period_ms = 1000;
+  // Linux process set-up for the executive (firmware/realtime.h): mlockall, prefaulted
+  // stack, SCHED_FIFO at this priority when permitted. Off on the host simulation.
+  bool realtime = false;
+  int fifo_priority = 50;
+  std::uint32_t watchdog_timeout_ms = 2000;  // /dev/watchdog timeout; 0 = do not arm it
+  // Background units per frame (0 = limited by time only); a simulated board may set it so
+  // the work done per frame does not depend on the host's speed.
+  std::uint32_t background_units_per_slice = 0;
+  std::uint32_t checkpoint_period_ms = 1000;  // idle cycle length until the mission lands
 };
 
 class Board {
@@ -50,8 +59,9 @@ class Board {
   virtual ~Board() = default;
   virtual const BoardInfo& info() const = 0;
   virtual const BoardConfig& config() const = 0;
-  // Creates and opens the devices for these options (the sim board loads --world). On
-  // failure returns false and writes a one-line reason into `error`.
+  // Creates the devices for these options (the sim board loads --world). The firmware then
+  // calls each device's init()/open() once. On failure returns false and writes a one-line
+  // reason into `error`.
   virtual bool init(const Options& options, char* error, std::size_t error_size) = 0;
   // The devices; valid after a successful init().
   virtual hal::Hal& hal() = 0;

@@ -5,8 +5,16 @@
 
 namespace boticelli::firmware {
 
-// Parses the command line and runs the firmware on the board. Returns the process exit
-// code: 0 for success, 2 for a usage error.
+// Exit codes: 0 the target was found (or --help/--version), 1 a failure (board, device or
+// state could not be set up), 2 a usage error, 3 the mission ended without finding the
+// target (result=not_found or aborted, e.g. stopped by a signal, the console or --max-cycles).
+inline constexpr int kExitFound = 0;
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitNotFound = 3;
+
+// Parses the command line and runs the firmware on the board until a signal, the console's
+// shutdown or --max-cycles; prints the MISSION line last and returns the exit code.
 int firmware_main(int argc, const char* const* argv, Board& board);
 
 }  // namespace boticelli::firmware

@@ -1,0 +1,404 @@
+// Console: command execution, telemetry and output buffering (see console.h, docs/console.md).
+#include "firmware/console.h"
+
+#include <cstdarg>
+#include <cstring>
+
+namespace boticelli::firmware {
+namespace {
+
+constexpr std::string_view kEol = "\r\n";
+
+}  // namespace
+
+const char* log_level_name(LogLevel level) {
+  switch (level) {
+    case LogLevel::kError:
+      return "error";
+    case LogLevel::kWarn:
+      return "warn";
+    case LogLevel::kInfo:
+      return "info";
+    case LogLevel::kDebug:
+      return "debug";
+  }
+  return "?";
+}
+
+bool parse_log_level(std::string_view text, LogLevel& out) {
+  for (const LogLevel l : {LogLevel::kError, LogLevel::kWarn, LogLevel::kInfo, LogLevel::kDebug}) {
+    if (text == log_level_name(l)) {
+      out = l;
+      return true;
+    }
+  }
+  return false;
+}
+
+const Console::Command Console::kCommands[] = {
+    {"help", "", "list the commands", &Console::cmd_help},
+    {"status", "", "state, e-stop, pause, health, cycles, uptime", &Console::cmd_status},
+    {"stats", "[reset]", "executive timing per task, frame jitter, background use",
+     &Console::cmd_stats},
+    {"pose", "", "robot pose in the world frame", &Console::cmd_pose},
+    {"model", "", "the occupancy ALN in the text format", &Console::cmd_model},
+    {"map", "", "navigation polygon and point list sizes", &Console::cmd_map},
+    {"pause", "", "pause the background work (mission)", &Console::cmd_pause},
+    {"resume", "", "resume the background work", &Console::cmd_resume},
+    {"estop", "", "stop the base now and latch the e-stop", &Console::cmd_estop},
+    {"clear-estop", "", "release the e-stop latch when no input is active",
+     &Console::cmd_clear_estop},
+    {"get", "[NAME]", "show one or every parameter", &Console::cmd_get},
+    {"set", "NAME VALUE", "set a parameter (range checked)", &Console::cmd_set},
+    {"log", "[error|warn|info|debug]", "show or set the log level", &Console::cmd_log},
+    {"shutdown", "", "stop the firmware in an orderly way", &Console::cmd_shutdown},
+    {"quit", "", "same as shutdown", &Console::cmd_shutdown},
+};
+
+Console::Console(hal::SerialPort& port, Executive& executive, Safety& safety, MissionView& view,
+                 ParameterTable& parameters)
+    : port_(port), executive_(executive), safety_(safety), view_(view), parameters_(parameters) {}
+
+bool Console::register_parameters() {
+  return parameters_.add({"telemetry_ms", &telemetry_ms_, 0.0F, 60000.0F, true,
+                          "telemetry period [ms], 0 = off"}) &&
+         parameters_.add({"echo", &echo_, 0.0F, 1.0F, true, "echo typed characters (0/1)"});
+}
+
+bool Console::emit(std::string_view bytes) {
+  if (bytes.size() > tx_free()) {
+    dropped_bytes_ += bytes.size();
+    return false;
+  }
+  std::size_t tail = (tx_head_ + tx_used_) % kTxBytes;
+  for (const char c : bytes) {
+    tx_[tail] = c;
+    tail = tail + 1 == kTxBytes ? 0 : tail + 1;
+  }
+  tx_used_ += bytes.size();
+  return true;
+}
+
+void Console::flush() {
+  while (tx_used_ > 0 && !port_fault_) {
+    const std::size_t chunk = tx_head_ + tx_used_ <= kTxBytes ? tx_used_ : kTxBytes - tx_head_;
+    const std::ptrdiff_t n =
+        port_.write(reinterpret_cast<const std::uint8_t*>(tx_.data() + tx_head_), chunk);
+    if (n < 0) {
+      port_fault_ = true;
+      return;
+    }
+    if (n == 0) return;
+    const std::size_t sent = static_cast<std::size_t>(n);
+    tx_head_ = (tx_head_ + sent) % kTxBytes;
+    tx_used_ -= sent;
+    if (sent < chunk) return;
+  }
+}
+
+void Console::reply_error(const char* reason) {
+  ++errors_;
+  reply_.clear();
+  reply_.appendf("ERR %s", reason);
+  reply_.append(kEol);
+  emit(reply_.view());
+}
+
+void Console::log(LogLevel level, const char* format, ...) {
+  if (level > log_level_) return;
+  TextBuffer<256> text;
+  text.appendf("LOG %s ", log_level_name(level));
+  std::va_list args;
+  va_start(args, format);
+  text.vappendf(format, args);
+  va_end(args);
+  if (text.size() > 256 - 3) text.clear();  // never cut a line in the middle of the protocol
+  if (text.size() == 0) return;
+  text.append(kEol);
+  emit(text.view());
+}
+
+void Console::service(std::uint64_t now_us) {
+  now_us_ = now_us;
+  if (!started_) {
+    started_ = true;
+    start_us_ = now_us;
+    next_telemetry_us_ = now_us;
+    next_overrun_log_us_ = now_us;
+  }
+  flush();
+  stream_model();
+  // Input is taken only while a full reply fits, so replies are never cut (the serial
+  // driver keeps the bytes meanwhile).
+  while (model_pending_.empty() && tx_free() >= kReplyBytes + 8) {
+    if (rx_pos_ == rx_len_) {
+      if (port_fault_) break;
+      const std::ptrdiff_t n = port_.read(rx_.data(), rx_.size());
+      if (n < 0) {
+        port_fault_ = true;
+        break;
+      }
+      if (n == 0) break;
+      rx_pos_ = 0;
+      rx_len_ = static_cast<std::size_t>(n);
+    }
+    const LineEvent event = line_.feed(rx_[rx_pos_++]);
+    if (echo_ != 0.0F && !line_.echo().empty()) emit(line_.echo());
+    switch (event) {
+      case LineEvent::kNone:
+      case LineEvent::kCancelled:
+        break;
+      case LineEvent::kTooLong:
+        reply_error("line too long");
+        break;
+      case LineEvent::kBadByte:
+        reply_error("bad character in line");
+        break;
+      case LineEvent::kLine:
+        execute(line_.line());
+        stream_model();
+        break;
+    }
+  }
+  check_executive(now_us);
+  send_telemetry(now_us);
+  flush();
+}
+
+void Console::execute(std::string_view line) {
+  ++lines_;
+  Words words;
+  if (!split_words(line, words)) {
+    reply_error("too many arguments");
+    return;
+  }
+  if (words.count == 0) return;
+  for (const Command& c : kCommands) {
+    if (words.word[0] == c.name) {
+      reply_.clear();
+      (this->*c.handler)(words);
+      return;
+    }
+  }
+  reply_error("unknown command (try help)");
+}
+
+// Each handler either fills reply_ and ends it with OK, or calls reply_error() alone.
+namespace {
+bool no_args(const Words& w) { return w.count == 1; }
+}  // namespace
+
+void Console::cmd_help(const Words& w) {
+  if (!no_args(w)) return reply_error("help takes no arguments");
+  for (const Command& c : kCommands) {
+    reply_.appendf("%-12s %-24s %s\r\n", c.name, c.args, c.help);
+  }
+  reply_.append("OK\r\n");
+  emit(reply_.view());
+}
+
+void Console::cmd_status(const Words& w) {
+  if (!no_args(w)) return reply_error("status takes no arguments");
+  const FrameStats& f = executive_.frame_stats();
+  reply_.appendf(
+      "status state=%s estop=%s paused=%d healthy=%d cycles=%llu frames=%llu uptime_s=%.1f\r\n"
+      "OK\r\n",
+      view_.state_name(), stop_cause_name(safety_.cause()),
+      executive_.background_paused() ? 1 : 0, executive_.all_healthy() ? 1 : 0,
+      static_cast<unsigned long long>(view_.cycles()), static_cast<unsigned long long>(f.frames),
+      static_cast<double>(now_us_ - start_us_) * 1e-6);
+  emit(reply_.view());
+}
+
+void Console::cmd_stats(const Words& w) {
+  if (w.count == 2 && w.word[1] == "reset") {
+    executive_.reset_stats();
+    seen_frame_overruns_ = 0;
+    seen_background_overruns_ = 0;
+    reply_.append("OK\r\n");
+    emit(reply_.view());
+    return;
+  }
+  if (!no_args(w)) return reply_error("stats takes no argument or 'reset'");
+  for (std::size_t i = 0; i < executive_.task_count(); ++i) {
+    const TaskSpec& s = executive_.spec(i);
+    const TaskStats& t = executive_.task_stats(i);
+    reply_.appendf(
+        "task %-8s period_us=%u budget_us=%u runs=%llu avg_us=%llu worst_us=%u overruns=%llu\r\n",
+        s.name, s.period_us, s.budget_us, static_cast<unsigned long long>(t.runs),
+        static_cast<unsigned long long>(t.average_us()), t.worst_us,
+        static_cast<unsigned long long>(t.overruns));
+  }
+  const FrameStats& f = executive_.frame_stats();
+  reply_.appendf(
+      "frame frame_us=%u frames=%llu overruns=%llu missed=%llu jitter_avg_us=%llu "
+      "jitter_worst_us=%u\r\n"
+      "background util_pct=%.1f slices=%llu overruns=%llu done=%llu paused=%d\r\nOK\r\n",
+      executive_.config().frame_us, static_cast<unsigned long long>(f.frames),
+      static_cast<unsigned long long>(f.overruns), static_cast<unsigned long long>(f.missed_frames),
+      static_cast<unsigned long long>(f.jitter_average_us()), f.jitter_worst_us,
+      static_cast<double>(f.background_per_mille()) / 10.0,
+      static_cast<unsigned long long>(f.background_slices),
+      static_cast<unsigned long long>(f.background_overruns),
+      static_cast<unsigned long long>(f.background_done), executive_.background_paused() ? 1 : 0);
+  if (reply_.truncated()) return reply_error("stats reply too long");
+  emit(reply_.view());
+}
+
+void Console::cmd_pose(const Words& w) {
+  if (!no_args(w)) return reply_error("pose takes no arguments");
+  const core::Pose2 p = view_.pose();
+  reply_.appendf("pose x_m=%.3f y_m=%.3f yaw_rad=%.4f\r\nOK\r\n", static_cast<double>(p.x_m),
+                 static_cast<double>(p.y_m), static_cast<double>(p.yaw_rad));
+  emit(reply_.view());
+}
+
+void Console::cmd_model(const Words& w) {
+  if (!no_args(w)) return reply_error("model takes no arguments");
+  const std::string_view text = view_.model_text();
+  if (text.empty()) return reply_error("no model yet");
+  model_pending_ = text;
+}
+
+void Console::stream_model() {
+  if (model_pending_.empty()) return;
+  // Queue the text in pieces as the ring drains; then end the reply.
+  while (!model_pending_.empty()) {
+    const std::size_t room = tx_free();
+    if (room < 64) return;
+    const std::size_t n = model_pending_.size() < room - 32 ? model_pending_.size() : room - 32;
+    const bool last = n == model_pending_.size();
+    emit(model_pending_.substr(0, n));
+    model_pending_.remove_prefix(n);
+    if (last) {
+      // model_pending_ is empty now; the text's last byte decides whether a line end is due.
+      break;
+    }
+    flush();
+  }
+  // Close the reply. The provider's text normally ends with a newline; add CRLF if not.
+  if (tx_used_ > 0) {
+    const std::size_t last = (tx_head_ + tx_used_ + kTxBytes - 1) % kTxBytes;
+    if (tx_[last] != '\n') emit(kEol);
+  }
+  emit("OK\r\n");
+}
+
+void Console::cmd_map(const Words& w) {
+  if (!no_args(w)) return reply_error("map takes no arguments");
+  const MapCounts m = view_.map_counts();
+  reply_.appendf("map polygon_vertices=%u obstacle_points=%u exploration_points=%u\r\nOK\r\n",
+                 m.polygon_vertices, m.obstacle_points, m.exploration_points);
+  emit(reply_.view());
+}
+
+void Console::cmd_pause(const Words& w) {
+  if (!no_args(w)) return reply_error("pause takes no arguments");
+  executive_.set_background_paused(true);
+  emit("OK\r\n");
+}
+
+void Console::cmd_resume(const Words& w) {
+  if (!no_args(w)) return reply_error("resume takes no arguments");
+  executive_.set_background_paused(false);
+  emit("OK\r\n");
+}
+
+void Console::cmd_estop(const Words& w) {
+  if (!no_args(w)) return reply_error("estop takes no arguments");
+  safety_.engage(StopCause::kConsole);
+  emit("OK\r\n");
+}
+
+void Console::cmd_clear_estop(const Words& w) {
+  if (!no_args(w)) return reply_error("clear-estop takes no arguments");
+  if (const char* why = safety_.clear(); why != nullptr) return reply_error(why);
+  emit("OK\r\n");
+}
+
+void Console::append_parameter(const Parameter& p) {
+  reply_.appendf("%s=%g range=[%g,%g] %s\r\n", p.name, static_cast<double>(*p.value),
+                 static_cast<double>(p.min), static_cast<double>(p.max), p.help);
+}
+
+void Console::cmd_get(const Words& w) {
+  if (w.count > 2) return reply_error("get takes at most one NAME");
+  if (w.count == 2) {
+    const Parameter* p = parameters_.find(w.word[1]);
+    if (p == nullptr) return reply_error("unknown parameter");
+    append_parameter(*p);
+  } else {
+    for (std::size_t i = 0; i < parameters_.size(); ++i) append_parameter(parameters_[i]);
+  }
+  if (reply_.truncated()) return reply_error("reply too long");
+  reply_.append("OK\r\n");
+  emit(reply_.view());
+}
+
+void Console::cmd_set(const Words& w) {
+  if (w.count != 3) return reply_error("usage: set NAME VALUE");
+  float value = 0.0F;
+  if (parameters_.find(w.word[1]) == nullptr) return reply_error("unknown parameter");
+  if (!parse_number(w.word[2], value)) return reply_error("value is not a number");
+  if (const char* why = parameters_.set(w.word[1], value); why != nullptr) {
+    return reply_error(why);
+  }
+  if (w.word[1] == "telemetry_ms") next_telemetry_us_ = now_us_;
+  emit("OK\r\n");
+}
+
+void Console::cmd_log(const Words& w) {
+  if (w.count > 2) return reply_error("usage: log [error|warn|info|debug]");
+  if (w.count == 2) {
+    LogLevel level = LogLevel::kInfo;
+    if (!parse_log_level(w.word[1], level)) return reply_error("unknown log level");
+    log_level_ = level;
+  }
+  reply_.appendf("log level=%s\r\nOK\r\n", log_level_name(log_level_));
+  emit(reply_.view());
+}
+
+void Console::cmd_shutdown(const Words& w) {
+  if (!no_args(w)) return reply_error("shutdown takes no arguments");
+  shutdown_requested_ = true;
+  emit("OK shutting down\r\n");
+}
+
+void Console::check_executive(std::uint64_t now_us) {
+  const FrameStats& f = executive_.frame_stats();
+  if (now_us >= next_overrun_log_us_ &&
+      (f.overruns != seen_frame_overruns_ || f.background_overruns != seen_background_overruns_)) {
+    // At most one line per second, however many overruns there were.
+    log(LogLevel::kWarn, "overruns frame=%llu background=%llu",
+        static_cast<unsigned long long>(f.overruns),
+        static_cast<unsigned long long>(f.background_overruns));
+    seen_frame_overruns_ = f.overruns;
+    seen_background_overruns_ = f.background_overruns;
+    next_overrun_log_us_ = now_us + 1000000U;
+  }
+  const bool healthy = executive_.all_healthy();
+  if (healthy != was_healthy_) {
+    log(healthy ? LogLevel::kInfo : LogLevel::kError, "tasks %s",
+        healthy ? "healthy again" : "unhealthy: watchdog not kicked");
+    was_healthy_ = healthy;
+  }
+}
+
+void Console::send_telemetry(std::uint64_t now_us) {
+  if (telemetry_ms_ <= 0.0F || now_us < next_telemetry_us_) return;
+  const auto period_us = static_cast<std::uint64_t>(telemetry_ms_) * 1000U;
+  next_telemetry_us_ += period_us;
+  if (next_telemetry_us_ <= now_us) next_telemetry_us_ = now_us + period_us;  // no bursts
+  const core::Pose2 p = view_.pose();
+  TextBuffer<256> line;
+  line.appendf(
+      "TLM t_s=%.2f state=%s pan_rad=%.3f features=%u pieces=%u x_m=%.3f y_m=%.3f "
+      "yaw_rad=%.3f estop=%s\r\n",
+      static_cast<double>(now_us - start_us_) * 1e-6, view_.state_name(),
+      static_cast<double>(view_.pan_rad()), view_.features(), view_.pieces(),
+      static_cast<double>(p.x_m), static_cast<double>(p.y_m), static_cast<double>(p.yaw_rad),
+      stop_cause_name(safety_.cause()));
+  if (!line.truncated()) emit(line.view());
+}
+
+}  // namespace boticelli::firmware

@@ -1,0 +1,126 @@
+// Console: the serial monitor — line commands, periodic telemetry and log lines over a hal::SerialPort.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "firmware/console_line.h"
+#include "firmware/console_parser.h"
+#include "firmware/executive.h"
+#include "firmware/mission_view.h"
+#include "firmware/parameters.h"
+#include "firmware/safety.h"
+#include "firmware/text_buffer.h"
+#include "hal/serial_port.h"
+
+namespace boticelli::firmware {
+
+enum class LogLevel : std::uint8_t { kError, kWarn, kInfo, kDebug };
+const char* log_level_name(LogLevel level);
+bool parse_log_level(std::string_view text, LogLevel& out);
+
+// Protocol (docs/console.md): one command per line; every command answers with its data
+// lines and then "OK", or with exactly one line "ERR <reason>" and no other effect.
+// Unsolicited lines start with "TLM " (telemetry) or "LOG " (log). Output lines end in CRLF.
+class Console {
+ public:
+  static constexpr std::size_t kTxBytes = 8192;        // output ring
+  static constexpr std::size_t kReplyBytes = 2048;     // one command's reply
+  static constexpr std::size_t kReadChunkBytes = 64;   // bytes read per service() call
+
+  Console(hal::SerialPort& port, Executive& executive, Safety& safety, MissionView& view,
+          ParameterTable& parameters);
+  Console(const Console&) = delete;
+  Console& operator=(const Console&) = delete;
+
+  // Registers the console's own parameters (telemetry_ms, echo); call once at init.
+  bool register_parameters();
+  // The console task's body: flushes output, reads and executes input, sends telemetry.
+  void service(std::uint64_t now_us);
+  // A log line ("LOG <level> <text>") when `level` is within the console's log level.
+  void log(LogLevel level, const char* format, ...) __attribute__((format(printf, 3, 4)));
+
+  bool shutdown_requested() const { return shutdown_requested_; }
+  bool healthy() const { return !port_fault_; }
+  LogLevel log_level() const { return log_level_; }
+  void set_echo(bool on) { echo_ = on ? 1.0F : 0.0F; }
+  void set_telemetry_ms(float ms) { telemetry_ms_ = ms; }
+  std::uint64_t lines_executed() const { return lines_; }
+  std::uint64_t errors() const { return errors_; }
+  std::uint64_t dropped_bytes() const { return dropped_bytes_; }
+  std::size_t pending_output() const { return tx_used_; }
+
+ private:
+  struct Command {
+    const char* name;
+    const char* args;
+    const char* help;
+    void (Console::*handler)(const Words&);
+  };
+
+  void execute(std::string_view line);
+  void reply_error(const char* reason);
+  bool emit(std::string_view bytes);  // all or nothing into the ring
+  std::size_t tx_free() const { return kTxBytes - tx_used_; }
+  void flush();
+  void stream_model();
+  void check_executive(std::uint64_t now_us);
+  void send_telemetry(std::uint64_t now_us);
+
+  void cmd_help(const Words& w);
+  void cmd_status(const Words& w);
+  void cmd_stats(const Words& w);
+  void cmd_pose(const Words& w);
+  void cmd_model(const Words& w);
+  void cmd_map(const Words& w);
+  void cmd_pause(const Words& w);
+  void cmd_resume(const Words& w);
+  void cmd_estop(const Words& w);
+  void cmd_clear_estop(const Words& w);
+  void cmd_get(const Words& w);
+  void cmd_set(const Words& w);
+  void cmd_log(const Words& w);
+  void cmd_shutdown(const Words& w);
+  void append_parameter(const Parameter& p);
+
+  static const Command kCommands[];
+
+  hal::SerialPort& port_;
+  Executive& executive_;
+  Safety& safety_;
+  MissionView& view_;
+  ParameterTable& parameters_;
+
+  LineAssembler line_;
+  std::array<std::uint8_t, kReadChunkBytes> rx_{};
+  std::size_t rx_pos_ = 0;
+  std::size_t rx_len_ = 0;
+
+  std::array<char, kTxBytes> tx_{};
+  std::size_t tx_head_ = 0;  // next byte to send
+  std::size_t tx_used_ = 0;
+  TextBuffer<kReplyBytes> reply_;
+
+  std::string_view model_pending_;  // rest of a `model` reply still to be queued
+
+  float telemetry_ms_ = 1000.0F;  // 0 = off
+  float echo_ = 0.0F;             // 1 = echo typed characters (for terminals without local echo)
+  std::uint64_t next_telemetry_us_ = 0;
+  std::uint64_t now_us_ = 0;
+  std::uint64_t start_us_ = 0;
+  bool started_ = false;
+  LogLevel log_level_ = LogLevel::kInfo;
+  bool shutdown_requested_ = false;
+  bool port_fault_ = false;
+  std::uint64_t lines_ = 0;
+  std::uint64_t errors_ = 0;
+  std::uint64_t dropped_bytes_ = 0;
+  std::uint64_t seen_frame_overruns_ = 0;
+  std::uint64_t seen_background_overruns_ = 0;
+  std::uint64_t next_overrun_log_us_ = 0;
+  bool was_healthy_ = true;
+};
+
+}  // namespace boticelli::firmware

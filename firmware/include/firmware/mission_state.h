@@ -1,0 +1,51 @@
+// MissionState: everything a mission must keep across a restart, in fixed capacities (saved by StateStore).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/core/geometry.h"
+
+namespace boticelli::firmware {
+
+// One line of the mission log: which cycle, what happened (printable ASCII).
+struct MissionLogEntry {
+  static constexpr std::size_t kMaxTextBytes = 95;
+  std::uint64_t cycle = 0;
+  std::array<char, kMaxTextBytes + 1> text{};  // NUL-terminated
+  std::string_view view() const { return {text.data()}; }
+};
+
+struct MissionState {
+  static constexpr std::size_t kMaxObstaclePoints = 2048;
+  static constexpr std::size_t kMaxExplorationPoints = 512;
+  static constexpr std::size_t kMaxModelBytes = 64 * 1024;
+  static constexpr std::size_t kMaxLogEntries = 128;
+
+  std::uint64_t cycle = 0;  // completed cycles
+  std::uint64_t seed = 1;   // --seed of the run that started the mission
+  core::Pose2 pose;         // robot pose in the world frame [m, rad]
+  bool has_goal = false;
+  core::Point2 goal;        // target position once seen [m]
+  core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles;      // global obstacle list [m]
+  core::FixedVector<core::Point2, kMaxExplorationPoints> exploration; // global exploration list [m]
+  std::array<char, kMaxModelBytes> model{};  // the last occupancy ALN, text format (opaque here)
+  std::size_t model_bytes = 0;
+  core::FixedVector<MissionLogEntry, kMaxLogEntries> log;  // oldest first
+
+  std::string_view model_text() const { return {model.data(), model_bytes}; }
+  // False (model unchanged) when the text is longer than kMaxModelBytes or contains NUL.
+  bool set_model(std::string_view text);
+  // Appends a log line; the oldest line goes when the log is full. Bytes outside printable
+  // ASCII become '?', and text longer than kMaxTextBytes is cut.
+  void add_log(std::uint64_t at_cycle, std::string_view text);
+  // Back to the state of a fresh mission.
+  void clear();
+};
+
+bool operator==(const MissionState& a, const MissionState& b);
+
+}  // namespace boticelli::firmware

@@ -1,0 +1,60 @@
+// Persistence: the mission state file — versioned text with a CRC32, strict loading, atomic saving.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "firmware/mission_state.h"
+
+namespace boticelli::firmware {
+
+// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320), as zlib's crc32().
+std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
+
+// Format (docs/console.md "State directory"):
+//   BOTICELLI-STATE 1 / cycle N / seed N / pose X Y YAW / goal none|goal X Y /
+//   obstacles N + N lines "X Y" / exploration N + N lines / model BYTES + the bytes + "\n" /
+//   log N + N lines "CYCLE TEXT" / end / crc32 XXXXXXXX (over everything before that line).
+inline constexpr std::uint32_t kStateFormatVersion = 1;
+inline constexpr std::size_t kMaxStateFileBytes =
+    256 + 40 * (MissionState::kMaxObstaclePoints + MissionState::kMaxExplorationPoints) +
+    MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64;
+
+// Writes the file's bytes into `out`; returns their count, 0 when `capacity` is too small.
+std::size_t encode_state(const MissionState& state, char* out, std::size_t capacity);
+// Parses a whole file. On failure `out` is cleared, `error` says what was wrong.
+bool decode_state(std::string_view file, MissionState& out, const char** error);
+
+enum class LoadResult : std::uint8_t { kLoaded, kMissing, kCorrupt, kIoError };
+
+// The state directory. save() is atomic: it writes `mission.state.tmp`, fsyncs it, renames
+// it over `mission.state` and fsyncs the directory, so after a crash at any point the file
+// is either the previous state or the new one, never a mix.
+class StateStore {
+ public:
+  static constexpr const char* kFileName = "mission.state";
+
+  StateStore() = default;
+  StateStore(const StateStore&) = delete;
+  StateStore& operator=(const StateStore&) = delete;
+
+  // Uses `dir`, creating it (one level) when missing. False with a reason otherwise.
+  bool open(const char* dir, char* error, std::size_t error_size);
+  bool save(const MissionState& state, char* error, std::size_t error_size);
+  // kLoaded fills `out`; kMissing when there is no state file; kCorrupt (out cleared) when
+  // the file is truncated, altered or from another version; the reason goes to `error`.
+  LoadResult load(MissionState& out, char* error, std::size_t error_size);
+  const char* path() const { return path_.data(); }
+  std::uint64_t saves() const { return saves_; }
+
+ private:
+  std::array<char, 512> dir_{};
+  std::array<char, 512> path_{};
+  std::array<char, 512> tmp_path_{};
+  std::array<char, kMaxStateFileBytes> buffer_{};
+  std::uint64_t saves_ = 0;
+};
+
+}  // namespace boticelli::firmware
