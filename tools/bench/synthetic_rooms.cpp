@@ -1,0 +1,343 @@
+// Synthetic range data for the environments of thesis §4.8.2: room geometry, ray casting, readings.
+#include "synthetic_rooms.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <random>
+
+namespace boticelli::bench {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// Cylinder of radius 2.5 m about (0, 0); rectangle 5 x 4.5 m; corridor 5 x 1.5 m.
+// The PTU centre is 1 m above the floor, mid-height of the 2 m walls.
+constexpr double kSensorZ = 1.0;
+constexpr FloorBox kNoBox{};
+constexpr FloorBox kBoxInCylinder{0.75, 1.25, -0.25, 0.25, 0.5};
+constexpr FloorBox kBoxInRectangleA{1.0, 1.5, 0.8, 1.3, 0.5};
+constexpr FloorBox kBoxInRectangleB{-1.4, -0.6, -1.3, -0.5, 0.5};
+
+const std::array<RoomSpec, 10> kEnvironments = {{
+    {"cylinder_centre",
+     "cylindrical room seen from its centre (Fig 4.5a,c)",
+     1,
+     RoomShape::kCylinder,
+     2.5,
+     0,
+     0,
+     0,
+     0,
+     {0.0, 0.0, kSensorZ},
+     kNoBox,
+     0.0},
+    {"cylinder_centre_outliers",
+     "same, 5% outliers at half distance (Fig 4.5b,d)",
+     7,
+     RoomShape::kCylinder,
+     2.5,
+     0,
+     0,
+     0,
+     0,
+     {0.0, 0.0, kSensorZ},
+     kNoBox,
+     0.05},
+    {"cylinder_offcentre",
+     "cylindrical room seen from an arbitrary point (Fig 4.5e,g)",
+     16,
+     RoomShape::kCylinder,
+     2.5,
+     0,
+     0,
+     0,
+     0,
+     {1.0, 0.7, kSensorZ},
+     kNoBox,
+     0.0},
+    {"cylinder_offcentre_outliers",
+     "same, 5% outliers (Fig 4.5f,h)",
+     57,
+     RoomShape::kCylinder,
+     2.5,
+     0,
+     0,
+     0,
+     0,
+     {1.0, 0.7, kSensorZ},
+     kNoBox,
+     0.05},
+    {"rectangle",
+     "rectangular room (Fig 4.6a,d)",
+     45,
+     RoomShape::kRectangle,
+     0,
+     -2.5,
+     2.5,
+     -2.0,
+     2.5,
+     {0.0, 0.0, kSensorZ},
+     kNoBox,
+     0.0},
+    {"corridor",
+     "corridor, one wall far (Fig 4.6b,e)",
+     6,
+     RoomShape::kRectangle,
+     0,
+     -1.0,
+     4.0,
+     -0.75,
+     0.75,
+     {0.0, 0.0, kSensorZ},
+     kNoBox,
+     0.0},
+    {"cylinder_box_view1",
+     "0.5 m box in the cylindrical room, view 1 (Fig 4.7a)",
+     59,
+     RoomShape::kCylinder,
+     2.5,
+     0,
+     0,
+     0,
+     0,
+     {0.0, 0.0, kSensorZ},
+     kBoxInCylinder,
+     0.0},
+    {"cylinder_box_view2",
+     "0.5 m box in the cylindrical room, view 2 (Fig 4.7b)",
+     65,
+     RoomShape::kCylinder,
+     2.5,
+     0,
+     0,
+     0,
+     0,
+     {-0.6, 0.8, kSensorZ},
+     kBoxInCylinder,
+     0.0},
+    {"rectangle_box_case1",
+     "box in the rectangular room, case 1 (Fig 4.7e)",
+     151,
+     RoomShape::kRectangle,
+     0,
+     -2.5,
+     2.5,
+     -2.0,
+     2.5,
+     {0.0, 0.0, kSensorZ},
+     kBoxInRectangleA,
+     0.0},
+    {"rectangle_box_case2",
+     "box in the rectangular room, case 2 (Fig 4.7f)",
+     252,
+     RoomShape::kRectangle,
+     0,
+     -2.5,
+     2.5,
+     -2.0,
+     2.5,
+     {0.0, 0.0, kSensorZ},
+     kBoxInRectangleB,
+     0.0},
+}};
+
+}  // namespace
+
+std::span<const RoomSpec> thesis_environments() {
+  return kEnvironments;
+}
+
+const RoomSpec* find_environment(const char* name) {
+  for (const RoomSpec& s : kEnvironments) {
+    if (std::strcmp(s.name, name) == 0) {
+      return &s;
+    }
+  }
+  return nullptr;
+}
+
+Bounds3 SyntheticRoom::bounds() const {
+  if (spec_.shape == RoomShape::kCylinder) {
+    const double r = spec_.radius_m;
+    return {{-r, -r, 0.0}, {r, r, spec_.wall_height_m}};
+  }
+  return {{spec_.x_min, spec_.y_min, 0.0}, {spec_.x_max, spec_.y_max, spec_.wall_height_m}};
+}
+
+bool SyntheticRoom::inside_room(const Vec3& p) const {
+  if (p.z < 0.0 || p.z > spec_.wall_height_m) {
+    return false;
+  }
+  if (spec_.shape == RoomShape::kCylinder) {
+    return p.x * p.x + p.y * p.y < spec_.radius_m * spec_.radius_m;
+  }
+  return p.x > spec_.x_min && p.x < spec_.x_max && p.y > spec_.y_min && p.y < spec_.y_max;
+}
+
+bool SyntheticRoom::inside_box(const Vec3& p) const {
+  const FloorBox& b = spec_.box;
+  return b.height_m > 0.0 && p.x >= b.x_min && p.x <= b.x_max && p.y >= b.y_min && p.y <= b.y_max &&
+         p.z >= 0.0 && p.z <= b.height_m;
+}
+
+bool SyntheticRoom::solid(const Vec3& p) const {
+  if (p.z < 0.0) {
+    return true;
+  }
+  if (inside_box(p)) {
+    return true;
+  }
+  return p.z <= spec_.wall_height_m && !inside_room(p);
+}
+
+double SyntheticRoom::box_entry(const Vec3& o, const Vec3& d, double t_max) const {
+  const FloorBox& b = spec_.box;
+  if (!(b.height_m > 0.0)) {
+    return kInf;
+  }
+  const std::array<double, 3> lo = {b.x_min, b.y_min, 0.0};
+  const std::array<double, 3> hi = {b.x_max, b.y_max, b.height_m};
+  const std::array<double, 3> oo = {o.x, o.y, o.z};
+  const std::array<double, 3> dd = {d.x, d.y, d.z};
+  double t0 = 0.0;
+  double t1 = t_max;
+  for (std::size_t a = 0; a < 3; ++a) {
+    if (std::fabs(dd[a]) < 1e-15) {
+      if (oo[a] < lo[a] || oo[a] > hi[a]) {
+        return kInf;
+      }
+      continue;
+    }
+    double ta = (lo[a] - oo[a]) / dd[a];
+    double tb = (hi[a] - oo[a]) / dd[a];
+    if (ta > tb) {
+      std::swap(ta, tb);
+    }
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) {
+      return kInf;
+    }
+  }
+  return t0;
+}
+
+bool SyntheticRoom::visible_free(const Vec3& p) const {
+  if (!inside_room(p) || inside_box(p)) {
+    return false;
+  }
+  const Vec3 s = spec_.sensor;
+  const Vec3 d{p.x - s.x, p.y - s.y, p.z - s.z};
+  // The segment s → p (parameter t in [0, 1]) must miss the box.
+  return !(box_entry(s, d, 1.0) <= 1.0);
+}
+
+double SyntheticRoom::wall_distance_xy(double cx, double cy) const {
+  const Vec3 s = spec_.sensor;
+  if (spec_.shape == RoomShape::kCylinder) {
+    // |s + t c| = R, t > 0 (s inside).
+    const double b = s.x * cx + s.y * cy;
+    const double c = s.x * s.x + s.y * s.y - spec_.radius_m * spec_.radius_m;
+    return -b + std::sqrt(b * b - c);
+  }
+  double t = kInf;
+  if (cx > 0.0) {
+    t = std::min(t, (spec_.x_max - s.x) / cx);
+  } else if (cx < 0.0) {
+    t = std::min(t, (spec_.x_min - s.x) / cx);
+  }
+  if (cy > 0.0) {
+    t = std::min(t, (spec_.y_max - s.y) / cy);
+  } else if (cy < 0.0) {
+    t = std::min(t, (spec_.y_min - s.y) / cy);
+  }
+  return t;
+}
+
+SyntheticRoom::Hit SyntheticRoom::cast_from_sensor(const Vec3& d) const {
+  const Vec3 s = spec_.sensor;
+  const double dxy = std::hypot(d.x, d.y);
+  double t_wall = kInf;
+  if (dxy > 1e-12) {
+    const double t = wall_distance_xy(d.x / dxy, d.y / dxy) / dxy;
+    const double z = s.z + d.z * t;
+    if (z >= 0.0 && z <= spec_.wall_height_m) {
+      t_wall = t;
+    }
+  }
+  const double t_floor = d.z < 0.0 ? -s.z / d.z : kInf;
+  const double t_box = box_entry(s, d, kInf);
+  if (t_box <= t_wall && t_box <= t_floor && std::isfinite(t_box)) {
+    return {t_box, true};
+  }
+  if (t_wall <= t_floor && std::isfinite(t_wall)) {
+    return {t_wall, true};
+  }
+  return {t_floor, false};
+}
+
+evidence::Reading SyntheticRoom::reading_of(const Vec3& p, float m) const {
+  const Vec3 s = spec_.sensor;
+  const double dx = p.x - s.x;
+  const double dy = p.y - s.y;
+  const double dz = p.z - s.z;
+  double a = std::atan2(dy, dx);
+  if (a < 0.0) {
+    a += kTwoPi;
+  }
+  if (a >= kTwoPi) {
+    a = 0.0;
+  }
+  return {static_cast<float>(a), static_cast<float>(dz),
+          static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz)), m};
+}
+
+Vec3 SyntheticRoom::world_of(const evidence::Reading& reading) const {
+  const double r = reading.r_m;
+  const double h = reading.h_m;
+  const double rho = std::sqrt(std::max(0.0, r * r - h * h));
+  const Vec3 s = spec_.sensor;
+  return {s.x + rho * std::cos(static_cast<double>(reading.alpha_rad)),
+          s.y + rho * std::sin(static_cast<double>(reading.alpha_rad)), s.z + h};
+}
+
+std::vector<evidence::Reading> SyntheticRoom::generate_readings(
+    std::size_t features, std::uint32_t seed, double outlier_fraction_override) const {
+  const double outliers =
+      outlier_fraction_override >= 0.0 ? outlier_fraction_override : spec_.outlier_fraction;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<evidence::Reading> out;
+  out.reserve(features);
+  const Vec3 s = spec_.sensor;
+  std::size_t attempts = 0;
+  while (out.size() < features && attempts < 100 * features + 100) {
+    ++attempts;
+    const double alpha = kTwoPi * unit(rng);
+    const double cx = std::cos(alpha);
+    const double cy = std::sin(alpha);
+    const double rho = wall_distance_xy(cx, cy);
+    const double z = spec_.wall_height_m * unit(rng);
+    Vec3 d{rho * cx, rho * cy, z - s.z};
+    const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    d = {d.x / len, d.y / len, d.z / len};
+    const Hit hit = cast_from_sensor(d);
+    if (!hit.featured || !(hit.distance_m <= spec_.max_range_m)) {
+      continue;
+    }
+    double t = hit.distance_m;
+    if (unit(rng) < outliers) {
+      t *= 0.5;  // §4.8.2: outliers appear twice as close as they are
+    }
+    out.push_back(reading_of({s.x + d.x * t, s.y + d.y * t, s.z + d.z * t},
+                             static_cast<float>(spec_.feature_m)));
+  }
+  return out;
+}
+
+}  // namespace boticelli::bench

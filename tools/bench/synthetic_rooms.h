@@ -1,0 +1,104 @@
+// Synthetic range data for the environments of thesis §4.8.2, with analytic ground truth.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "algo/evidence/reading.h"
+
+namespace boticelli::bench {
+
+// A point or direction in the world frame [m]: floor is z = 0, z up.
+struct Vec3 {
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+};
+
+enum class RoomShape : std::uint8_t { kCylinder, kRectangle };
+
+// An axis-aligned box standing on the floor (the thesis's "small box, half a meter high").
+struct FloorBox {
+  double x_min = 0.0;
+  double x_max = 0.0;
+  double y_min = 0.0;
+  double y_max = 0.0;
+  double height_m = 0.0;  // 0 = no box
+};
+
+// One environment of §4.8.2. Walls are vertical, wall_height_m high, and full of
+// features with evidence feature_m; the floor is featureless; there is no ceiling.
+struct RoomSpec {
+  const char* name;         // short id, e.g. "cylinder_centre"
+  const char* thesis_case;  // the thesis's wording / figure
+  int thesis_pieces;        // linear pieces the thesis reports (ε = 0.15)
+  RoomShape shape;
+  double radius_m;                    // kCylinder: wall radius about (0, 0)
+  double x_min, x_max, y_min, y_max;  // kRectangle: wall lines
+  Vec3 sensor;                        // PTU centre
+  FloorBox box;
+  double outlier_fraction;  // share of features seen at half their distance (§4.8.2)
+  double wall_height_m = 2.0;
+  double feature_m = 0.9;
+  double max_range_m = 4.5;  // visibility of the sensor (§3.4)
+};
+
+// Axis-aligned bounds [m].
+struct Bounds3 {
+  Vec3 min;
+  Vec3 max;
+};
+
+// The ten rows of the thesis's simulation table, in its order.
+std::span<const RoomSpec> thesis_environments();
+// Looks a row up by name; nullptr if unknown.
+const RoomSpec* find_environment(const char* name);
+
+class SyntheticRoom {
+ public:
+  explicit SyntheticRoom(const RoomSpec& spec) : spec_(spec) {}
+
+  [[nodiscard]] const RoomSpec& spec() const { return spec_; }
+  // The PTU centre: the origin of every Reading's (α, h, r).
+  [[nodiscard]] Vec3 sensor() const { return spec_.sensor; }
+  // The room's bounding box, floor to wall top (cylinder: the square around it).
+  [[nodiscard]] Bounds3 bounds() const;
+
+  // Ground truth. Inside: within the walls, above the floor, below the wall top.
+  [[nodiscard]] bool inside_room(const Vec3& p) const;
+  [[nodiscard]] bool inside_box(const Vec3& p) const;
+  // Solid: outside the walls (at wall height), inside the box, or below the floor.
+  [[nodiscard]] bool solid(const Vec3& p) const;
+  // Free and seen: inside the room, not in the box, and the segment from the sensor to p
+  // is not blocked by the box. Everything else is occupied or unknown to the sensor.
+  [[nodiscard]] bool visible_free(const Vec3& p) const;
+
+  // First surface along a ray from the sensor: distance [m] (infinity if none) and
+  // whether the surface has features (walls and the box do, the floor does not).
+  struct Hit {
+    double distance_m;
+    bool featured;
+  };
+  [[nodiscard]] Hit cast_from_sensor(const Vec3& direction_unit) const;
+
+  // `features` readings: pan angle uniform in [0, 2π), a point uniform in height on the
+  // wall in that direction, the first surface on the line of sight to it (wall or box),
+  // evidence feature_m. A share outlier_fraction (of the spec, or the override if ≥ 0)
+  // is moved to half its distance. Deterministic for a seed.
+  [[nodiscard]] std::vector<evidence::Reading> generate_readings(
+      std::size_t features, std::uint32_t seed, double outlier_fraction_override = -1.0) const;
+
+  // (α, h, r) about the sensor ↔ world frame.
+  [[nodiscard]] evidence::Reading reading_of(const Vec3& world_point, float m) const;
+  [[nodiscard]] Vec3 world_of(const evidence::Reading& reading) const;
+
+ private:
+  // Horizontal distance from the sensor to the walls in direction (cx, cy) (unit).
+  [[nodiscard]] double wall_distance_xy(double cx, double cy) const;
+  [[nodiscard]] double box_entry(const Vec3& origin, const Vec3& dir, double t_max) const;
+  RoomSpec spec_;
+};
+
+}  // namespace boticelli::bench
