@@ -1,0 +1,313 @@
+// Adaptive Logic Network: a MIN/MAX tree over linear pieces, y = F(x), x in R^N (thesis Eq 4.26).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+
+#include <Eigen/Core>
+
+namespace boticelli::aln {
+
+// What a tree node does: hold a linear piece, or take the MIN or MAX of its two children.
+enum class NodeKind : std::uint8_t { kPiece = 0, kMin = 1, kMax = 2 };
+
+// A closed interval of one variable, in that variable's own units.
+template <typename Scalar>
+struct Range {
+  Scalar lo = Scalar(0);
+  Scalar hi = Scalar(1);
+};
+
+// One linear piece (thesis Eq 5.5 form): y = centroid_output + sum_i weight_i (x_i - centroid_i).
+// The centroid is a point on the piece (roughly the middle of the samples it fits); the
+// bias is derived from it, bias = centroid_output - weight . centroid, so a piece read back
+// from text is bit-identical to the one written.
+template <typename Scalar, int N>
+struct Piece {
+  using Vec = Eigen::Matrix<Scalar, N, 1>;
+  Vec weight = Vec::Zero();    // dy/dx_i, output units per input unit
+  Vec centroid = Vec::Zero();  // input part of a point on the piece
+  Scalar centroid_output = Scalar(0);
+  Scalar bias = Scalar(0);  // derived, see set()
+
+  void set(const Vec& w, const Vec& c, Scalar cy) {
+    weight = w;
+    centroid = c;
+    centroid_output = cy;
+    bias = cy - w.dot(c);
+  }
+  [[nodiscard]] Scalar value(const Vec& x) const { return bias + weight.dot(x); }
+};
+
+// The result of an evaluation: the value, the responsible (active) piece, and how many
+// pieces were evaluated to get it (the cost measure of alpha-beta and DTREE).
+template <typename Scalar>
+struct EvalResult {
+  Scalar value = Scalar(0);
+  std::uint16_t piece = 0;
+  std::uint16_t pieces_evaluated = 0;
+};
+
+// The ALN function. Scalar is float or double, N the input dimension (1..4 tested),
+// MaxPieces the capacity. All storage is inside the object: nothing allocates, ever.
+// The tree has node 0 as root; a kPiece node's `a` is a piece index, a kMin/kMax node's
+// `a` and `b` are its children's node indices. Every piece is used by exactly one node.
+// Input ranges (a box per input) and the output range are part of the function
+// (thesis Figure 5.4); weight bounds are the training constraints (Eqs 4.27-4.28).
+template <typename Scalar, int N, std::size_t MaxPieces>
+class Aln {
+  static_assert(N >= 1 && N <= 8, "ALN input dimension 1..8");
+  static_assert(MaxPieces >= 1 && MaxPieces <= 16384, "piece capacity 1..16384");
+  static_assert(std::numeric_limits<Scalar>::is_iec559, "float or double");
+
+ public:
+  static constexpr int kInputs = N;
+  static constexpr std::size_t kMaxPieces = MaxPieces;
+  static constexpr std::size_t kMaxNodes = 2 * MaxPieces - 1;
+  using ScalarType = Scalar;
+  using Vec = Eigen::Matrix<Scalar, N, 1>;
+  using PieceType = Piece<Scalar, N>;
+  struct Node {
+    NodeKind kind = NodeKind::kPiece;
+    std::uint16_t a = 0;
+    std::uint16_t b = 0;
+  };
+
+  // One flat piece y = 0, inputs and output on [0, 1], weights unbounded.
+  Aln() {
+    for (int i = 0; i < N; ++i) {
+      weight_lo_[static_cast<std::size_t>(i)] = -std::numeric_limits<Scalar>::infinity();
+      weight_hi_[static_cast<std::size_t>(i)] = std::numeric_limits<Scalar>::infinity();
+    }
+    reset(PieceType{});
+  }
+
+  // --- Ranges and constraints -------------------------------------------------------
+  void set_input_range(int i, Scalar lo, Scalar hi) { input_range_[idx(i)] = {lo, hi}; }
+  void set_output_range(Scalar lo, Scalar hi) { output_range_ = {lo, hi}; }
+  [[nodiscard]] Range<Scalar> input_range(int i) const { return input_range_[idx(i)]; }
+  [[nodiscard]] Range<Scalar> output_range() const { return output_range_; }
+  // Every piece's weight on input i must lie in [lo, hi] (Eqs 4.27-4.28: monotone
+  // increasing in r is lo > 0, e.g. 1e-4; |a| < 1 is [-1, 1]). Infinite means unbounded.
+  void set_weight_bounds(int i, Scalar lo, Scalar hi) {
+    weight_lo_[idx(i)] = lo;
+    weight_hi_[idx(i)] = hi;
+  }
+  [[nodiscard]] Scalar weight_lo(int i) const { return weight_lo_[idx(i)]; }
+  [[nodiscard]] Scalar weight_hi(int i) const { return weight_hi_[idx(i)]; }
+  // True if every piece's weights are inside their bounds.
+  [[nodiscard]] bool pieces_within_bounds() const {
+    for (std::size_t p = 0; p < piece_count_; ++p) {
+      for (int i = 0; i < N; ++i) {
+        const Scalar w = pieces_[p].weight(i);
+        if (!(w >= weight_lo_[idx(i)] && w <= weight_hi_[idx(i)])) return false;
+      }
+    }
+    return true;
+  }
+
+  // --- Structure ----------------------------------------------------------------------
+  // Makes the function a single piece.
+  void reset(const PieceType& piece) {
+    pieces_[0] = piece;
+    piece_count_ = 1;
+    nodes_[0] = Node{NodeKind::kPiece, 0, 0};
+    node_count_ = 1;
+    piece_node_[0] = 0;
+    post_order_[0] = 0;
+    depth_ = 1;
+  }
+  // Replaces the leaf holding piece `p` by kind(first, second): `first` keeps index p,
+  // `second` gets index piece_count()-1. False (nothing changed) if full or bad arguments.
+  bool split_piece(std::size_t p, NodeKind kind, const PieceType& first, const PieceType& second) {
+    if (p >= piece_count_ || kind == NodeKind::kPiece || piece_count_ >= MaxPieces) {
+      return false;
+    }
+    const std::size_t leaf = piece_node_[p];
+    const std::size_t n1 = node_count_;
+    const std::size_t n2 = node_count_ + 1;
+    const std::size_t q = piece_count_;
+    pieces_[p] = first;
+    pieces_[q] = second;
+    nodes_[n1] = Node{NodeKind::kPiece, static_cast<std::uint16_t>(p), 0};
+    nodes_[n2] = Node{NodeKind::kPiece, static_cast<std::uint16_t>(q), 0};
+    nodes_[leaf] = Node{kind, static_cast<std::uint16_t>(n1), static_cast<std::uint16_t>(n2)};
+    piece_node_[p] = n1;
+    piece_node_[q] = n2;
+    node_count_ += 2;
+    piece_count_ += 1;
+    return finish_structure();
+  }
+  // Sets the whole tree at once (reader, inversion, pruning). Checks that the nodes form
+  // one tree rooted at node 0 that uses every piece exactly once; false (and the function
+  // unchanged) otherwise. Never recurses, so hostile input cannot exhaust the stack.
+  bool assign(std::span<const Node> nodes, std::span<const PieceType> pieces) {
+    if (nodes.empty() || nodes.size() > kMaxNodes || pieces.empty() || pieces.size() > MaxPieces ||
+        nodes.size() != 2 * pieces.size() - 1) {
+      return false;
+    }
+    // Validate before touching our own storage.
+    std::array<std::uint8_t, kMaxNodes> seen_node{};
+    std::array<std::uint8_t, MaxPieces> seen_piece{};
+    std::array<std::uint16_t, kMaxNodes> stack{};
+    std::size_t top = 0;
+    stack[top++] = 0;
+    std::size_t visited = 0;
+    while (top > 0) {
+      const std::size_t n = stack[--top];
+      if (seen_node[n] != 0) return false;
+      seen_node[n] = 1;
+      ++visited;
+      const Node& node = nodes[n];
+      if (node.kind == NodeKind::kPiece) {
+        if (node.a >= pieces.size() || seen_piece[node.a] != 0) return false;
+        seen_piece[node.a] = 1;
+      } else if (node.kind == NodeKind::kMin || node.kind == NodeKind::kMax) {
+        if (node.a >= nodes.size() || node.b >= nodes.size() || top + 2 > kMaxNodes) {
+          return false;
+        }
+        stack[top++] = node.a;
+        stack[top++] = node.b;
+      } else {
+        return false;
+      }
+    }
+    if (visited != nodes.size()) return false;
+    for (std::size_t i = 0; i < nodes.size(); ++i) nodes_[i] = nodes[i];
+    for (std::size_t i = 0; i < pieces.size(); ++i) pieces_[i] = pieces[i];
+    node_count_ = nodes.size();
+    piece_count_ = pieces.size();
+    for (std::size_t i = 0; i < node_count_; ++i) {
+      if (nodes_[i].kind == NodeKind::kPiece) piece_node_[nodes_[i].a] = i;
+    }
+    return finish_structure();
+  }
+
+  [[nodiscard]] std::size_t piece_count() const { return piece_count_; }
+  [[nodiscard]] std::size_t node_count() const { return node_count_; }
+  // Longest root-to-piece path, counted in nodes.
+  [[nodiscard]] std::size_t depth() const { return depth_; }
+  [[nodiscard]] const PieceType& piece(std::size_t i) const { return pieces_[i]; }
+  PieceType& piece(std::size_t i) { return pieces_[i]; }
+  [[nodiscard]] const Node& node(std::size_t i) const { return nodes_[i]; }
+  [[nodiscard]] std::span<const Node> nodes() const { return {nodes_.data(), node_count_}; }
+  [[nodiscard]] std::span<const PieceType> pieces() const { return {pieces_.data(), piece_count_}; }
+  // Node indices, children before their parent (root last).
+  [[nodiscard]] std::span<const std::uint16_t> post_order() const {
+    return {post_order_.data(), node_count_};
+  }
+  // Node index of the leaf holding piece p.
+  [[nodiscard]] std::size_t node_of_piece(std::size_t p) const { return piece_node_[p]; }
+
+  // --- Evaluation ---------------------------------------------------------------------
+  // Plain evaluation: every piece, children before parents (post order), no recursion.
+  // Ties go to the first child, so all evaluators agree on the responsible piece.
+  [[nodiscard]] EvalResult<Scalar> evaluate(const Vec& x) const {
+    std::array<Scalar, MaxPieces> value;  // a stack; only entries below `top` are read
+    std::array<std::uint16_t, MaxPieces> who;
+    std::size_t top = 0;
+    for (std::size_t k = 0; k < node_count_; ++k) {
+      const Node& n = nodes_[post_order_[k]];
+      if (n.kind == NodeKind::kPiece) {
+        value[top] = pieces_[n.a].value(x);
+        who[top] = n.a;
+        ++top;
+      } else {
+        --top;
+        const Scalar second = value[top];
+        const Scalar first = value[top - 1];
+        const bool take_second = n.kind == NodeKind::kMax ? second > first : second < first;
+        if (take_second) {
+          value[top - 1] = second;
+          who[top - 1] = who[top];
+        }
+      }
+    }
+    return {value[0], who[0], static_cast<std::uint16_t>(piece_count_)};
+  }
+
+  // Alpha-beta evaluation: same value and piece as evaluate(), but a MAX node skips its
+  // second child once the first reaches the bound of a MIN ancestor (and vice versa).
+  // Recursion depth is at most depth() <= piece capacity.
+  [[nodiscard]] EvalResult<Scalar> evaluate_alpha_beta(const Vec& x) const {
+    EvalResult<Scalar> r{};
+    std::uint16_t touched = 0;
+    ab(0, x, -std::numeric_limits<Scalar>::infinity(), std::numeric_limits<Scalar>::infinity(), r,
+       touched);
+    r.pieces_evaluated = touched;
+    return r;
+  }
+
+  [[nodiscard]] Scalar operator()(const Vec& x) const { return evaluate_alpha_beta(x).value; }
+
+ private:
+  static std::size_t idx(int i) { return static_cast<std::size_t>(i); }
+
+  void ab(std::size_t n, const Vec& x, Scalar lo, Scalar hi, EvalResult<Scalar>& out,
+          std::uint16_t& touched) const {
+    const Node& node = nodes_[n];
+    if (node.kind == NodeKind::kPiece) {
+      out.value = pieces_[node.a].value(x);
+      out.piece = node.a;
+      ++touched;
+      return;
+    }
+    ab(node.a, x, lo, hi, out, touched);
+    EvalResult<Scalar> second{};
+    if (node.kind == NodeKind::kMax) {
+      if (out.value >= hi) return;  // a MIN ancestor will not take anything this large
+      ab(node.b, x, out.value > lo ? out.value : lo, hi, second, touched);
+      if (second.value > out.value) out = second;
+    } else {
+      if (out.value <= lo) return;  // a MAX ancestor will not take anything this small
+      ab(node.b, x, lo, out.value < hi ? out.value : hi, second, touched);
+      if (second.value < out.value) out = second;
+    }
+  }
+
+  // Recomputes the post order and the depth (iteratively).
+  bool finish_structure() {
+    struct Frame {
+      std::uint16_t node;
+      std::uint16_t depth;
+      bool expanded;
+    };
+    std::array<Frame, kMaxNodes> stack{};
+    std::size_t top = 0;
+    std::size_t k = 0;
+    depth_ = 0;
+    stack[top++] = Frame{0, 1, false};
+    while (top > 0) {
+      Frame& f = stack[top - 1];
+      const Node& n = nodes_[f.node];
+      if (f.depth > depth_) depth_ = f.depth;
+      if (n.kind == NodeKind::kPiece || f.expanded) {
+        post_order_[k++] = f.node;
+        --top;
+        continue;
+      }
+      f.expanded = true;
+      const auto d = static_cast<std::uint16_t>(f.depth + 1);
+      stack[top++] = Frame{n.b, d, false};
+      stack[top++] = Frame{n.a, d, false};
+    }
+    return k == node_count_;
+  }
+
+  std::array<PieceType, MaxPieces> pieces_{};
+  std::array<Node, kMaxNodes> nodes_{};
+  std::array<std::size_t, MaxPieces> piece_node_{};
+  std::array<std::uint16_t, kMaxNodes> post_order_{};
+  std::array<Range<Scalar>, static_cast<std::size_t>(N)> input_range_{};
+  Range<Scalar> output_range_{};
+  std::array<Scalar, static_cast<std::size_t>(N)> weight_lo_{};
+  std::array<Scalar, static_cast<std::size_t>(N)> weight_hi_{};
+  std::size_t piece_count_ = 1;
+  std::size_t node_count_ = 1;
+  std::size_t depth_ = 1;
+};
+
+}  // namespace boticelli::aln

@@ -1,0 +1,296 @@
+// DTREE: an ALN compiled into axis-aligned blocks, each keeping only the pieces that can be active
+// there (thesis §4.7.2).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "algo/aln/aln.h"
+
+namespace boticelli::aln {
+
+// compile() partitions the model's input box by thresholds on one input at a time. In each
+// block, a MIN/MAX child that is dominated over the whole block (its bounds over the block
+// cannot win, with a rounding margin) is dropped, so the block keeps a small MIN/MAX tree of
+// the pieces that can be active there. A block is split further (at the midpoint of the input
+// that leaves the fewest pieces in the two halves) while it has more than N + 1 pieces and the
+// depth limit allows. evaluate() walks the thresholds and evaluates the block's small tree:
+// about N + 1 pieces per query (thesis §4.7.2). Exact (same value and piece as
+// Aln::evaluate) for inputs inside the model's input box; callers clamp inputs to it.
+// Storage: MaxSplits threshold nodes, MaxBlocks blocks, MaxBlockNodes nodes over all blocks.
+template <typename Scalar, int N, std::size_t MaxPieces, std::size_t MaxBlocks = 2048,
+          std::size_t MaxBlockNodes = 32768>
+class Dtree {
+ public:
+  using Model = Aln<Scalar, N, MaxPieces>;
+  using Vec = Eigen::Matrix<Scalar, N, 1>;
+  static constexpr std::size_t kMaxSplits = MaxBlocks - 1;
+  static_assert(MaxBlocks >= 1 && MaxBlocks < (1U << 30), "block capacity");
+  static_assert(MaxBlockNodes < (1U << 31), "block node capacity");
+
+  // Compiles `model`; max_depth bounds the number of thresholds on a query's path (and the
+  // compiler's recursion). False if the capacities were too small (the DTREE is then empty).
+  bool compile(const Model& model, std::size_t max_depth = 14) {
+    model_ = &model;
+    splits_used_ = 0;
+    blocks_used_ = 0;
+    pool_used_ = 0;
+    ok_ = true;
+    for (int i = 0; i < N; ++i) {
+      const Range<Scalar> r = model.input_range(i);
+      lo_(i) = static_cast<double>(r.lo);
+      hi_(i) = static_cast<double>(r.hi);
+    }
+    for (std::size_t p = 0; p < model.piece_count(); ++p) {
+      weight_[p] = model.piece(p).weight;
+      bias_[p] = model.piece(p).bias;
+    }
+    root_ = build(lo_, hi_, 0, max_depth);
+    if (!ok_) {
+      splits_used_ = 0;
+      blocks_used_ = 0;
+      pool_used_ = 0;
+    }
+    model_ = nullptr;
+    return ok_;
+  }
+
+  [[nodiscard]] EvalResult<Scalar> evaluate(const Vec& x) const {
+    std::int32_t c = root_;
+    while (c >= 0) {
+      const Split& s = splits_[static_cast<std::size_t>(c)];
+      c = x(s.axis) < s.threshold ? s.below : s.above;
+    }
+    const Block& b = blocks_[static_cast<std::size_t>(-c - 1)];
+    const Op* op = &pool_[b.first];
+    if (b.count == 1) {
+      return {value(op->piece, x), op->piece, 1};
+    }
+    std::array<Scalar, MaxPieces> v;  // a stack; only entries below `top` are read
+    std::array<std::uint16_t, MaxPieces> who;
+    std::size_t top = 0;
+    for (std::uint32_t k = 0; k < b.count; ++k, ++op) {
+      if (op->kind == NodeKind::kPiece) {
+        v[top] = value(op->piece, x);
+        who[top] = op->piece;
+        ++top;
+      } else {
+        --top;
+        const bool take_second =
+            op->kind == NodeKind::kMax ? v[top] > v[top - 1] : v[top] < v[top - 1];
+        if (take_second) {
+          v[top - 1] = v[top];
+          who[top - 1] = who[top];
+        }
+      }
+    }
+    return {v[0], who[0], b.pieces};
+  }
+
+  [[nodiscard]] std::size_t block_count() const { return blocks_used_; }
+  [[nodiscard]] std::size_t split_count() const { return splits_used_; }
+  [[nodiscard]] std::size_t node_count() const { return pool_used_; }
+  // Largest number of pieces kept in one block, and the mean over blocks.
+  [[nodiscard]] std::size_t max_block_pieces() const {
+    std::size_t m = 0;
+    for (std::size_t b = 0; b < blocks_used_; ++b)
+      m = blocks_[b].pieces > m ? blocks_[b].pieces : m;
+    return m;
+  }
+  [[nodiscard]] double mean_block_pieces() const {
+    double s = 0.0;
+    for (std::size_t b = 0; b < blocks_used_; ++b) s += blocks_[b].pieces;
+    return blocks_used_ > 0 ? s / static_cast<double>(blocks_used_) : 0.0;
+  }
+
+ private:
+  using VecD = Eigen::Matrix<double, N, 1>;
+  struct Split {
+    Scalar threshold = Scalar(0);
+    int axis = 0;
+    std::int32_t below = 0;  // >= 0 a split, < 0 block -(code + 1)
+    std::int32_t above = 0;
+  };
+  struct Block {
+    std::uint32_t first = 0;  // first op in pool_ (post order, root last)
+    std::uint32_t count = 0;  // ops
+    std::uint16_t pieces = 0;
+  };
+  struct Op {
+    NodeKind kind = NodeKind::kPiece;
+    std::uint16_t piece = 0;
+  };
+  enum Keep : std::uint8_t { kBoth, kFirst, kSecond };
+
+  Scalar value(std::uint16_t p, const Vec& x) const { return bias_[p] + weight_[p].dot(x); }
+
+  // Bottom-up bounds of every node over the box [lo, hi]; returns the kept piece count.
+  std::size_t analyse(const VecD& lo, const VecD& hi) {
+    const Model& m = *model_;
+    for (const std::uint16_t n : m.post_order()) {
+      const auto& node = m.node(n);
+      if (node.kind == NodeKind::kPiece) {
+        const auto& p = m.piece(node.a);
+        double mn = static_cast<double>(p.bias);
+        double mx = mn;
+        double mag = std::fabs(mn);
+        for (int i = 0; i < N; ++i) {
+          const double w = static_cast<double>(p.weight(i));
+          mn += w > 0.0 ? w * lo(i) : w * hi(i);
+          mx += w > 0.0 ? w * hi(i) : w * lo(i);
+          mag += std::fabs(w) * std::max(std::fabs(lo(i)), std::fabs(hi(i)));
+        }
+        // Margin for rounding in Scalar evaluation.
+        const double margin =
+            16.0 * static_cast<double>(std::numeric_limits<Scalar>::epsilon()) * mag;
+        min_[n] = mn - margin;
+        max_[n] = mx + margin;
+        keep_[n] = kBoth;
+        pieces_[n] = 1;
+        continue;
+      }
+      const double amin = min_[node.a];
+      const double amax = max_[node.a];
+      const double bmin = min_[node.b];
+      const double bmax = max_[node.b];
+      if (node.kind == NodeKind::kMax) {
+        if (amin >= bmax) {
+          keep_[n] = kFirst;
+        } else if (bmin > amax) {
+          keep_[n] = kSecond;
+        } else {
+          keep_[n] = kBoth;
+        }
+        min_[n] = std::max(amin, bmin);
+        max_[n] = std::max(amax, bmax);
+      } else {
+        if (amax <= bmin) {
+          keep_[n] = kFirst;
+        } else if (bmax < amin) {
+          keep_[n] = kSecond;
+        } else {
+          keep_[n] = kBoth;
+        }
+        min_[n] = std::min(amin, bmin);
+        max_[n] = std::min(amax, bmax);
+      }
+      pieces_[n] = keep_[n] == kFirst    ? pieces_[node.a]
+                   : keep_[n] == kSecond ? pieces_[node.b]
+                                         : pieces_[node.a] + pieces_[node.b];
+    }
+    return pieces_[0];
+  }
+
+  // Emits the kept tree (after analyse) as a block in post order; false if out of room.
+  bool emit_block(std::int32_t& code) {
+    if (blocks_used_ >= MaxBlocks) return false;
+    const Model& m = *model_;
+    Block& b = blocks_[blocks_used_];
+    b.first = static_cast<std::uint32_t>(pool_used_);
+    b.pieces = static_cast<std::uint16_t>(pieces_[0]);
+    struct Frame {
+      std::uint16_t node;
+      bool expanded;
+    };
+    std::array<Frame, Model::kMaxNodes> stack;
+    std::size_t top = 0;
+    stack[top++] = Frame{0, false};
+    while (top > 0) {
+      Frame& f = stack[top - 1];
+      std::uint16_t n = f.node;
+      while (m.node(n).kind != NodeKind::kPiece && keep_[n] != kBoth) {
+        n = keep_[n] == kFirst ? m.node(n).a : m.node(n).b;
+      }
+      f.node = n;
+      const auto& node = m.node(n);
+      if (node.kind == NodeKind::kPiece || f.expanded) {
+        if (pool_used_ >= MaxBlockNodes) return false;
+        pool_[pool_used_++] =
+            Op{node.kind, node.kind == NodeKind::kPiece ? node.a : std::uint16_t{0}};
+        --top;
+        continue;
+      }
+      f.expanded = true;
+      stack[top++] = Frame{node.b, false};
+      stack[top++] = Frame{node.a, false};
+    }
+    b.count = static_cast<std::uint32_t>(pool_used_ - b.first);
+    code = -static_cast<std::int32_t>(blocks_used_) - 1;
+    ++blocks_used_;
+    return true;
+  }
+
+  std::int32_t build(const VecD& lo, const VecD& hi, std::size_t depth, std::size_t max_depth) {
+    if (!ok_) return -1;
+    const std::size_t here = analyse(lo, hi);
+    const std::size_t target = static_cast<std::size_t>(N) + 1;
+    if (here <= target || depth >= max_depth || splits_used_ >= kMaxSplits) {
+      std::int32_t code = -1;
+      if (!emit_block(code)) ok_ = false;
+      return code;
+    }
+    // The input whose midpoint split leaves the fewest pieces in the two halves.
+    int axis = -1;
+    std::size_t best = 0;
+    for (int i = 0; i < N; ++i) {
+      if (!(hi(i) > lo(i))) continue;
+      const double mid = 0.5 * (lo(i) + hi(i));
+      VecD h1 = hi;
+      h1(i) = mid;
+      VecD l2 = lo;
+      l2(i) = mid;
+      const std::size_t cost = analyse(lo, h1) + analyse(l2, hi);
+      if (axis < 0 || cost < best) {
+        axis = i;
+        best = cost;
+      }
+    }
+    if (axis < 0 || best >= 2 * here) {
+      analyse(lo, hi);
+      std::int32_t code = -1;
+      if (!emit_block(code)) ok_ = false;
+      return code;
+    }
+    const double mid = 0.5 * (lo(axis) + hi(axis));
+    const std::size_t s = splits_used_++;
+    splits_[s].axis = axis;
+    splits_[s].threshold = static_cast<Scalar>(mid);
+    // Route by the Scalar threshold exactly as evaluate() does.
+    const double t = static_cast<double>(splits_[s].threshold);
+    VecD h1 = hi;
+    h1(axis) = t;
+    VecD l2 = lo;
+    l2(axis) = t;
+    const std::int32_t below = build(lo, h1, depth + 1, max_depth);
+    const std::int32_t above = build(l2, hi, depth + 1, max_depth);
+    splits_[s].below = below;
+    splits_[s].above = above;
+    return static_cast<std::int32_t>(s);
+  }
+
+  const Model* model_ = nullptr;
+  bool ok_ = false;
+  std::int32_t root_ = -1;
+  VecD lo_ = VecD::Zero();
+  VecD hi_ = VecD::Zero();
+  std::array<Split, kMaxSplits> splits_{};
+  std::array<Block, MaxBlocks> blocks_{};
+  std::array<Op, MaxBlockNodes> pool_{};
+  std::array<Vec, MaxPieces> weight_{};
+  std::array<Scalar, MaxPieces> bias_{};
+  std::size_t splits_used_ = 0;
+  std::size_t blocks_used_ = 0;
+  std::size_t pool_used_ = 0;
+  // Compile-time scratch, per model node.
+  std::array<double, Model::kMaxNodes> min_{};
+  std::array<double, Model::kMaxNodes> max_{};
+  std::array<Keep, Model::kMaxNodes> keep_{};
+  std::array<std::size_t, Model::kMaxNodes> pieces_{};
+};
+
+}  // namespace boticelli::aln

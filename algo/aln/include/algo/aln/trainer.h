@@ -1,0 +1,509 @@
+// ALN training: grow a MIN/MAX tree from samples by splitting pieces until the error is below
+// epsilon.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "algo/aln/aln.h"
+#include "algo/aln/constrained_lsq.h"
+#include "algo/aln/samples.h"
+
+namespace boticelli::aln {
+
+// When a piece is split (thesis §4.7.3: "linear pieces with greater than the specified error
+// are split in two, until the allowable error E in Eq 4.22 is achieved").
+enum class SplitRule : std::uint8_t {
+  kPieceRms,    // split every piece whose own RMS error exceeds epsilon (as the thesis)
+  kOverallRms,  // while the overall RMS exceeds epsilon, split the pieces with above-mean SSE
+};
+
+// Iteratively reweighted least squares inside each piece's fit, so a few percent of
+// outliers do not force extra pieces (the thesis names robust regression as future work).
+enum class RobustWeighting : std::uint8_t { kNone, kHuber, kTukey };
+
+struct TrainerConfig {
+  double epsilon = 0.15;            // allowed RMS error, output units (Eq 4.22)
+  std::size_t max_pieces = 0;       // piece cap; 0 = the model's capacity
+  std::size_t max_iterations = 10;  // split rounds (the thesis caps iterations)
+  SplitRule split_rule = SplitRule::kPieceRms;
+  RobustWeighting robust = RobustWeighting::kNone;
+  double robust_scale = 0.0;         // residual scale s, output units; 0 = epsilon. A piece
+                                     // uses max(s, its own robust RMS): Huber k = 1.345 s,
+                                     // Tukey c = 4.685 s.
+  std::size_t max_refit_passes = 8;  // assign/refit (Lloyd) passes per split round
+  std::uint32_t seed = 1;            // jitter of the split tilt; same seed, same model
+};
+
+struct TrainerStats {
+  std::size_t pieces = 0;
+  std::size_t iterations = 0;  // split rounds done
+  std::size_t passes = 0;      // passes over the samples
+  std::uint64_t sample_visits = 0;
+  double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
+  double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
+  bool done = false;
+};
+
+// Trains an Aln<Scalar, N, MaxPieces>. The method (ALN.md "better training"): every pass
+// assigns each sample to its responsible piece (alpha-beta evaluation) and accumulates that
+// piece's normal equations; then each piece is refitted exactly by box-constrained least
+// squares (its weight bounds, Eqs 4.27-4.28), a k-plane / Lloyd iteration. When the error
+// stops falling, pieces whose error exceeds epsilon are split into MIN or MAX of two tilted
+// copies (MAX if the data rise above the piece at the rim of its region, i.e. convex, else
+// MIN), pieces no sample uses are pruned, and the next round starts. Stops at epsilon, at the
+// piece cap or at the iteration cap; the model is always one that was evaluated, with every
+// piece inside its bounds.
+// Resumable: step(budget) visits at most about `budget` samples and returns; the sequence of
+// operations does not depend on the budgets, so sliced training equals one-shot training.
+// All working memory is inside the object (about 0.5 KB per piece for N = 3): make it static.
+template <typename Scalar, int N, std::size_t MaxPieces>
+class Trainer {
+ public:
+  using Model = Aln<Scalar, N, MaxPieces>;
+  using PieceType = Piece<Scalar, N>;
+  using Vec = Eigen::Matrix<Scalar, N, 1>;
+  using VecD = Eigen::Matrix<double, N, 1>;
+  using MatD = Eigen::Matrix<double, N, N>;
+
+  Trainer() = default;
+  Trainer(const Trainer&) = delete;
+  Trainer& operator=(const Trainer&) = delete;
+
+  void configure(const TrainerConfig& config) { config_ = config; }
+  [[nodiscard]] const TrainerConfig& config() const { return config_; }
+
+  // Resets `model` to one piece (keeping its ranges and weight bounds) and prepares to train
+  // it on `samples`, which must stay valid and unchanged until done. False if empty.
+  bool start(SampleSet<Scalar, N> samples, Model& model) {
+    samples_ = samples;
+    model_ = &model;
+    stats_ = TrainerStats{};
+    rng_ = config_.seed * 2654435761U + 0x9E3779B9U;
+    cap_ = config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
+    if (samples.empty()) {
+      stats_.done = true;
+      return false;
+    }
+    PieceType first{};
+    VecD w0 = VecD::Zero();
+    Vec centre = Vec::Zero();
+    for (int i = 0; i < N; ++i) {
+      w0(i) = std::clamp(0.0, lo(i), hi(i));
+      const Range<Scalar> r = model.input_range(i);
+      centre(i) = (r.lo + r.hi) / Scalar(2);
+    }
+    first.set(w0.template cast<Scalar>(), centre, Scalar(0));
+    model.reset(first);
+    scale_[0] = std::numeric_limits<double>::infinity();
+    cursor_ = 0;
+    pass_in_round_ = 0;
+    prev_objective_ = 0.0;
+    begin_pass();
+    stats_.pieces = 1;
+    return true;
+  }
+
+  // Advances by about max_sample_visits samples (at least one). True when training is done.
+  bool step(std::size_t max_sample_visits) {
+    if (stats_.done || model_ == nullptr) return true;
+    std::size_t budget = std::max<std::size_t>(max_sample_visits, 1);
+    while (budget > 0 && !stats_.done) {
+      const std::size_t end = std::min(samples_.size(), cursor_ + budget);
+      for (std::size_t k = cursor_; k < end; ++k) visit(samples_[k]);
+      budget -= end - cursor_;
+      stats_.sample_visits += end - cursor_;
+      cursor_ = end;
+      if (cursor_ == samples_.size()) finish_pass();
+    }
+    return stats_.done;
+  }
+
+  // One-shot training: start() and step() to completion.
+  bool train(SampleSet<Scalar, N> samples, Model& model) {
+    if (!start(samples, model)) return false;
+    while (!step(std::numeric_limits<std::size_t>::max() / 2)) {
+    }
+    return true;
+  }
+
+  [[nodiscard]] bool done() const { return stats_.done; }
+  [[nodiscard]] const TrainerStats& stats() const { return stats_; }
+
+ private:
+  // Per-piece sums over the samples it is responsible for, in coordinates shifted by the
+  // piece's centroid at the start of the pass (better conditioned).
+  struct Accumulator {
+    double sw = 0.0;  // sum of (robust) weights
+    std::size_t count = 0;
+    VecD sx = VecD::Zero();
+    double sy = 0.0;
+    MatD sxx = MatD::Zero();
+    VecD sxy = VecD::Zero();
+    double sse = 0.0;        // robust-weighted squared residuals
+    double sse_plain = 0.0;  // sample-weighted squared residuals
+    double sw_plain = 0.0;
+    VecD srd = VecD::Zero();  // sum w r d_j^2 (d normalised by the input range width)
+    VecD sd = VecD::Zero();   // sum w d_j^2
+    double sr = 0.0;          // sum w r
+  };
+  using Accumulators = std::array<Accumulator, MaxPieces>;
+
+  double lo(int i) const { return static_cast<double>(model_->weight_lo(i)); }
+  double hi(int i) const { return static_cast<double>(model_->weight_hi(i)); }
+  double width(int i) const {
+    const Range<Scalar> r = model_->input_range(i);
+    const double w = static_cast<double>(r.hi) - static_cast<double>(r.lo);
+    return w > 0.0 ? w : 1.0;
+  }
+
+  std::uint32_t next_random() {
+    rng_ ^= rng_ << 13;
+    rng_ ^= rng_ >> 17;
+    rng_ ^= rng_ << 5;
+    return rng_;
+  }
+
+  double robust_weight(double r, double s) const {
+    if (config_.robust == RobustWeighting::kNone || !std::isfinite(s)) return 1.0;
+    const double u = std::fabs(r) / s;
+    if (config_.robust == RobustWeighting::kHuber) {
+      constexpr double kHuber = 1.345;
+      return u <= kHuber ? 1.0 : kHuber / u;
+    }
+    constexpr double kTukey = 4.685;
+    if (u >= kTukey) return 0.0;
+    const double t = 1.0 - (u / kTukey) * (u / kTukey);
+    return t * t;
+  }
+
+  void begin_pass() {
+    Accumulators& acc = *current_;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) acc[p] = Accumulator{};
+  }
+
+  void visit(const Sample<Scalar, N>& s) {
+    const EvalResult<Scalar> e = model_->evaluate_alpha_beta(s.x);
+    const PieceType& piece = model_->piece(e.piece);
+    Accumulator& a = (*current_)[e.piece];
+    const double r = static_cast<double>(s.y) - static_cast<double>(e.value);
+    const double w_plain = static_cast<double>(s.weight);
+    const double w = w_plain * robust_weight(r, scale_[e.piece]);
+    const VecD x = (s.x - piece.centroid).template cast<double>();
+    const double y = static_cast<double>(s.y) - static_cast<double>(piece.centroid_output);
+    a.count += 1;
+    a.sw_plain += w_plain;
+    a.sse_plain += w_plain * r * r;
+    a.sw += w;
+    a.sx += w * x;
+    a.sy += w * y;
+    a.sxx.template selfadjointView<Eigen::Lower>().rankUpdate(x, w);
+    a.sxy += (w * y) * x;
+    a.sse += w * r * r;
+    a.sr += w * r;
+    for (int j = 0; j < N; ++j) {
+      const double d = x(j) / width(j);
+      a.sd(j) += w * d * d;
+      a.srd(j) += w * r * d * d;
+    }
+  }
+
+  // Least-squares refit of piece p from its sums, honouring the weight bounds exactly.
+  void refit(std::size_t p, const Accumulator& a) {
+    if (a.sw <= 0.0 || a.count == 0) return;
+    PieceType& piece = model_->piece(p);
+    const VecD xbar = a.sx / a.sw;
+    const double ybar = a.sy / a.sw;
+    MatD c = a.sxx.template selfadjointView<Eigen::Lower>();
+    c = c / a.sw - xbar * xbar.transpose();
+    VecD g = a.sxy / a.sw - xbar * ybar;
+    // A tiny ridge towards the current slopes keeps directions without data where they were.
+    const VecD w_now = piece.weight.template cast<double>();
+    std::array<double, static_cast<std::size_t>(N)> lo_b{};
+    std::array<double, static_cast<std::size_t>(N)> hi_b{};
+    for (int i = 0; i < N; ++i) {
+      const double ridge = 1e-9 * std::max(c(i, i), 0.0) + 1e-12 * width(i) * width(i);
+      c(i, i) += ridge;
+      g(i) += ridge * w_now(i);
+      lo_b[static_cast<std::size_t>(i)] = lo(i);
+      hi_b[static_cast<std::size_t>(i)] = hi(i);
+    }
+    VecD w = w_now;
+    if (!solve_box_constrained_lsq<N>(c, g, lo_b, hi_b, w)) return;
+    const Vec centroid = piece.centroid + xbar.template cast<Scalar>();
+    const Scalar cy = piece.centroid_output + static_cast<Scalar>(ybar);
+    piece.set(w.template cast<Scalar>(), centroid, cy);
+  }
+
+  void finish_pass() {
+    stats_.passes += 1;
+    Accumulators& acc = *current_;
+    const std::size_t pieces = model_->piece_count();
+    double sse = 0.0;
+    double sw = 0.0;
+    double sse_plain = 0.0;
+    double sw_plain = 0.0;
+    for (std::size_t p = 0; p < pieces; ++p) {
+      sse += acc[p].sse;
+      sw += acc[p].sw;
+      sse_plain += acc[p].sse_plain;
+      sw_plain += acc[p].sw_plain;
+    }
+    const double objective = sse;
+    const bool worse = pass_in_round_ > 0 && objective > prev_objective_;
+    const bool converged = worse || pass_in_round_ >= config_.max_refit_passes ||
+                           (pass_in_round_ > 0 && objective >= prev_objective_ * (1.0 - 1e-4));
+    if (worse) {
+      // The last refit made things worse: go back to the model before it, and its sums.
+      for (std::size_t p = 0; p < pieces; ++p) {
+        model_->piece(p) = backup_[p];
+        scale_[p] = backup_scale_[p];
+      }
+      std::swap(current_, previous_);
+      finish_round();
+      return;
+    }
+    stats_.rms = sw_plain > 0.0 ? std::sqrt(sse_plain / sw_plain) : 0.0;
+    stats_.robust_rms = sw > 0.0 ? std::sqrt(sse / sw) : 0.0;
+    if (converged) {
+      finish_round();
+      return;
+    }
+    // Refit every piece; keep the evaluated model and its sums in case the refit is worse.
+    for (std::size_t p = 0; p < pieces; ++p) {
+      backup_[p] = model_->piece(p);
+      backup_scale_[p] = scale_[p];
+    }
+    update_scales(acc);
+    for (std::size_t p = 0; p < pieces; ++p) refit(p, acc[p]);
+    prev_objective_ = objective;
+    pass_in_round_ += 1;
+    std::swap(current_, previous_);
+    next_pass();
+  }
+
+  void next_pass() {
+    cursor_ = 0;
+    begin_pass();
+  }
+
+  void update_scales(const Accumulators& acc) {
+    const double base = config_.robust_scale > 0.0 ? config_.robust_scale : config_.epsilon;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+      const double rms = acc[p].sw > 0.0 ? std::sqrt(acc[p].sse / acc[p].sw) : 0.0;
+      scale_[p] = std::max(base, rms);
+    }
+  }
+
+  // The current model and the sums in *current_ belong together: prune, split or stop.
+  void finish_round() {
+    Accumulators& acc = *current_;
+    double sse = 0.0;
+    double sw = 0.0;
+    double sse_plain = 0.0;
+    double sw_plain = 0.0;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+      sse += acc[p].sse;
+      sw += acc[p].sw;
+      sse_plain += acc[p].sse_plain;
+      sw_plain += acc[p].sw_plain;
+    }
+    stats_.rms = sw_plain > 0.0 ? std::sqrt(sse_plain / sw_plain) : 0.0;
+    stats_.robust_rms = sw > 0.0 ? std::sqrt(sse / sw) : 0.0;
+    prune(acc);
+    stats_.pieces = model_->piece_count();
+    if (stats_.iterations >= config_.max_iterations || model_->piece_count() >= cap_) {
+      stats_.done = true;
+      return;
+    }
+    // Candidates for splitting.
+    const std::size_t pieces = model_->piece_count();
+    std::array<std::uint8_t, MaxPieces> want{};
+    std::size_t wanted = 0;
+    const double eps2 = config_.epsilon * config_.epsilon;
+    const auto enough = [&](const Accumulator& a) {
+      return a.count > static_cast<std::size_t>(N) + 1 && a.sw > 0.0;
+    };
+    if (config_.split_rule == SplitRule::kPieceRms) {
+      for (std::size_t p = 0; p < pieces; ++p) {
+        if (enough(acc[p]) && acc[p].sse > eps2 * acc[p].sw) {
+          want[p] = 1;
+          ++wanted;
+        }
+      }
+    } else if (stats_.robust_rms > config_.epsilon) {
+      const double mean_sse = sse / static_cast<double>(pieces);
+      for (std::size_t p = 0; p < pieces; ++p) {
+        if (enough(acc[p]) && acc[p].sse >= mean_sse) {
+          want[p] = 1;
+          ++wanted;
+        }
+      }
+    }
+    if (wanted == 0) {
+      stats_.done = true;
+      return;
+    }
+    update_scales(acc);
+    // Split the worst first until the cap.
+    std::size_t made = 0;
+    while (model_->piece_count() < cap_) {
+      std::size_t best = MaxPieces;
+      for (std::size_t p = 0; p < pieces; ++p) {
+        if (want[p] != 0 && (best == MaxPieces || acc[p].sse > acc[best].sse)) best = p;
+      }
+      if (best == MaxPieces) break;
+      want[best] = 0;
+      if (split(best, acc[best])) ++made;
+    }
+    if (made == 0) {
+      stats_.done = true;
+      return;
+    }
+    stats_.iterations += 1;
+    stats_.pieces = model_->piece_count();
+    pass_in_round_ = 0;
+    prev_objective_ = 0.0;
+    next_pass();
+  }
+
+  // Splits piece p into kind(A, B): two copies tilted up and down along the input where the
+  // residuals curve most, crossing at the centroid of the piece's samples.
+  bool split(std::size_t p, const Accumulator& a) {
+    const PieceType old = model_->piece(p);
+    const VecD mean = a.sx / a.sw;
+    const double rbar = a.sr / a.sw;
+    const double rms = std::sqrt(a.sse / a.sw);
+    int axis = -1;
+    double best_score = -1.0;
+    double best_cov = 0.0;
+    for (int j = 0; j < N; ++j) {
+      const double var = a.sxx(j, j) / a.sw - mean(j) * mean(j);
+      const bool room =
+          hi(j) > static_cast<double>(old.weight(j)) || lo(j) < static_cast<double>(old.weight(j));
+      if (!(var > 0.0) || !room) continue;
+      const double cov = a.srd(j) / a.sw - rbar * (a.sd(j) / a.sw);
+      const double score = std::fabs(cov) + 1e-12 * var / (width(j) * width(j));
+      if (score > best_score) {
+        best_score = score;
+        best_cov = cov;
+        axis = j;
+      }
+    }
+    if (axis < 0) return false;
+    const double var = a.sxx(axis, axis) / a.sw - mean(axis) * mean(axis);
+    const double jitter = 0.75 + 0.5 * static_cast<double>(next_random() >> 8) / 16777216.0;
+    const double tilt = jitter * 2.0 * std::max(rms, 1e-6) / std::sqrt(var);
+    const double w = static_cast<double>(old.weight(axis));
+    const double up = std::min(tilt, hi(axis) - w);
+    const double down = std::min(tilt, w - lo(axis));
+    if (!(up + down > 0.0)) return false;
+    const Vec centroid = old.centroid + mean.template cast<Scalar>();
+    const Scalar cy = old.value(centroid);
+    Vec wa = old.weight;
+    Vec wb = old.weight;
+    wa(axis) = static_cast<Scalar>(std::max(up, 0.0) + w);
+    wb(axis) = static_cast<Scalar>(w - std::max(down, 0.0));
+    wa(axis) = std::clamp(wa(axis), model_->weight_lo(axis), model_->weight_hi(axis));
+    wb(axis) = std::clamp(wb(axis), model_->weight_lo(axis), model_->weight_hi(axis));
+    PieceType first{};
+    PieceType second{};
+    first.set(wa, centroid, cy);
+    second.set(wb, centroid, cy);
+    const NodeKind kind = best_cov > 0.0 ? NodeKind::kMax : NodeKind::kMin;
+    const std::size_t q = model_->piece_count();
+    if (!model_->split_piece(p, kind, first, second)) return false;
+    scale_[q] = scale_[p];
+    return true;
+  }
+
+  // Removes pieces no sample is responsible for (their parent becomes their sibling). The
+  // value at every sample is unchanged, so the sums stay valid; they are renumbered.
+  void prune(Accumulators& acc) {
+    std::array<std::uint8_t, Model::kMaxNodes> alive{};
+    std::size_t dead = 0;
+    for (const std::uint16_t n : model_->post_order()) {
+      const auto& node = model_->node(n);
+      if (node.kind == NodeKind::kPiece) {
+        alive[n] = acc[node.a].count > 0 ? 1 : 0;
+        if (alive[n] == 0) ++dead;
+      } else {
+        alive[n] = (alive[node.a] != 0 || alive[node.b] != 0) ? 1 : 0;
+      }
+    }
+    if (dead == 0 || alive[0] == 0) return;
+    // Copy the live tree top-down into new arrays (explicit stack, no recursion).
+    struct Job {
+      std::uint16_t from;
+      std::uint16_t to;
+    };
+    std::array<Job, Model::kMaxNodes> stack{};
+    std::size_t top = 0;
+    std::size_t new_nodes = 1;
+    std::size_t new_pieces = 0;
+    stack[top++] = Job{0, 0};
+    while (top > 0) {
+      const Job job = stack[--top];
+      std::uint16_t from = job.from;
+      // Skip inner nodes with one dead child.
+      while (model_->node(from).kind != NodeKind::kPiece) {
+        const auto& n = model_->node(from);
+        if (alive[n.a] != 0 && alive[n.b] != 0) break;
+        from = alive[n.a] != 0 ? n.a : n.b;
+      }
+      const auto& n = model_->node(from);
+      if (n.kind == NodeKind::kPiece) {
+        tmp_pieces_[new_pieces] = model_->piece(n.a);
+        tmp_acc_[new_pieces] = acc[n.a];
+        tmp_scale_[new_pieces] = scale_[n.a];
+        tmp_nodes_[job.to] =
+            typename Model::Node{NodeKind::kPiece, static_cast<std::uint16_t>(new_pieces), 0};
+        ++new_pieces;
+      } else {
+        const auto left = static_cast<std::uint16_t>(new_nodes);
+        const auto right = static_cast<std::uint16_t>(new_nodes + 1);
+        new_nodes += 2;
+        tmp_nodes_[job.to] = typename Model::Node{n.kind, left, right};
+        stack[top++] = Job{n.b, right};
+        stack[top++] = Job{n.a, left};
+      }
+    }
+    if (!model_->assign(std::span<const typename Model::Node>(tmp_nodes_.data(), new_nodes),
+                        std::span<const PieceType>(tmp_pieces_.data(), new_pieces))) {
+      return;
+    }
+    for (std::size_t p = 0; p < new_pieces; ++p) {
+      acc[p] = tmp_acc_[p];
+      scale_[p] = tmp_scale_[p];
+    }
+  }
+
+  TrainerConfig config_{};
+  TrainerStats stats_{};
+  SampleSet<Scalar, N> samples_{};
+  Model* model_ = nullptr;
+  std::size_t cap_ = MaxPieces;
+  std::size_t cursor_ = 0;
+  std::size_t pass_in_round_ = 0;
+  double prev_objective_ = 0.0;
+  std::uint32_t rng_ = 1;
+  Accumulators acc_a_{};
+  Accumulators acc_b_{};
+  Accumulators tmp_acc_{};
+  Accumulators* current_ = &acc_a_;
+  Accumulators* previous_ = &acc_b_;
+  std::array<PieceType, MaxPieces> backup_{};
+  std::array<double, MaxPieces> scale_{};
+  std::array<double, MaxPieces> backup_scale_{};
+  std::array<PieceType, MaxPieces> tmp_pieces_{};
+  std::array<typename Model::Node, Model::kMaxNodes> tmp_nodes_{};
+  std::array<double, MaxPieces> tmp_scale_{};
+};
+
+}  // namespace boticelli::aln
