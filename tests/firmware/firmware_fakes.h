@@ -1,0 +1,103 @@
+// Small device fakes for the firmware tests: inputs, output, base, PTU, camera, watchdog (state only, no I/O).
+#pragma once
+
+#include <cstdint>
+
+#include "hal/hal.h"
+
+namespace boticelli::test {
+
+class FakeInput final : public hal::DigitalIn {
+ public:
+  bool read() override { return level; }
+  bool activated_since_last_poll() override {
+    const bool e = edge;
+    edge = false;
+    return e;
+  }
+  void press() {
+    level = true;
+    edge = true;
+  }
+  bool level = false;
+  bool edge = false;
+};
+
+class FakeOutput final : public hal::DigitalOut {
+ public:
+  void write(bool active) override {
+    level = active;
+    ++writes;
+  }
+  bool level = false;
+  int writes = 0;
+};
+
+// Records stop() with the clock's time, so tests can tell how soon the base was stopped.
+class FakeBase final : public hal::Base {
+ public:
+  explicit FakeBase(hal::Clock* clock = nullptr) : clock_(clock) {}
+  bool init() override { return true; }
+  void update() override { ++updates; }
+  void set_velocity(float v, float w) override {
+    if (health_ == hal::BaseHealth::kReady) {
+      v_m_s = v;
+      omega_rad_s = w;
+    }
+  }
+  void stop() override {
+    if (health_ != hal::BaseHealth::kStopped && clock_ != nullptr) {
+      stopped_at_us = clock_->now_us();
+    }
+    ++stops;
+    health_ = hal::BaseHealth::kStopped;
+    v_m_s = 0.0F;
+    omega_rad_s = 0.0F;
+  }
+  bool resume() override {
+    if (refuse_resume) return false;
+    health_ = hal::BaseHealth::kReady;
+    return true;
+  }
+  hal::BaseHealth health() const override { return health_; }
+  hal::Odometry odometry() const override { return odometry_value; }
+
+  hal::Odometry odometry_value;
+  float v_m_s = 0.0F;
+  float omega_rad_s = 0.0F;
+  int updates = 0;
+  int stops = 0;
+  bool refuse_resume = false;
+  std::uint64_t stopped_at_us = 0;
+  hal::BaseHealth health_ = hal::BaseHealth::kReady;
+
+ private:
+  hal::Clock* clock_;
+};
+
+class FakePanTilt final : public hal::PanTilt {
+ public:
+  bool init() override { return true; }
+  void update() override { ++updates; }
+  bool move_to(float pan, float tilt) override {
+    state_value.pan_rad = pan;
+    state_value.tilt_rad = tilt;
+    return true;
+  }
+  void halt() override { ++halts; }
+  hal::PanTiltState state() const override { return state_value; }
+  hal::PanTiltLimits limits() const override { return {}; }
+  hal::PanTiltState state_value;
+  int updates = 0;
+  int halts = 0;
+};
+
+class FakeWatchdog final : public hal::Watchdog {
+ public:
+  bool start(std::uint32_t) override { return true; }
+  void kick() override { ++kicks; }
+  void stop() override {}
+  int kicks = 0;
+};
+
+}  // namespace boticelli::test
