@@ -1,0 +1,94 @@
+// Single-camera stereo on one frame pair (§3.4.1): downsample, select, track, triangulate, evidence
+// → Readings.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/reading.h"
+#include "algo/image/epipolar_tracker.h"
+#include "algo/image/features.h"
+#include "algo/image/low_res_frame.h"
+#include "algo/stereo/rig.h"
+
+namespace boticelli::stereo {
+
+struct StereoParams {
+  image::FeatureParams features;    // cap 500, central band, min strength
+  image::TrackParams tracking;      // 3 px band, E_thresh, distinctiveness
+  float match_error_max = 1500.0F;  // E_max of Eq 3.8 [grey levels²], in agreement with E_thresh
+  float min_range_m = 0.2F;         // nearest depth searched, from the first optical centre [m]
+  bool fast_triangulation = false;  // Eq 3.4 instead of the exact Eq 3.2
+};
+
+// Where the PTU was for the two frames [rad]: same pan; the second frame after tilting
+// down by Φ (second_tilt_rad = first_tilt_rad − Φ for the thesis's rig).
+struct PairPose {
+  float pan_rad = 0.0F;
+  float first_tilt_rad = 0.0F;
+  float second_tilt_rad = 0.0F;
+};
+
+// One tracked and triangulated feature, with what went into its reading.
+struct StereoPoint {
+  Eigen::Vector2f first_px = Eigen::Vector2f::Zero();     // feature, low-resolution pixels
+  Eigen::Vector2f second_px = Eigen::Vector2f::Zero();    // match, sub-pixel
+  float match_error = 0.0F;                               // E (Eq 3.1) [grey levels²]
+  Eigen::Vector3f point_ptu_m = Eigen::Vector3f::Zero();  // PTU frame [m]
+  float range_camera_m = 0.0F;                            // from the first optical centre [m]
+  float range_error_m = 0.0F;                             // δr of Eq 3.7 at that range [m]
+  evidence::Reading reading;                              // {α, h, r, m}
+};
+
+class StereoProcessor {
+ public:
+  static constexpr std::size_t kMaxPoints = image::FeatureSelector::kMaxFeatures;
+
+  explicit StereoProcessor(const RigModel& rig, const StereoParams& params = {});
+  [[nodiscard]] const RigModel& rig() const { return rig_; }
+  [[nodiscard]] const StereoParams& params() const { return params_; }
+
+  // Averages the two YUYV frames (full resolution, as the rig's camera) by the rig's
+  // downsample factor into first_frame()/second_frame(), then process()es them.
+  std::size_t process_yuyv(const std::uint8_t* first_yuyv, const std::uint8_t* second_yuyv,
+                           std::uint32_t stride_bytes, const PairPose& pose,
+                           core::FixedVectorBase<evidence::Reading>& readings);
+
+  // One frame pair at the rig's low resolution → readings APPENDED to `readings` (a look
+  // around collects 15 pairs into one buffer); returns how many were appended. Also
+  // fills features() and points(). Nothing is allocated.
+  std::size_t process(const image::LowResFrame& first, const image::LowResFrame& second,
+                      const PairPose& pose, core::FixedVectorBase<evidence::Reading>& readings);
+
+  // Triangulates one correspondence (low-resolution pixels) for the given poses into the
+  // PTU frame, with the configured method; used for features and for the target.
+  bool triangulate(const CameraPose& first, const CameraPose& second,
+                   const Eigen::Vector2f& first_px, const Eigen::Vector2f& second_px,
+                   Eigen::Vector3f& point_ptu_m) const;
+
+  // The epipolar segment (App. A) searched for a first-frame pixel: from the image of
+  // the ray's point at infinity to that of its point at min_range_m.
+  bool epipolar_segment(const CameraPose& first, const CameraPose& second,
+                        const Eigen::Vector2f& first_px, image::EpipolarSegment& segment) const;
+
+  [[nodiscard]] const image::LowResFrame& first_frame() const { return first_; }
+  [[nodiscard]] const image::LowResFrame& second_frame() const { return second_; }
+  [[nodiscard]] const core::FixedVector<image::Feature, kMaxPoints>& features() const {
+    return features_;
+  }
+  [[nodiscard]] const core::FixedVector<StereoPoint, kMaxPoints>& points() const { return points_; }
+
+ private:
+  RigModel rig_;
+  StereoParams params_;
+  image::FeatureSelector selector_;
+  image::LowResFrame first_;
+  image::LowResFrame second_;
+  core::FixedVector<image::Feature, kMaxPoints> features_;
+  core::FixedVector<StereoPoint, kMaxPoints> points_;
+};
+
+}  // namespace boticelli::stereo

@@ -1,0 +1,175 @@
+// Ray-casting renderer of textured rectangles for the stereo tests and benchmark.
+#include "scene_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace boticelli::test {
+
+namespace {
+
+std::uint32_t hash3(std::int32_t x, std::int32_t y, std::uint32_t seed) {
+  std::uint32_t h = seed * 0x9E3779B9U ^ static_cast<std::uint32_t>(x) * 0x85EBCA6BU ^
+                    static_cast<std::uint32_t>(y) * 0xC2B2AE35U;
+  h ^= h >> 16;
+  h *= 0x7FEB352DU;
+  h ^= h >> 15;
+  h *= 0x846CA68BU;
+  h ^= h >> 16;
+  return h;
+}
+
+float unit_hash(std::int32_t x, std::int32_t y, std::uint32_t seed) {
+  return static_cast<float>(hash3(x, y, seed) >> 8) * (1.0F / 16777216.0F);
+}
+
+// Smooth value noise in [0, 1] with lattice spacing 1.
+float value_noise(float x, float y, std::uint32_t seed) {
+  const float fx = std::floor(x);
+  const float fy = std::floor(y);
+  const auto ix = static_cast<std::int32_t>(fx);
+  const auto iy = static_cast<std::int32_t>(fy);
+  float tx = x - fx;
+  float ty = y - fy;
+  tx = tx * tx * (3.0F - 2.0F * tx);
+  ty = ty * ty * (3.0F - 2.0F * ty);
+  const float a = unit_hash(ix, iy, seed);
+  const float b = unit_hash(ix + 1, iy, seed);
+  const float c = unit_hash(ix, iy + 1, seed);
+  const float d = unit_hash(ix + 1, iy + 1, seed);
+  return (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
+}
+
+const Eigen::Vector3f kPaperWhite(0.9F, 0.9F, 0.88F);
+const Eigen::Vector3f kTargetGreen(0.12F, 0.6F, 0.22F);
+
+Eigen::Vector3f surface_colour(const Patch& p, float x_m, float y_m) {
+  switch (p.surface) {
+    case Surface::kTexture: {
+      const float s = p.scale_m;
+      const float n = 0.5F * value_noise(x_m / s, y_m / s, p.seed) +
+                      0.3F * value_noise(x_m / (0.4F * s), y_m / (0.4F * s), p.seed + 1) +
+                      0.2F * value_noise(x_m / (0.16F * s), y_m / (0.16F * s), p.seed + 2);
+      const float g = 0.1F + 0.8F * n;
+      return {g, g * 0.95F, g * 0.9F};
+    }
+    case Surface::kCamouflage: {
+      const float s = p.scale_m;
+      const float n = 0.7F * value_noise(x_m / s, y_m / s, p.seed) +
+                      0.3F * value_noise(x_m / (0.3F * s), y_m / (0.3F * s), p.seed + 7);
+      if (n < 0.3F) return {0.1F, 0.1F, 0.08F};     // black
+      if (n < 0.48F) return {0.38F, 0.27F, 0.16F};  // brown
+      if (n < 0.64F) return {0.3F, 0.38F, 0.2F};    // olive green
+      return {0.55F, 0.52F, 0.36F};                 // khaki
+    }
+    case Surface::kPlain:
+      return p.colour;
+    case Surface::kPaper:
+      return kPaperWhite;
+    case Surface::kTarget: {
+      // Equilateral triangle, vertex up, centroid at the patch centre.
+      const float s = p.target_side_m;
+      const float h = s * 0.8660254F;
+      const float top = 2.0F * h / 3.0F;
+      const float below = y_m - (top - h);  // height above the base
+      if (below >= 0.0F && y_m <= top) {
+        const float half = 0.5F * s * (top - y_m) / h;
+        if (std::fabs(x_m) <= half) return kTargetGreen;
+      }
+      return kPaperWhite;
+    }
+    case Surface::kGreenSquare:
+      return (std::fabs(x_m) <= 0.5F * p.target_side_m && std::fabs(y_m) <= 0.5F * p.target_side_m)
+                 ? kTargetGreen
+                 : kPaperWhite;
+  }
+  return p.colour;
+}
+
+std::uint8_t to_byte(float v) {
+  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0F, 255.0F)));
+}
+
+}  // namespace
+
+Patch facing_wall(const Eigen::Vector3f& eye_m, const Eigen::Vector3f& forward, float distance_m,
+                  float half_size_m, Surface surface, std::uint32_t seed) {
+  Eigen::Vector3f f(forward.x(), forward.y(), 0.0F);
+  f.normalize();
+  Patch p;
+  p.centre_m = eye_m + distance_m * f;
+  p.right = Eigen::Vector3f(f.y(), -f.x(), 0.0F);  // seen from the eye, right is f × z
+  p.up = Eigen::Vector3f::UnitZ();
+  p.half_width_m = half_size_m;
+  p.half_height_m = half_size_m;
+  p.surface = surface;
+  p.seed = seed;
+  return p;
+}
+
+bool SceneRenderer::intersect(const Eigen::Vector3f& origin_m, const Eigen::Vector3f& dir,
+                              float& t_m, const Patch** hit) const {
+  bool found = false;
+  for (const Patch& p : patches_) {
+    const Eigen::Vector3f normal = p.right.cross(p.up);
+    const float denom = normal.dot(dir);
+    if (std::fabs(denom) < 1e-9F) continue;
+    const float t = normal.dot(p.centre_m - origin_m) / denom;
+    if (!(t > 1e-4F) || (found && t >= t_m)) continue;
+    const Eigen::Vector3f q = origin_m + t * dir - p.centre_m;
+    if (std::fabs(q.dot(p.right)) > p.half_width_m || std::fabs(q.dot(p.up)) > p.half_height_m)
+      continue;
+    t_m = t;
+    if (hit != nullptr) *hit = &p;
+    found = true;
+  }
+  return found;
+}
+
+Eigen::Vector3f SceneRenderer::shade(const Eigen::Vector3f& origin_m,
+                                     const Eigen::Vector3f& dir) const {
+  float t = 0.0F;
+  const Patch* hit = nullptr;
+  if (!intersect(origin_m, dir, t, &hit)) return background;
+  const Eigen::Vector3f q = origin_m + t * dir - hit->centre_m;
+  return surface_colour(*hit, q.dot(hit->right), q.dot(hit->up));
+}
+
+void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::CameraPose& pose,
+                                std::uint8_t* yuyv, std::uint32_t noise_seed,
+                                float noise_sigma) const {
+  const stereo::CameraIntrinsics& cam = rig.camera();
+  const auto w = static_cast<std::int32_t>(cam.width_px);
+  const auto h = static_cast<std::int32_t>(cam.height_px);
+  for (std::int32_t v = 0; v < h; ++v) {
+    std::uint8_t* row = yuyv + static_cast<std::ptrdiff_t>(v) * w * 2;
+    for (std::int32_t u = 0; u < w; u += 2) {
+      float ys[2];
+      float cb = 0.0F;
+      float cr = 0.0F;
+      for (std::int32_t k = 0; k < 2; ++k) {
+        const Eigen::Vector2f pixel(static_cast<float>(u + k), static_cast<float>(v));
+        const Eigen::Vector3f rgb =
+            255.0F * shade(pose.centre_m, stereo::RigModel::ray_ptu(pose, cam, pixel));
+        // Noise: sum of three uniforms (variance 3/12 per unit), scaled to noise_sigma.
+        const float n = unit_hash(u + k, v, noise_seed) + unit_hash(u + k, v, noise_seed + 101) +
+                        unit_hash(u + k, v, noise_seed + 202) - 1.5F;
+        ys[k] = 0.299F * rgb.x() + 0.587F * rgb.y() + 0.114F * rgb.z() + 2.0F * noise_sigma * n;
+        cb += 0.5F * (-0.168736F * rgb.x() - 0.331264F * rgb.y() + 0.5F * rgb.z());
+        cr += 0.5F * (0.5F * rgb.x() - 0.418688F * rgb.y() - 0.081312F * rgb.z());
+      }
+      std::uint8_t* p = row + static_cast<std::ptrdiff_t>(u) * 2;
+      p[0] = to_byte(ys[0]);
+      p[1] = to_byte(cb + 128.0F);
+      p[2] = to_byte(ys[1]);
+      p[3] = to_byte(cr + 128.0F);
+    }
+  }
+}
+
+Eigen::Vector3f SceneRenderer::target_corner(const Patch& patch) {
+  const float top = 2.0F * patch.target_side_m * 0.8660254F / 3.0F;
+  return patch.centre_m + top * patch.up;
+}
+
+}  // namespace boticelli::test

@@ -1,0 +1,132 @@
+// Target detection (§3.4.2) on rendered scenes: found at 0.5–4 m, never in scenes without it.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <vector>
+
+#include "algo/image/low_res_frame.h"
+#include "algo/image/target_detector.h"
+#include "algo/stereo/rig.h"
+#include "scene_renderer.h"
+#include "CppUTest/TestHarness.h"
+#include "alloc_guard.h"
+
+using namespace boticelli;
+
+namespace {
+
+// Deterministic scene parameters.
+struct Lcg {
+  std::uint32_t state;
+  float next() {
+    state = state * 1664525U + 1013904223U;
+    return static_cast<float>(state >> 8) * (1.0F / 16777216.0F);
+  }
+  float range(float lo, float hi) { return lo + (hi - lo) * next(); }
+};
+
+image::LowResFrame& frame() {
+  static image::LowResFrame instance;
+  return instance;
+}
+
+image::TargetDetection render_and_detect(const stereo::RigModel& rig,
+                                         const stereo::CameraPose& pose,
+                                         const test::SceneRenderer& scene, std::uint32_t seed) {
+  std::vector<std::uint8_t> yuyv(std::size_t{rig.camera().width_px} * rig.camera().height_px * 2);
+  scene.render_yuyv(rig, pose, yuyv.data(), seed, 1.5F);
+  CHECK(image::downsample_yuyv(yuyv.data(), rig.camera().width_px, rig.camera().height_px,
+                               rig.camera().width_px * 2, 4, frame()));
+  static image::TargetDetector detector;
+  image::TargetDetection d;
+  CHECK_NO_ALLOCATION(d = detector.detect(frame()));
+  return d;
+}
+
+}  // namespace
+
+TEST_GROUP(Target){};
+
+TEST(Target, CornerIsFoundFromHalfAMetreToFourMetres) {
+  const stereo::RigModel rig;
+  Lcg rng{12345};
+  std::printf("\n  distance [m]  found  confidence  corner error [low-res px]\n");
+  for (const float distance : {0.5F, 0.8F, 1.2F, 1.8F, 2.5F, 3.2F, 4.0F}) {
+    const float pan = rng.range(-3.0F, 3.0F);
+    const float tilt = rng.range(-0.15F, 0.15F);
+    const stereo::CameraPose pose = rig.camera_pose(pan, tilt);
+    test::SceneRenderer scene;
+    // Camouflage wall behind, the paper a little in front of it, off the optical axis.
+    const Eigen::Vector3f forward = pose.rotation.col(2);
+    test::Patch wall = test::facing_wall(pose.centre_m, forward, distance + 0.02F, 5.0F,
+                                         test::Surface::kCamouflage, 9);
+    wall.scale_m = 0.08F;
+    scene.add(wall);
+    test::Patch paper =
+        test::facing_wall(pose.centre_m, forward, distance, 0.15F, test::Surface::kTarget, 1);
+    const float lateral = rng.range(-0.2F, 0.2F) * distance;
+    paper.centre_m += lateral * paper.right + rng.range(-0.1F, 0.1F) * distance * paper.up;
+    scene.add(paper);
+    const image::TargetDetection d = render_and_detect(rig, pose, scene, 77);
+    Eigen::Vector2f truth;
+    CHECK(stereo::RigModel::project_ptu(pose, rig.low_res_camera(),
+                                        test::SceneRenderer::target_corner(paper), truth));
+    const float error = (Eigen::Vector2f(d.u_px, d.v_px) - truth).norm();
+    std::printf("  %4.1f          %s    %.2f        %.2f\n", static_cast<double>(distance),
+                d.found ? "yes" : "no ", static_cast<double>(d.confidence),
+                static_cast<double>(error));
+    CHECK(d.found);
+    CHECK(error < 1.5F);
+  }
+}
+
+TEST(Target, NothingIsFoundInFiftyScenesWithoutTheTarget) {
+  const stereo::RigModel rig;
+  Lcg rng{777};
+  int false_detections = 0;
+  for (int scene_index = 0; scene_index < 50; ++scene_index) {
+    const float pan = rng.range(-3.0F, 3.0F);
+    const float tilt = rng.range(-0.2F, 0.15F);
+    const stereo::CameraPose pose = rig.camera_pose(pan, tilt);
+    const Eigen::Vector3f forward = pose.rotation.col(2);
+    test::SceneRenderer scene;
+    const float distance = rng.range(0.6F, 4.5F);
+    test::Patch wall;
+    const int kind = scene_index % 3;
+    wall = test::facing_wall(pose.centre_m, forward, distance, 6.0F,
+                             kind == 0 ? test::Surface::kCamouflage : test::Surface::kPlain,
+                             static_cast<std::uint32_t>(scene_index));
+    wall.scale_m = rng.range(0.04F, 0.15F);
+    wall.colour =
+        Eigen::Vector3f(rng.range(0.2F, 0.9F), rng.range(0.2F, 0.9F), rng.range(0.2F, 0.9F));
+    scene.add(wall);
+    // Boxes (cardboard brown, camouflage or green faces), paper sheets and decoys in front.
+    const int objects = 1 + scene_index % 4;
+    for (int o = 0; o < objects; ++o) {
+      test::Patch box = test::facing_wall(pose.centre_m, forward, distance * rng.range(0.4F, 0.9F),
+                                          rng.range(0.1F, 0.4F), test::Surface::kPlain,
+                                          static_cast<std::uint32_t>(100 + o));
+      box.centre_m += rng.range(-0.4F, 0.4F) * distance * box.right +
+                      rng.range(-0.3F, 0.3F) * distance * box.up;
+      const int look = (scene_index + o) % 5;
+      if (look == 0) box.colour = Eigen::Vector3f(0.55F, 0.4F, 0.25F);  // cardboard
+      if (look == 1) box.surface = test::Surface::kCamouflage;
+      if (look == 2) box.colour = Eigen::Vector3f(0.12F, 0.6F, 0.22F);  // a plain green box
+      if (look == 3) box.surface = test::Surface::kPaper;
+      if (look == 4) {
+        box.surface = test::Surface::kGreenSquare;  // green square on white paper
+        box.target_side_m = 1.2F * box.half_width_m;
+      }
+      scene.add(box);
+    }
+    const image::TargetDetection d =
+        render_and_detect(rig, pose, scene, static_cast<std::uint32_t>(scene_index));
+    if (d.found) {
+      ++false_detections;
+      std::printf("\n  false detection in scene %d at (%.1f, %.1f), confidence %.2f", scene_index,
+                  static_cast<double>(d.u_px), static_cast<double>(d.v_px),
+                  static_cast<double>(d.confidence));
+    }
+  }
+  LONGS_EQUAL(0, false_detections);
+}

@@ -1,0 +1,95 @@
+// Tests of triangulation (Eqs 3.2, 3.4), readings about the PTU centre, and Eq 3.7/3.8 bookkeeping.
+#include <cmath>
+
+#include <Eigen/Core>
+
+#include "algo/core/angles.h"
+#include "algo/evidence/sensor_model.h"
+#include "algo/stereo/rig.h"
+#include "algo/stereo/triangulation.h"
+#include "CppUTest/TestHarness.h"
+
+using namespace boticelli::stereo;
+
+TEST_GROUP(Triangulation){};
+
+TEST(Triangulation, ExactFormRecoversAPointFromItsTwoImages) {
+  const RigModel rig;
+  const CameraIntrinsics& cam = rig.low_res_camera();
+  const CameraPose first = rig.camera_pose(-0.7F, 0.1F);
+  const CameraPose second = rig.second_pose(-0.7F, 0.1F);
+  const Eigen::Vector3f truth = first.to_ptu(Eigen::Vector3f(0.3F, -0.2F, 2.0F));
+  Eigen::Vector2f p1;
+  Eigen::Vector2f p2;
+  CHECK(RigModel::project_ptu(first, cam, truth, p1));
+  CHECK(RigModel::project_ptu(second, cam, truth, p2));
+  Eigen::Vector3f point;
+  CHECK(triangulate_exact(first.centre_m, RigModel::ray_ptu(first, cam, p1), second.centre_m,
+                          RigModel::ray_ptu(second, cam, p2), point));
+  CHECK((point - truth).norm() < 1e-3F);
+}
+
+TEST(Triangulation, FastFormAgreesWithTheExactOneNearTheImageCentre) {
+  const RigModel rig;
+  const CameraIntrinsics& cam = rig.low_res_camera();
+  const CameraPose first = rig.camera_pose(0.3F, -0.05F);
+  const CameraPose second = rig.second_pose(0.3F, -0.05F);
+  for (const float depth : {0.3F, 1.0F, 2.5F, 4.5F}) {
+    for (const float x : {-0.3F, 0.0F, 0.25F}) {
+      const Eigen::Vector3f truth_cam(x * depth, -0.2F * depth, depth);
+      const Eigen::Vector3f truth = first.to_ptu(truth_cam);
+      Eigen::Vector2f p1;
+      Eigen::Vector2f p2;
+      CHECK(RigModel::project_ptu(first, cam, truth, p1));
+      CHECK(RigModel::project_ptu(second, cam, truth, p2));
+      Eigen::Vector3f fast_cam;
+      CHECK(triangulate_fast(first, second, cam.normalized_from_pixel(p1),
+                             cam.normalized_from_pixel(p2), fast_cam));
+      // Eq 3.4 ignores the horizontal part of the motion; with the tilt axis parallel to
+      // the image rows that part is zero, so the two forms agree.
+      DOUBLES_EQUAL(truth_cam.z(), fast_cam.z(), 1e-3F * depth);
+      DOUBLES_EQUAL(truth_cam.x(), fast_cam.x(), 1e-3F * depth);
+    }
+  }
+}
+
+TEST(Triangulation, RaysThatMeetBehindTheCameraAreRejected) {
+  Eigen::Vector3f point;
+  CHECK_FALSE(triangulate_exact(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX(),
+                                Eigen::Vector3f(0, 0, -0.03F),
+                                Eigen::Vector3f(1.0F, 0.0F, -0.1F).normalized(), point));
+  CHECK_FALSE(triangulate_exact(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX(),
+                                Eigen::Vector3f(0, 0, -0.03F), Eigen::Vector3f::UnitX(), point));
+}
+
+TEST(Triangulation, ReadingIsTakenAboutThePtuCentre) {
+  const auto reading = reading_from_point(Eigen::Vector3f(-1.0F, -1.0F, 0.5F), 0.8F);
+  DOUBLES_EQUAL(1.25 * boticelli::core::kPi<double>, reading.alpha_rad, 1e-5);
+  DOUBLES_EQUAL(0.5, reading.h_m, 1e-6);
+  DOUBLES_EQUAL(1.5, reading.r_m, 1e-6);
+  DOUBLES_EQUAL(0.8, reading.m, 1e-6);
+}
+
+TEST(Triangulation, OnePixelOfDisparityMovesTheRangeByAboutHalfOfEq37) {
+  // Eq 3.7's δr = 2r²/(bF + r) bounds the error of one pixel of disparity; the derivative
+  // of the exact triangulation at the centre is r²/(bF): about half of it.
+  const RigModel rig;
+  const CameraIntrinsics& cam = rig.low_res_camera();
+  const CameraPose first = rig.camera_pose(0.0F, 0.0F);
+  const CameraPose second = rig.second_pose(0.0F, 0.0F);
+  for (const float depth : {0.5F, 1.0F, 2.0F}) {
+    const Eigen::Vector3f truth = first.to_ptu(Eigen::Vector3f(0.0F, 0.0F, depth));
+    Eigen::Vector2f p1;
+    Eigen::Vector2f p2;
+    CHECK(RigModel::project_ptu(first, cam, truth, p1));
+    CHECK(RigModel::project_ptu(second, cam, truth, p2));
+    Eigen::Vector3f moved;
+    CHECK(triangulate_exact(first.centre_m, RigModel::ray_ptu(first, cam, p1), second.centre_m,
+                            RigModel::ray_ptu(second, cam, p2 + Eigen::Vector2f(0.0F, 0.5F)),
+                            moved));
+    const float change = 2.0F * ((moved - first.centre_m).norm() - depth);  // per pixel
+    const float dr = boticelli::evidence::range_error_m(depth, rig.baseline_m(), cam.focal_px);
+    CHECK(std::fabs(change) > 0.35F * dr);
+    CHECK(std::fabs(change) < 0.75F * dr);
+  }
+}
