@@ -1,0 +1,97 @@
+// Navigation polygon from the inverted occupancy function: r = F⁻¹(α, h, m_safe), ρ = √(r² − h²)
+// (§5.4.1–5.4.2).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+#include "algo/core/angles.h"
+#include "algo/mapping/polygon_ops.h"
+#include "algo/mapping/star_polygon.h"
+
+namespace boticelli::mapping {
+
+// Everything the extraction needs to know, in one place. Heights are measured from the
+// floor; the occupancy model's h is relative to the PTU centre (thesis §4.5.2).
+struct ExtractionParams {
+  std::size_t vertex_count = kDefaultPolygonVertices;  // evenly spaced pan angles
+  float safe_occupancy = 0.6F;     // m_safe: at most this occupancy is free (§5.4)
+  float bounding_radius_m = 3.0F;  // beyond this the model is not trusted (§5.4.4)
+  float robot_radius_m = 0.2F;     // the cylindrical robot's radius
+  float ptu_height_m = 0.35F;      // PTU centre above the floor
+  float lowest_height_m = 0.03F;   // lowest slice above the floor (ground clearance)
+  float robot_height_m = 0.45F;    // top of the robot above the floor
+  std::size_t height_count = 5;    // slices from lowest_height_m to robot_height_m
+  float seam_margin_rad = 0.2F;    // near α = 0 also read the model at α ± 2π (the α seam)
+};
+
+inline constexpr std::size_t kMaxHeights = 16;
+
+// Height [m] of slice i relative to the PTU centre.
+inline float slice_height_m(const ExtractionParams& p, std::size_t i) {
+  const std::size_t n = std::clamp<std::size_t>(p.height_count, 1, kMaxHeights);
+  const float t = n == 1 ? 0.0F : static_cast<float>(i) / static_cast<float>(n - 1);
+  return p.lowest_height_m + t * (p.robot_height_m - p.lowest_height_m) - p.ptu_height_m;
+}
+
+// §5.4.2: the horizontal free distance ρ = √(r² − h²) for a free range r along the slice
+// at height h, clipped to the bounding circle. No solution (r not finite, e.g. the model
+// never reaches m_safe) is free up to the bounding circle; r ≤ |h| means the nearest point
+// of the slice, straight above or below the PTU, is already occupied: ρ = 0.
+inline float horizontal_free_distance_m(float r_m, float h_m, float bounding_radius_m) {
+  if (std::isnan(r_m) || (std::isinf(r_m) && r_m > 0.0F)) {
+    return bounding_radius_m;
+  }
+  if (!(r_m > std::fabs(h_m))) {
+    return 0.0F;
+  }
+  return std::min(std::sqrt(r_m * r_m - h_m * h_m), bounding_radius_m);
+}
+
+// The free polygon of one slice: `free_range(α [rad], h [m])` returns r [m] with
+// F(α, h, r) = m_safe (the inverted occupancy model, §5.4.1). Near the seam α = 0 the model
+// is also read at α + 2π (and just below 2π at α − 2π), where the α-wrapped samples were
+// fitted too (§4.9.1), and the smaller distance is kept: both describe the same direction.
+template <typename FreeRange>
+void extract_slice(const FreeRange& free_range, float h_m, const ExtractionParams& p,
+                   StarPolygon& out) {
+  out.set_vertex_count(p.vertex_count);
+  const float two_pi = core::kTwoPi<float>;
+  for (std::size_t k = 0; k < out.vertex_count(); ++k) {
+    const float alpha = out.angle_rad(k);
+    float rho = horizontal_free_distance_m(free_range(alpha, h_m), h_m, p.bounding_radius_m);
+    if (alpha < p.seam_margin_rad) {
+      rho = std::min(rho, horizontal_free_distance_m(free_range(alpha + two_pi, h_m), h_m,
+                                                     p.bounding_radius_m));
+    } else if (alpha > two_pi - p.seam_margin_rad) {
+      rho = std::min(rho, horizontal_free_distance_m(free_range(alpha - two_pi, h_m), h_m,
+                                                     p.bounding_radius_m));
+    }
+    out.set_rho_m(k, rho);
+  }
+}
+
+// The local map of one cycle, in the robot frame.
+struct LocalMap {
+  StarPolygon free;       // intersection of the slices' polygons, within the bounding circle
+  StarPolygon navigable;  // `free` shrunk by the robot radius: where the centre may go
+  bool can_move = false;  // false if the robot's disc already touches an obstacle
+};
+
+// §5.4.2: slices at height_count heights from the floor to the robot's top, intersected,
+// then shrunk exactly by the robot radius. The slope bounds on h in the model (Eq 4.25)
+// are what make a finite set of heights sufficient.
+template <typename FreeRange>
+void extract_local_map(const FreeRange& free_range, const ExtractionParams& p, LocalMap& out,
+                       StarPolygon& scratch) {
+  const std::size_t n = std::clamp<std::size_t>(p.height_count, 1, kMaxHeights);
+  extract_slice(free_range, slice_height_m(p, 0), p, out.free);
+  for (std::size_t i = 1; i < n; ++i) {
+    extract_slice(free_range, slice_height_m(p, i), p, scratch);
+    (void)intersect_into(out.free, scratch);
+  }
+  out.can_move = shrink_by_radius(out.free, p.robot_radius_m, out.navigable);
+}
+
+}  // namespace boticelli::mapping

@@ -1,0 +1,64 @@
+// Obstacle points inside the bounding circle and exploration points on it (§5.4.4), and their
+// global lists.
+#pragma once
+
+#include <cstddef>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/core/geometry.h"
+#include "algo/mapping/star_polygon.h"
+
+namespace boticelli::mapping {
+
+using PointList = core::FixedVectorBase<core::Point2>;
+
+struct MapPointParams {
+  float obstacle_spacing_m = 0.15F;     // along the boundary inside the bounding circle
+  float exploration_spacing_m = 0.5F;   // along the bounding circle: finds ~0.5 m channels
+  float on_circle_tolerance_m = 0.02F;  // ρ within this of the bounding radius is "on it"
+  float obstacle_merge_radius_m =
+      0.1F;  // a new obstacle point this close to a known one is the same
+  float exploration_merge_radius_m = 0.35F;  // likewise for exploration points
+  float explored_margin_m =
+      0.3F;  // an exploration point this far inside a later polygon is explored
+};
+
+// §5.4.4: splits the free polygon's boundary (robot frame) into sectors on the bounding
+// circle and sectors inside it, and places points at evenly spaced vertex angles in each
+// sector: obstacle points on the boundary inside the circle (about one per
+// obstacle_spacing_m of boundary), exploration points on the circle (one per
+// exploration_spacing_m of arc). Appends to the lists; returns false if one was full.
+bool extract_map_points(const StarPolygon& free, float bounding_radius_m,
+                        const MapPointParams& params, PointList& obstacles_robot,
+                        PointList& exploration_robot);
+
+inline constexpr std::size_t kMaxObstaclePoints = 4096;
+inline constexpr std::size_t kMaxExplorationPoints = 512;
+
+// The global obstacle and exploration lists in the world frame, merged across cycles.
+class GlobalMap {
+ public:
+  // Merges one cycle's points (robot frame, taken at `pose` from odometry): obstacle points
+  // closer than obstacle_merge_radius_m to a known one are dropped (deduplicated); known
+  // exploration points that the new free polygon covers (explored_margin_m inside it) are
+  // removed as explored, then new ones are added unless one is already that close. Returns
+  // false if a list overflowed (the points that did not fit are counted and dropped).
+  bool merge(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
+             const PointList& obstacles_robot, const PointList& exploration_robot,
+             const MapPointParams& params);
+
+  void clear();
+  [[nodiscard]] const PointList& obstacles() const { return obstacles_; }
+  [[nodiscard]] const PointList& exploration() const { return exploration_; }
+  // For persistence: restores saved lists (world frame) with push_back after clear().
+  PointList& obstacles() { return obstacles_; }
+  PointList& exploration() { return exploration_; }
+  [[nodiscard]] std::size_t dropped_points() const { return dropped_; }
+
+ private:
+  core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles_;
+  core::FixedVector<core::Point2, kMaxExplorationPoints> exploration_;
+  std::size_t dropped_ = 0;
+};
+
+}  // namespace boticelli::mapping

@@ -1,0 +1,29 @@
+// Intersection and exact robot-radius shrink of star-shaped navigation polygons (§5.4.2).
+#pragma once
+
+#include "algo/mapping/star_polygon.h"
+
+namespace boticelli::mapping {
+
+// into ← into ∩ other, vertex by vertex: ρ_k = min(ρ_k, ρ'_k). Both polygons must have the
+// same vertex count (returns false otherwise and leaves `into` unchanged). The result lies
+// inside both polygons (each sector's triangle is inside both sectors' triangles) and equals
+// the true intersection along every vertex ray; it is the largest polygon of this form that
+// lies in the intersection.
+bool intersect_into(StarPolygon& into, const StarPolygon& other);
+
+// Shrinks `free_region` by the robot radius [m] into `out` (same vertex count) such that
+// for every point p of `out` the robot's disc, moved in a straight line from the centre to
+// p, never leaves `free_region` (dist(segment [0, p], boundary) ≥ radius). Exact, not an
+// offset approximation: each ρ is the first contact of the ray with the radius-neighbourhood
+// of the boundary (stadiums around the edges), then each sector's triangle is checked
+// against the boundary and pulled in if the straight edge between two exact vertices would
+// cut a corner. Returns false (and all ρ = 0) if the disc at the centre already touches the
+// boundary: the robot cannot move safely at all.
+bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygon& out);
+
+// Smallest distance [m] from the segment [0, p] (robot frame) to the polygon's boundary;
+// the brute-force reference the tests and the planner's checks use (O(n)).
+[[nodiscard]] float sweep_clearance_m(const StarPolygon& region, core::Point2 p);
+
+}  // namespace boticelli::mapping
