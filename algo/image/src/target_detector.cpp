@@ -121,7 +121,31 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   if (aspect < 0.55F || aspect > 1.3F || fill < 0.3F || fill > 0.7F) {
     return out;
   }
-  // Row extents; a hole or a second run in a row breaks the triangle.
+  // Reference green: mean Cr of the blob's interior (pixels whose 4 neighbours are in it).
+  double interior_cr = 0.0;
+  int interior = 0;
+  int darkest_cr = 0;
+  for (std::uint32_t v = v_min; v <= v_max; ++v) {
+    for (std::uint32_t u = u_min; u <= u_max; ++u) {
+      const std::size_t i = frame.index(u, v);
+      if (labels_[i] != label) {
+        continue;
+      }
+      const int cr = int{frame.chroma_v[i]} - 128;
+      darkest_cr = std::min(darkest_cr, cr);
+      if (labels_[i - 1] == label && labels_[i + 1] == label && labels_[i - w] == label && labels_[i + w] == label) {
+        interior_cr += cr;
+        ++interior;
+      }
+    }
+  }
+  const double reference_cr = interior > 0 ? interior_cr / interior : static_cast<double>(darkest_cr);
+  if (!(reference_cr < 0.0)) {
+    return out;
+  }
+  // Row extents; a hole or a second run in a row breaks the triangle. Edges are sub-pixel:
+  // a row's green width is the sum of the coverage Cr/Cr_green of its pixels, centred on
+  // their coverage-weighted column (the 4x4 averaging makes coverage proportional to Cr).
   LineFit left;
   LineFit right;
   for (std::uint32_t v = v_min; v <= v_max; ++v) {
@@ -138,10 +162,19 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
     if (first < 0 || static_cast<std::uint32_t>(last - first + 1) > count + 1) {
       return out;
     }
-    // Edges (half-coverage boundaries) of the inner rows; the extreme rows are partial.
+    // The extreme rows are cut by the pixel grid vertically: only inner rows are fit.
     if (v > v_min && v < v_max) {
-      left.add(static_cast<double>(v), static_cast<double>(first) - 0.5);
-      right.add(static_cast<double>(v), static_cast<double>(last) + 0.5);
+      double width = 0.0;
+      double moment = 0.0;
+      for (std::int32_t u = first - 1; u <= last + 1; ++u) {
+        const int cr = int{frame.chroma_v[frame.index(static_cast<std::uint32_t>(u), v)]} - 128;
+        const double coverage = std::clamp(static_cast<double>(cr) / reference_cr, 0.0, 1.0);
+        width += coverage;
+        moment += coverage * u;
+      }
+      const double centre = moment / width;
+      left.add(static_cast<double>(v), centre - 0.5 * width);
+      right.add(static_cast<double>(v), centre + 0.5 * width);
     }
   }
   double a_l = 0, b_l = 0, rms_l = 0, a_r = 0, b_r = 0, rms_r = 0;
