@@ -1,0 +1,370 @@
+// Tests of the serial console: line assembly, parsing with hostile input, every command, telemetry, no allocation.
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fake_clock.h"
+#include "fake_serial_port.h"
+#include "firmware/console.h"
+#include "firmware/console_line.h"
+#include "firmware/console_parser.h"
+#include "firmware/executive.h"
+#include "firmware_fakes.h"
+
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+using boticelli::fakes::FakeClock;
+using boticelli::fakes::FakeSerialPort;
+using namespace boticelli::firmware;
+using namespace boticelli::test;
+
+namespace {
+
+class FakeView final : public MissionView {
+ public:
+  const char* state_name() const override { return "look"; }
+  boticelli::core::Pose2 pose() const override { return pose_value; }
+  float pan_rad() const override { return 0.5F; }
+  std::uint32_t features() const override { return 321; }
+  std::uint32_t pieces() const override { return 17; }
+  std::uint64_t cycles() const override { return 4; }
+  std::string_view model_text() const override { return model; }
+  MapCounts map_counts() const override { return {12, 34, 5}; }
+  boticelli::core::Pose2 pose_value{1.25F, -0.5F, 0.75F};
+  std::string model;
+};
+
+class IdleTask final : public Task {
+ public:
+  void run(std::uint64_t) override {}
+};
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = text.find("\r\n", start);
+    if (end == std::string::npos) break;
+    out.push_back(text.substr(start, end - start));
+    start = end + 2;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_GROUP(LineAssembler) {
+  LineAssembler a;
+  std::vector<std::string> lines;
+  std::vector<LineEvent> events;
+  void feed(std::string_view bytes) {
+    for (const char c : bytes) {
+      const LineEvent e = a.feed(static_cast<std::uint8_t>(c));
+      if (e == LineEvent::kLine) lines.emplace_back(a.line());
+      if (e != LineEvent::kNone) events.push_back(e);
+    }
+  }
+};
+
+TEST(LineAssembler, EndsLinesAtCrLfOrCrlfAndIgnoresEmptyLines) {
+  feed("status\rstats\npose\r\n\r\n\nmap\r");
+  CHECK_EQUAL(4U, lines.size());
+  STRCMP_EQUAL("status", lines[0].c_str());
+  STRCMP_EQUAL("stats", lines[1].c_str());
+  STRCMP_EQUAL("pose", lines[2].c_str());
+  STRCMP_EQUAL("map", lines[3].c_str());
+}
+
+TEST(LineAssembler, ErasesWithBackspaceOrDeleteAndCancelsWithCtrlC) {
+  feed("stax\btz\x7f\x7fts\r");
+  feed("garbage\x03help\r");
+  CHECK_EQUAL(2U, lines.size());
+  STRCMP_EQUAL("stats", lines[0].c_str());
+  STRCMP_EQUAL("help", lines[1].c_str());
+  CHECK(events[1] == LineEvent::kCancelled);
+}
+
+TEST(LineAssembler, DiscardsAnOverlongLineWholeAndRecovers) {
+  feed(std::string(LineAssembler::kMaxLineBytes + 1, 'a') + "\r");
+  CHECK_EQUAL(0U, lines.size());
+  CHECK(events.back() == LineEvent::kTooLong);
+  feed(std::string(LineAssembler::kMaxLineBytes, 'b') + "\r");
+  CHECK_EQUAL(1U, lines.size());
+  CHECK_EQUAL(LineAssembler::kMaxLineBytes, lines[0].size());
+  // Backspace cannot rescue an overflowed line.
+  feed(std::string(LineAssembler::kMaxLineBytes + 5, 'c') + "\b\b\b\b\b\b\r");
+  CHECK(events.back() == LineEvent::kTooLong);
+}
+
+TEST(LineAssembler, SpoilsALineWithControlOrNonAsciiBytes) {
+  feed("st\x1b[Aatus\r");
+  CHECK(events.back() == LineEvent::kBadByte);
+  feed("pose\xc3\xa9\r");
+  CHECK(events.back() == LineEvent::kBadByte);
+  feed(std::string("se\0t", 4) + "\r");
+  CHECK(events.back() == LineEvent::kBadByte);
+  CHECK_EQUAL(0U, lines.size());
+  feed("\tpose\r");
+  STRCMP_EQUAL(" pose", lines.at(0).c_str());
+}
+
+TEST_GROUP(ConsoleParser) {};
+
+TEST(ConsoleParser, SplitsWordsOnSpacesAndRefusesTooMany) {
+  Words w;
+  CHECK(split_words("  set   telemetry_ms  500 ", w));
+  CHECK_EQUAL(3U, w.count);
+  CHECK(w.word[1] == "telemetry_ms");
+  CHECK(w.word[2] == "500");
+  CHECK(split_words("", w));
+  CHECK_EQUAL(0U, w.count);
+  CHECK_FALSE(split_words("a b c d e", w));
+}
+
+TEST(ConsoleParser, ReadsOnlyPlainDecimalNumbers) {
+  float v = 0.0F;
+  CHECK(parse_number("-1.5", v));
+  DOUBLES_EQUAL(-1.5, v, 0.0);
+  CHECK(parse_number("2e-3", v));
+  DOUBLES_EQUAL(0.002, v, 1e-9);
+  for (const char* bad : {"", "-", ".", "e5", "0x10", "inf", "nan", "1.5x", "1 2", "1e99",
+                          "--1", "123456789012345678901234567890123"}) {
+    CHECK_FALSE_TEXT(parse_number(bad, v), bad);
+  }
+}
+
+TEST_GROUP(Console) {
+  FakeClock clock{5000000};
+  FakeSerialPort port;
+  Executive exec{clock};
+  FakeInput button, bumper;
+  FakeBase base;
+  Safety safety{button, bumper, base};
+  FakeView view;
+  ParameterTable parameters;
+  Console console{port, exec, safety, view, parameters};
+  IdleTask idle;
+  float gain = 2.0F;
+  std::uint64_t now_us = 5000000;
+  const char* error = "";
+
+  void setup() override {
+    CHECK(exec.add_task({"estop", 10000, 200}, idle, &error));
+    CHECK(exec.add_task({"camera", 20000, 2000}, idle, &error));
+    CHECK(exec.start(ExecutiveConfig{}, &error));
+    CHECK(console.register_parameters());
+    CHECK(parameters.add({"gain", &gain, 0.0F, 10.0F, false, "a gain [1]"}));
+    console.set_telemetry_ms(0.0F);
+  }
+  void service(int times = 1) {
+    for (int i = 0; i < times; ++i) {
+      console.service(now_us);
+      now_us += 10000;
+    }
+  }
+  // Sends one line and returns the reply lines.
+  std::vector<std::string> command(std::string_view line) {
+    port.clear_written();
+    port.feed(line);
+    port.feed("\r");
+    service(3);
+    return lines_of(port.written());
+  }
+};
+
+TEST(Console, AnswersHelpWithEveryCommand) {
+  const auto reply = command("help");
+  CHECK_EQUAL("OK", reply.back());
+  for (const char* name : {"help", "status", "stats", "pose", "model", "map", "pause", "resume",
+                           "estop", "clear-estop", "get", "set", "log", "shutdown", "quit"}) {
+    bool found = false;
+    for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
+    CHECK_TEXT(found, name);
+  }
+}
+
+TEST(Console, ReportsStatusPoseAndMap) {
+  auto reply = command("status");
+  CHECK_EQUAL(2U, reply.size());
+  STRCMP_CONTAINS("state=look estop=none paused=0", reply[0].c_str());
+  STRCMP_CONTAINS("cycles=4", reply[0].c_str());
+  reply = command("pose");
+  STRCMP_EQUAL("pose x_m=1.250 y_m=-0.500 yaw_rad=0.7500", reply.at(0).c_str());
+  reply = command("map");
+  STRCMP_EQUAL("map polygon_vertices=12 obstacle_points=34 exploration_points=5", reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.back());
+}
+
+TEST(Console, ShowsExecutiveTimingPerTask) {
+  for (int i = 0; i < 10; ++i) exec.run_frame();
+  const auto reply = command("stats");
+  CHECK_EQUAL(5U, reply.size());
+  STRCMP_CONTAINS("task estop", reply[0].c_str());
+  STRCMP_CONTAINS("runs=10", reply[0].c_str());
+  STRCMP_CONTAINS("task camera", reply[1].c_str());
+  STRCMP_CONTAINS("runs=5", reply[1].c_str());
+  STRCMP_CONTAINS("frame frame_us=10000 frames=10", reply[2].c_str());
+  STRCMP_CONTAINS("background util_pct=", reply[3].c_str());
+  CHECK_EQUAL("OK", command("stats reset").back());
+  STRCMP_CONTAINS("runs=0", command("stats").at(0).c_str());
+}
+
+TEST(Console, SaysThereIsNoModelUntilTheMissionHasOne) {
+  const auto reply = command("model");
+  CHECK_EQUAL(1U, reply.size());
+  STRCMP_EQUAL("ERR no model yet", reply[0].c_str());
+}
+
+TEST(Console, StreamsAModelLargerThanItsOutputBufferThroughASlowLine) {
+  std::string text = "VARIABLES 3\r\n";
+  while (text.size() < 3 * Console::kTxBytes) text += "LINEARFORM 0.125 -0.5 1.0 0.25\r\n";
+  view.model = text;
+  port.set_write_limit(100);  // about what 115200 baud moves in a 10 ms frame
+  port.clear_written();
+  port.feed("model\rstatus\r");
+  service(600);
+  const std::string& out = port.written();
+  CHECK(out.rfind(text, 0) == 0);  // the whole text first, intact
+  const auto reply = lines_of(out.substr(text.size()));
+  CHECK_EQUAL(3U, reply.size());
+  CHECK_EQUAL("OK", reply[0]);  // model's end
+  STRCMP_CONTAINS("status state=look", reply[1].c_str());
+  CHECK_EQUAL("OK", reply[2]);
+}
+
+TEST(Console, PausesAndResumesTheBackgroundWork) {
+  CHECK_EQUAL("OK", command("pause").back());
+  CHECK(exec.background_paused());
+  STRCMP_CONTAINS("paused=1", command("status").at(0).c_str());
+  CHECK_EQUAL("OK", command("resume").back());
+  CHECK_FALSE(exec.background_paused());
+}
+
+TEST(Console, EstopStopsTheBaseAndClearEstopReleasesIt) {
+  CHECK_EQUAL("OK", command("estop").back());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK(safety.cause() == StopCause::kConsole);
+  button.level = true;
+  STRCMP_EQUAL("ERR e-stop button still pressed", command("clear-estop").at(0).c_str());
+  CHECK(safety.engaged());
+  button.level = false;
+  CHECK_EQUAL("OK", command("clear-estop").back());
+  CHECK_FALSE(safety.engaged());
+}
+
+TEST(Console, GetsAndSetsParametersWithinTheirRange) {
+  auto reply = command("get gain");
+  STRCMP_EQUAL("gain=2 range=[0,10] a gain [1]", reply.at(0).c_str());
+  CHECK_EQUAL("OK", command("set gain 7.5").back());
+  DOUBLES_EQUAL(7.5, gain, 0.0);
+  reply = command("get");
+  CHECK_EQUAL(parameters.size() + 1, reply.size());
+  for (const char* bad : {"set gain 11", "set gain -0.1", "set gain abc", "set gain 0x3",
+                          "set gain nan", "set gain", "set nothing 1", "set gain 1 2",
+                          "set telemetry_ms 10.5", "set echo 2", "get nothing"}) {
+    reply = command(bad);
+    CHECK_EQUAL_TEXT(1U, reply.size(), bad);
+    CHECK_TEXT(reply[0].rfind("ERR ", 0) == 0, bad);
+  }
+  DOUBLES_EQUAL(7.5, gain, 0.0);
+}
+
+TEST(Console, ChangesTheLogLevelAndFiltersLogLines) {
+  STRCMP_EQUAL("log level=info", command("log").at(0).c_str());
+  STRCMP_EQUAL("log level=warn", command("log warn").at(0).c_str());
+  CHECK(console.log_level() == LogLevel::kWarn);
+  STRCMP_EQUAL("ERR unknown log level", command("log loud").at(0).c_str());
+  port.clear_written();
+  console.log(LogLevel::kInfo, "hidden %d", 1);
+  console.log(LogLevel::kError, "shown %d", 2);
+  service();
+  const auto out = lines_of(port.written());
+  CHECK_EQUAL(1U, out.size());
+  STRCMP_EQUAL("LOG error shown 2", out[0].c_str());
+}
+
+TEST(Console, AnswersBadInputWithOneErrorLineAndChangesNothing) {
+  const std::string too_long(LineAssembler::kMaxLineBytes + 10, 'x');
+  for (const std::string& bad :
+       {std::string("fly"), std::string("pose extra"), std::string("a b c d e"), too_long,
+        std::string("st\x01" "atus"), std::string("estop now")}) {
+    const auto reply = command(bad);
+    CHECK_EQUAL_TEXT(1U, reply.size(), bad.c_str());
+    CHECK_TEXT(reply[0].rfind("ERR ", 0) == 0, bad.c_str());
+  }
+  CHECK_FALSE(safety.engaged());
+  CHECK_FALSE(console.shutdown_requested());
+  DOUBLES_EQUAL(2.0, gain, 0.0);
+}
+
+TEST(Console, RequestsShutdownOnQuit) {
+  CHECK_EQUAL("OK shutting down", command("quit").back());
+  CHECK(console.shutdown_requested());
+}
+
+TEST(Console, EchoesTypedCharactersWhenAsked) {
+  CHECK_EQUAL("OK", command("set echo 1").back());
+  port.clear_written();
+  port.feed("poz\x7fse\r");
+  service(2);
+  CHECK(port.written().rfind("poz\b \bse\r\npose x_m=", 0) == 0);
+}
+
+TEST(Console, SendsTelemetryAtTheConfiguredPeriod) {
+  CHECK_EQUAL("OK", command("set telemetry_ms 500").at(0));
+  port.clear_written();
+  service(500);  // 5 s of 10 ms service calls
+  const auto out = lines_of(port.written());
+  CHECK_EQUAL(10U, out.size());
+  STRCMP_CONTAINS("TLM t_s=", out[0].c_str());
+  STRCMP_CONTAINS(
+      "state=look pan_rad=0.500 features=321 pieces=17 x_m=1.250 y_m=-0.500 yaw_rad=0.750 "
+      "estop=none",
+      out[0].c_str());
+  CHECK_EQUAL("OK", command("set telemetry_ms 0").at(0));
+  port.clear_written();
+  service(300);
+  CHECK_EQUAL(0U, port.written().size());
+}
+
+TEST(Console, SurvivesAFloodOfRandomBytesAndStillAnswers) {
+  std::uint32_t x = 12345;
+  std::string noise;
+  for (int round = 0; round < 200; ++round) {
+    noise.clear();
+    for (int i = 0; i < 500; ++i) {
+      x = x * 1664525U + 1013904223U;
+      noise.push_back(static_cast<char>(x >> 24));
+    }
+    port.clear_written();
+    port.feed(noise);
+    service(20);
+    for (const auto& l : lines_of(port.written())) {
+      // Every line the console sends is a protocol line, whatever came in.
+      bool known = l.rfind("ERR ", 0) == 0 || l == "OK" || l.rfind("LOG ", 0) == 0;
+      for (const char* data : {"status ", "task ", "frame ", "background ", "pose ", "map ",
+                               "log level=", "OK shutting down"}) {
+        known = known || l.rfind(data, 0) == 0;
+      }
+      CHECK_TEXT(known, l.c_str());
+    }
+  }
+  CHECK(gain >= 0.0F && gain <= 10.0F);
+  port.clear_written();
+  port.feed("\x03\rpose\r");
+  service(3);
+  STRCMP_CONTAINS("pose x_m=1.250", port.written().c_str());
+}
+
+TEST(Console, HandlesBytesAndLinesWithoutAllocating) {
+  console.set_telemetry_ms(100.0F);
+  service(2);
+  port.clear_written();
+  port.feed("status\rstats\rpose\rset gain 3\rget gain\rbogus\rlog debug\r");
+  port.feed(std::string(300, 'z') + "\r\x1b[A\rhelp\r");
+  CHECK_NO_ALLOCATION(service(50));
+  CHECK(port.written().size() > 1000U);
+  DOUBLES_EQUAL(3.0, gain, 0.0);
+}
