@@ -83,7 +83,7 @@ bool GlobalMap::merge(const core::Pose2& pose, const StarPolygon& free, float bo
       ok = false;
     }
   }
-  // Explored: well inside the new free polygon (and the bounding circle).
+  // Explored: well inside this cycle's free polygon (and the bounding circle).
   std::size_t kept = 0;
   for (std::size_t i = 0; i < exploration_.size(); ++i) {
     const core::Point2 q = core::to_robot(pose, exploration_[i]);

@@ -16,11 +16,11 @@ struct MapPointParams {
   float obstacle_spacing_m = 0.15F;     // along the boundary inside the bounding circle
   float exploration_spacing_m = 0.5F;   // along the bounding circle: finds ~0.5 m channels
   float on_circle_tolerance_m = 0.02F;  // ρ within this of the bounding radius is "on it"
-  float obstacle_merge_radius_m =
-      0.1F;  // a new obstacle point this close to a known one is the same
-  float exploration_merge_radius_m = 0.35F;  // likewise for exploration points
-  float explored_margin_m =
-      0.3F;  // an exploration point this far inside a later polygon is explored
+  // An incoming obstacle point this close to a known one is the same point [m].
+  float obstacle_merge_radius_m = 0.1F;
+  float exploration_merge_radius_m = 0.35F;  // likewise for exploration points [m]
+  // An exploration point this far inside a later free polygon has been explored [m].
+  float explored_margin_m = 0.3F;
 };
 
 // §5.4.4: splits the free polygon's boundary (robot frame) into sectors on the bounding
@@ -40,8 +40,8 @@ class GlobalMap {
  public:
   // Merges one cycle's points (robot frame, taken at `pose` from odometry): obstacle points
   // closer than obstacle_merge_radius_m to a known one are dropped (deduplicated); known
-  // exploration points that the new free polygon covers (explored_margin_m inside it) are
-  // removed as explored, then new ones are added unless one is already that close. Returns
+  // exploration points that this free polygon covers (explored_margin_m inside it) are
+  // removed as explored, then incoming ones are added unless one is already that close. Returns
   // false if a list overflowed (the points that did not fit are counted and dropped).
   bool merge(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
              const PointList& obstacles_robot, const PointList& exploration_robot,
