@@ -1,41 +1,170 @@
-// Tests of ALN evaluation: plain, alpha-beta, DTREE and fixed point agree.
+// Tests of ALN evaluation: plain, alpha-beta, DTREE and fixed point agree, without allocating.
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
+
+#include <Eigen/Core>
 
 #include "algo/aln/aln.h"
 #include "algo/aln/dtree.h"
 #include "algo/aln/fixed_point.h"
-#include "algo/aln/invert.h"
-#include "algo/aln/text_format.h"
-#include "algo/aln/trainer.h"
+#include "aln_test_util.h"
 #include "alloc_guard.h"
 #include "CppUTest/TestHarness.h"
 
 namespace aln = boticelli::aln;
 
+namespace {
+using Model3 = aln::Aln<float, 3, 128>;
+using Dtree3 = aln::Dtree<float, 3, 128>;
+Model3 g_model;
+Dtree3 g_dtree;
+aln::FixedPointAln<3, 128> g_fixed;
+}  // namespace
+
 TEST_GROUP(AlnEval){};
 
-TEST(AlnEval, ASinglePieceIsALinearFunction) {
+TEST(AlnEval, ASinglePieceIsTheLinearFunctionThroughItsCentroid) {
   aln::Aln<float, 2, 8> f;
   aln::Piece<float, 2> p;
-  p.set(Eigen::Vector2f(1.0F, 2.0F), Eigen::Vector2f(0.0F, 0.0F), 3.0F);
+  p.set(Eigen::Vector2f(1.0F, 2.0F), Eigen::Vector2f(1.0F, 0.5F), 3.0F);
   f.reset(p);
-  DOUBLES_EQUAL(6.0, f.evaluate(Eigen::Vector2f(1.0F, 1.0F)).value, 1e-6);
+  // 3 + 1 (2 - 1) + 2 (1 - 0.5) = 5
+  DOUBLES_EQUAL(5.0, f.evaluate(Eigen::Vector2f(2.0F, 1.0F)).value, 1e-6);
+  DOUBLES_EQUAL(5.0, f.evaluate_alpha_beta(Eigen::Vector2f(2.0F, 1.0F)).value, 1e-6);
 }
 
-template class aln::Aln<float, 3, 32>;
-template class aln::Aln<double, 2, 64>;
-template class aln::Trainer<float, 3, 32>;
-template class aln::Trainer<double, 2, 64>;
-template class aln::Dtree<float, 3, 32>;
-template class aln::Dtree<double, 2, 64>;
-template bool aln::FixedPointAln<3, 32>::compile<float>(const aln::Aln<float, 3, 32>&);
-template bool aln::invert<float, 3, 32>(const aln::Aln<float, 3, 32>&, int,
-                                        aln::Aln<float, 3, 32>&);
-template std::size_t aln::write_text<float, 3, 32>(const aln::Aln<float, 3, 32>&, char*,
-                                                   std::size_t);
-template bool aln::read_text<float, 3, 32>(const char*, std::size_t, aln::Aln<float, 3, 32>&,
-                                           aln::TextError&);
-template std::size_t aln::write_text<double, 2, 64>(const aln::Aln<double, 2, 64>&, char*,
-                                                    std::size_t);
-template bool aln::read_text<double, 2, 64>(const char*, std::size_t, aln::Aln<double, 2, 64>&,
-                                            aln::TextError&);
+TEST(AlnEval, MinOfTwoMaxesPicksTheRightPiece) {
+  // F(x) = MIN(MAX(x, -x), MAX(1 - x, 0.25)) on [-1, 1]
+  aln::Aln<double, 1, 4> f;
+  aln::Piece<double, 1> p0, p1, p2, p3;
+  using V = Eigen::Matrix<double, 1, 1>;
+  p0.set(V(1.0), V(0.0), 0.0);
+  p1.set(V(-1.0), V(0.0), 0.0);
+  p2.set(V(-1.0), V(0.0), 1.0);
+  p3.set(V(0.0), V(0.0), 0.25);
+  f.reset(p0);
+  CHECK(f.split_piece(0, aln::NodeKind::kMin, p0, p2));  // MIN(p0, p2): p2 is piece 1
+  CHECK(f.split_piece(0, aln::NodeKind::kMax, p0, p1));  // MIN(MAX(p0, p1'), p2)
+  CHECK(f.split_piece(1, aln::NodeKind::kMax, p2, p3));
+  LONGS_EQUAL(4, f.piece_count());
+  // Pieces now: 0 = x, 1 = 1 - x, 2 = -x, 3 = 0.25.
+  const auto at = [&](double x) { return f.evaluate(V(x)); };
+  DOUBLES_EQUAL(0.8, at(-0.8).value, 1e-12);  // MIN(0.8, MAX(1.8, .25)) = 0.8 from -x
+  LONGS_EQUAL(2, at(-0.8).piece);
+  DOUBLES_EQUAL(0.3, at(0.3).value, 1e-12);  // MIN(0.3, 0.7)
+  LONGS_EQUAL(0, at(0.3).piece);
+  DOUBLES_EQUAL(0.25, at(0.9).value, 1e-12);  // MIN(0.9, MAX(0.1, 0.25))
+  LONGS_EQUAL(3, at(0.9).piece);
+  LONGS_EQUAL(3, f.depth());
+}
+
+TEST(AlnEval, AlphaBetaAndDtreeEqualPlainEvaluationOnManyRandomInputs) {
+  aln_test::Rng rng(7);
+  std::size_t total_ab = 0;
+  std::size_t total_dt = 0;
+  std::size_t total_plain = 0;
+  constexpr int kModels = 4;
+  constexpr int kPoints = 25000;  // 10^5 in all
+  for (int m = 0; m < kModels; ++m) {
+    aln_test::random_model(g_model, m == 0 ? 8 : (m == 1 ? 32 : 128), rng);
+    CHECK(g_dtree.compile(g_model));
+    for (int k = 0; k < kPoints; ++k) {
+      const auto x = aln_test::random_point<Model3::Vec>(rng);
+      const auto plain = g_model.evaluate(x);
+      const auto ab = g_model.evaluate_alpha_beta(x);
+      const auto dt = g_dtree.evaluate(x);
+      if (plain.value != ab.value || plain.piece != ab.piece || plain.value != dt.value ||
+          plain.piece != dt.piece) {
+        FAIL("alpha-beta or DTREE differs from plain evaluation");
+      }
+      total_plain += plain.pieces_evaluated;
+      total_ab += ab.pieces_evaluated;
+      total_dt += dt.pieces_evaluated;
+    }
+  }
+  CHECK(total_ab < total_plain);
+  CHECK(total_dt < total_ab);
+}
+
+TEST(AlnEval, DtreeKeepsAboutNPlusOnePiecesPerBlock) {
+  aln_test::Rng rng(11);
+  aln_test::random_model(g_model, 32, rng);
+  CHECK(g_dtree.compile(g_model));
+  CHECK(g_dtree.block_count() > 1);
+  CHECK(g_dtree.mean_block_pieces() <= 4.5);
+}
+
+TEST(AlnEval, DtreeAndAlphaBetaWorkInDoubleAndOneDimension) {
+  aln_test::Rng rng(3);
+  static aln::Aln<double, 1, 16> f;
+  static aln::Dtree<double, 1, 16> d;
+  aln_test::random_model(f, 16, rng);
+  CHECK(d.compile(f));
+  for (int k = 0; k < 5000; ++k) {
+    const auto x = aln_test::random_point<Eigen::Matrix<double, 1, 1>>(rng);
+    const auto plain = f.evaluate(x);
+    CHECK(plain.value == f.evaluate_alpha_beta(x).value);
+    CHECK(plain.value == d.evaluate(x).value);
+    LONGS_EQUAL(plain.piece, d.evaluate(x).piece);
+  }
+}
+
+TEST(AlnEval, FixedPointMatchesFloatWithinItsResolution) {
+  aln_test::Rng rng(5);
+  aln_test::random_model(g_model, 32, rng);
+  CHECK(g_fixed.compile(g_model));
+  CHECK(g_fixed.weight_frac_bits() >= 20);
+  double worst = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    const auto x = aln_test::random_point<Model3::Vec>(rng);
+    aln::FixedPointAln<3, 128>::Input xq{};
+    for (int i = 0; i < 3; ++i) {
+      xq[static_cast<std::size_t>(i)] = aln::FixedPointAln<3, 128>::to_fixed(x(i));
+    }
+    const double fixed = aln::FixedPointAln<3, 128>::to_double(g_fixed.evaluate(xq).value);
+    const double ref = static_cast<double>(g_model.evaluate(x).value);
+    worst = std::fmax(worst, std::fabs(fixed - ref));
+  }
+  CHECK_TEXT(worst < 1e-4, "fixed point differs from float by more than 1e-4");
+}
+
+TEST(AlnEval, FixedPointRefusesAModelBeyondQ16Range) {
+  aln::Aln<float, 1, 2> f;
+  f.set_input_range(0, 0.0F, 1e6F);
+  CHECK_FALSE((aln::FixedPointAln<1, 2>{}.compile(f)));
+}
+
+TEST(AlnEval, EvaluationDoesNotAllocate) {
+  aln_test::Rng rng(9);
+  aln_test::random_model(g_model, 64, rng);
+  CHECK(g_dtree.compile(g_model));
+  CHECK(g_fixed.compile(g_model));
+  float sum = 0.0F;
+  CHECK_NO_ALLOCATION({
+    for (int k = 0; k < 1000; ++k) {
+      const auto x = aln_test::random_point<Model3::Vec>(rng);
+      sum += g_model.evaluate(x).value + g_model.evaluate_alpha_beta(x).value +
+             g_dtree.evaluate(x).value;
+      sum += static_cast<float>(g_fixed.evaluate({0, 65536, 32768}).value);
+    }
+  });
+  CHECK_NO_ALLOCATION(CHECK(g_dtree.compile(g_model)));
+  CHECK(std::isfinite(sum));
+}
+
+TEST(AlnEval, AssignRejectsNodesThatAreNotOneTree) {
+  aln::Aln<float, 1, 4> f;
+  using Node = aln::Aln<float, 1, 4>::Node;
+  aln::Piece<float, 1> pieces[2];
+  const Node cycle[3] = {
+      {aln::NodeKind::kMin, 1, 0}, {aln::NodeKind::kPiece, 0, 0}, {aln::NodeKind::kPiece, 1, 0}};
+  CHECK_FALSE(f.assign(cycle, pieces));
+  const Node reused[3] = {
+      {aln::NodeKind::kMin, 1, 2}, {aln::NodeKind::kPiece, 0, 0}, {aln::NodeKind::kPiece, 0, 0}};
+  CHECK_FALSE(f.assign(reused, pieces));
+  const Node good[3] = {
+      {aln::NodeKind::kMin, 1, 2}, {aln::NodeKind::kPiece, 0, 0}, {aln::NodeKind::kPiece, 1, 0}};
+  CHECK(f.assign(good, pieces));
+  LONGS_EQUAL(2, f.piece_count());
+}

@@ -1,0 +1,313 @@
+// Tests of ALN training: exact recovery, constrained fits, robust weights, resumable slices.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+#include <Eigen/Core>
+
+#include "algo/aln/aln.h"
+#include "algo/aln/constrained_lsq.h"
+#include "algo/aln/samples.h"
+#include "algo/aln/trainer.h"
+#include "aln_test_util.h"
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+namespace aln = boticelli::aln;
+
+namespace {
+
+// MIN(MAX(p0, p1), MAX(p2, p3)) on [0, 1]^2: a ridge along x with a valley along y.
+double known_pl(double x, double y) {
+  const double a = std::fmax(2.0 * x + y - 0.5, 2.0 * x - y + 0.5);
+  const double b = std::fmax(2.0 - 2.0 * x + 0.8 * y - 0.24, 2.0 - 2.0 * x - 0.8 * y + 0.24);
+  return std::fmin(a, b);
+}
+
+// Thesis Eq 5.2, cylindrical room observed from its centre: m = MIN((r / R)^n, 1),
+// with r and R in decimetres (R = 50 dm), n = 2; alpha in rad, h in dm.
+double cylinder_room(double r_dm) {
+  const double u = r_dm / 50.0;
+  return std::fmin(u * u, 1.0);
+}
+
+using Model2 = aln::Aln<double, 2, 64>;
+using Trainer2 = aln::Trainer<double, 2, 64>;
+using Model3 = aln::Aln<float, 3, 256>;
+using Trainer3 = aln::Trainer<float, 3, 256>;
+
+aln::Sample<double, 2> g_samples2[2500];
+aln::Sample<float, 3> g_samples3[6000];
+Model2 g_model2;
+Model2 g_model2b;
+Trainer2 g_trainer2;
+Model3 g_model3;
+Model3 g_model3b;
+Trainer3 g_trainer3;
+
+void fill_known_pl() {
+  aln_test::Rng rng(21);
+  for (auto& s : g_samples2) {
+    s.x = Eigen::Vector2d(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    s.y = known_pl(s.x(0), s.x(1));
+    s.weight = 1.0;
+  }
+}
+
+// Samples of the cylindrical room: alpha in [-pi, pi] rad, h in [0, 20] dm, r in [0, 100] dm.
+// `outliers` of them (every k-th) get a uniformly random occupancy instead.
+std::size_t fill_room(std::size_t n, double outlier_fraction, std::uint64_t seed) {
+  aln_test::Rng rng(seed);
+  for (std::size_t k = 0; k < n; ++k) {
+    auto& s = g_samples3[k];
+    s.x = Eigen::Vector3f(static_cast<float>(rng.uniform(-3.14159, 3.14159)),
+                          static_cast<float>(rng.uniform(0.0, 20.0)),
+                          static_cast<float>(rng.uniform(0.0, 100.0)));
+    s.y = static_cast<float>(cylinder_room(static_cast<double>(s.x(2))));
+    if (rng.uniform(0.0, 1.0) < outlier_fraction) s.y = static_cast<float>(rng.uniform(0.0, 1.0));
+    s.weight = 1.0F;
+  }
+  return n;
+}
+
+void set_room_ranges(Model3& m) {
+  m.set_input_range(0, -3.14159F, 3.14159F);
+  m.set_input_range(1, 0.0F, 20.0F);
+  m.set_input_range(2, 0.0F, 100.0F);
+  m.set_output_range(-0.1F, 1.1F);
+  // Eqs 4.27-4.28: c > 0 (monotone increasing in r), |a| <= 1, |b| <= 1 per rad / dm.
+  m.set_weight_bounds(0, -1.0F, 1.0F);
+  m.set_weight_bounds(1, -1.0F, 1.0F);
+  m.set_weight_bounds(2, 1e-4F, 1.0F);
+}
+
+bool same_model(const Model3& a, const Model3& b) {
+  if (a.piece_count() != b.piece_count() || a.node_count() != b.node_count()) return false;
+  for (std::size_t n = 0; n < a.node_count(); ++n) {
+    if (a.node(n).kind != b.node(n).kind || a.node(n).a != b.node(n).a ||
+        a.node(n).b != b.node(n).b) {
+      return false;
+    }
+  }
+  for (std::size_t p = 0; p < a.piece_count(); ++p) {
+    if (a.piece(p).weight != b.piece(p).weight || a.piece(p).centroid != b.piece(p).centroid ||
+        a.piece(p).centroid_output != b.piece(p).centroid_output) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_GROUP(AlnTrain){};
+
+TEST(AlnTrain, RecoversAKnownMinOfMaxesWithNoMorePiecesThanItHas) {
+  fill_known_pl();
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 1e-5;
+  cfg.max_iterations = 10;
+  cfg.max_refit_passes = 20;
+  g_trainer2.configure(cfg);
+  CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2), g_model2));
+  CHECK(g_model2.piece_count() <= 4);
+  // RMS on fresh points.
+  aln_test::Rng rng(99);
+  double sse = 0.0;
+  constexpr int kTest = 5000;
+  for (int k = 0; k < kTest; ++k) {
+    const Eigen::Vector2d x(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    const double e = g_model2.evaluate(x).value - known_pl(x(0), x(1));
+    sse += e * e;
+  }
+  const double rms = std::sqrt(sse / kTest);
+  CHECK_TEXT(rms < 1e-4, "known piecewise-linear function not recovered to 1e-4 RMS");
+  CHECK(g_trainer2.stats().rms < 1e-4);
+}
+
+TEST(AlnTrain, FitsTheCylindricalRoomToEpsilonWithEveryPieceInsideItsBounds) {
+  const std::size_t n = fill_room(6000, 0.0, 5);
+  set_room_ranges(g_model3);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.02;
+  cfg.max_iterations = 12;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  CHECK(g_trainer3.stats().rms <= 0.02);
+  CHECK(g_model3.pieces_within_bounds());
+  // Per piece RMS <= epsilon (the thesis's split rule), and monotone increasing in r.
+  double sse[256] = {};
+  double cnt[256] = {};
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto e = g_model3.evaluate(g_samples3[k].x);
+    const double r = static_cast<double>(e.value - g_samples3[k].y);
+    sse[e.piece] += r * r;
+    cnt[e.piece] += 1.0;
+  }
+  for (std::size_t p = 0; p < g_model3.piece_count(); ++p) {
+    if (cnt[p] > 0.0) CHECK(std::sqrt(sse[p] / cnt[p]) <= 0.02 + 1e-6);
+    CHECK(g_model3.piece(p).weight(2) >= 1e-4F);
+    CHECK(std::fabs(g_model3.piece(p).weight(0)) <= 1.0F);
+  }
+  aln_test::Rng rng(4);
+  for (int k = 0; k < 2000; ++k) {
+    Eigen::Vector3f x(static_cast<float>(rng.uniform(-3.0, 3.0)),
+                      static_cast<float>(rng.uniform(0.0, 20.0)),
+                      static_cast<float>(rng.uniform(0.0, 99.0)));
+    const float m0 = g_model3.evaluate(x).value;
+    x(2) += 1.0F;
+    CHECK(g_model3.evaluate(x).value > m0);
+  }
+  CHECK(g_model3.piece_count() < 64);
+}
+
+TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
+  const std::size_t n = fill_room(4000, 0.03, 8);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.05;
+  cfg.robust = aln::RobustWeighting::kHuber;
+  cfg.seed = 17;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const aln::TrainerStats one_shot = g_trainer3.stats();
+  CHECK(g_trainer3.start(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  std::size_t steps = 0;
+  std::size_t budget = 1;
+  while (!g_trainer3.step(budget)) {
+    budget = budget * 3 % 997 + 1;  // uneven slices, some of them a single sample
+    ++steps;
+  }
+  CHECK(steps > 20);
+  CHECK(same_model(g_model3, g_model3b));
+  LONGS_EQUAL(one_shot.passes, g_trainer3.stats().passes);
+  LONGS_EQUAL(one_shot.sample_visits, g_trainer3.stats().sample_visits);
+  CHECK(one_shot.rms == g_trainer3.stats().rms);
+}
+
+TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
+  const std::size_t n = fill_room(3000, 0.0, 12);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.03;
+  cfg.seed = 5;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  CHECK(same_model(g_model3, g_model3b));
+}
+
+TEST(AlnTrain, RobustWeightsStopOutliersForcingExtraPieces) {
+  const std::size_t n = fill_room(6000, 0.05, 31);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.1;
+  cfg.max_iterations = 8;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const std::size_t plain_pieces = g_model3.piece_count();
+  cfg.robust = aln::RobustWeighting::kTukey;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  const std::size_t robust_pieces = g_model3b.piece_count();
+  CHECK(robust_pieces < plain_pieces);
+  // ... and the robust model is close to the clean function.
+  aln_test::Rng rng(6);
+  double sse = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector3f x(static_cast<float>(rng.uniform(-3.0, 3.0)),
+                            static_cast<float>(rng.uniform(0.0, 20.0)),
+                            static_cast<float>(rng.uniform(0.0, 100.0)));
+    const double e =
+        static_cast<double>(g_model3b.evaluate(x).value) - cylinder_room(static_cast<double>(x(2)));
+    sse += e * e;
+  }
+  CHECK(std::sqrt(sse / 2000.0) < 0.1);
+}
+
+TEST(AlnTrain, PieceCapAndIterationCapAreHonoured) {
+  const std::size_t n = fill_room(3000, 0.0, 2);
+  set_room_ranges(g_model3);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.001;
+  cfg.max_pieces = 5;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  CHECK(g_model3.piece_count() <= 5);
+  cfg.max_pieces = 0;
+  cfg.max_iterations = 2;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  CHECK(g_trainer3.stats().iterations <= 2);
+  CHECK(g_model3.piece_count() <= 4);
+  CHECK(g_model3.pieces_within_bounds());
+}
+
+TEST(AlnTrain, TrainingStepsDoNotAllocate) {
+  const std::size_t n = fill_room(3000, 0.02, 3);
+  set_room_ranges(g_model3);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.05;
+  cfg.robust = aln::RobustWeighting::kTukey;
+  g_trainer3.configure(cfg);
+  bool done = false;
+  CHECK_NO_ALLOCATION({
+    CHECK(g_trainer3.start(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+    while (!done) done = g_trainer3.step(500);
+  });
+  CHECK(g_model3.piece_count() > 1);
+}
+
+TEST(AlnTrain, AnEmptySampleSetIsRefused) {
+  g_trainer3.configure(aln::TrainerConfig{});
+  CHECK_FALSE(g_trainer3.start(aln::SampleSet<float, 3>(), g_model3));
+  CHECK(g_trainer3.step(10));
+}
+
+TEST_GROUP(ConstrainedLsq){};
+
+// The KKT conditions certify the optimum of a convex QP: the gradient 2 (C w - g) is zero
+// in free coordinates, >= 0 at a lower bound and <= 0 at an upper bound.
+TEST(ConstrainedLsq, TheSolutionMeetsTheOptimalityConditionsAndBeatsClipping) {
+  aln_test::Rng rng(77);
+  int constrained = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    Eigen::Matrix3d a;
+    for (int i = 0; i < 9; ++i) a(i / 3, i % 3) = rng.uniform(-1.0, 1.0);
+    const Eigen::Matrix3d c = a * a.transpose() + 0.01 * Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d g(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+    std::array<double, 3> lo{-0.5, -INFINITY, 0.1};
+    std::array<double, 3> hi{0.5, 0.3, INFINITY};
+    Eigen::Vector3d w;
+    CHECK(aln::solve_box_constrained_lsq<3>(c, g, lo, hi, w));
+    const Eigen::Vector3d grad = 2.0 * (c * w - g);
+    bool any_active = false;
+    for (int i = 0; i < 3; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      CHECK(w(i) >= lo[k] && w(i) <= hi[k]);
+      if (w(i) == lo[k]) {
+        CHECK(grad(i) >= -1e-9);
+        any_active = true;
+      } else if (w(i) == hi[k]) {
+        CHECK(grad(i) <= 1e-9);
+        any_active = true;
+      } else {
+        DOUBLES_EQUAL(0.0, grad(i), 1e-9);
+      }
+    }
+    if (any_active) ++constrained;
+    // Clipping the unconstrained optimum is never better.
+    Eigen::Vector3d clipped = c.ldlt().solve(g);
+    for (int i = 0; i < 3; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      clipped(i) = std::fmin(std::fmax(clipped(i), lo[k]), hi[k]);
+    }
+    const auto q = [&](const Eigen::Vector3d& v) { return v.dot(c * v) - 2.0 * g.dot(v); };
+    CHECK(q(w) <= q(clipped) + 1e-12);
+  }
+  CHECK(constrained > 500);
+}
