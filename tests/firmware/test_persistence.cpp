@@ -1,0 +1,259 @@
+// Tests of the mission state file: round trip, strict rejection of corrupt files, atomic saves under SIGKILL, resume.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <string>
+
+#include "firmware/mission_state.h"
+#include "firmware/persistence.h"
+
+#include "CppUTest/TestHarness.h"
+
+using namespace boticelli::firmware;
+using boticelli::core::Point2;
+
+namespace {
+
+// Large buffers live in static storage, not on the stack.
+MissionState g_a;
+MissionState g_b;
+StateStore g_store;
+char g_file[kMaxStateFileBytes];
+
+// The state a mission would have after `cycle` cycles: every field derived from the cycle,
+// so a loaded state can be checked against the cycle it claims.
+void make_state(std::uint64_t cycle, MissionState& s) {
+  s.clear();
+  s.cycle = cycle;
+  s.seed = 42;
+  s.pose = {0.1F * static_cast<float>(cycle), -0.37F, 0.001F * static_cast<float>(cycle)};
+  s.has_goal = cycle % 3 == 0;
+  s.goal = {1.0F / 3.0F, 2.5e-7F * static_cast<float>(cycle)};
+  const std::size_t n_obs = (cycle * 37) % MissionState::kMaxObstaclePoints;
+  for (std::size_t i = 0; i < n_obs; ++i) {
+    (void)s.obstacles.push_back({static_cast<float>(i) * 0.01F + 0.001F * static_cast<float>(cycle),
+                                 -static_cast<float>(i) / 7.0F});
+  }
+  for (std::size_t i = 0; i < cycle % 50; ++i) {
+    (void)s.exploration.push_back({static_cast<float>(i), static_cast<float>(cycle)});
+  }
+  std::string model = "VARIABLES 3\nOUTPUT 2\nLINEARFORMS " + std::to_string(cycle) + "\n";
+  while (model.size() < 2000 + (cycle % 7) * 1000) model += "0.125 -0.5 1 0.25\n";
+  model += "BLOCKS\nMIN 0 1\n";
+  CHECK(s.set_model(model));
+  for (std::uint64_t c = 1; c <= cycle && c <= 200; ++c) {
+    s.add_log(c, "cycle " + std::to_string(c) + " done");
+  }
+}
+
+std::string temp_dir() {
+  char templ[] = "/tmp/boticelli-state-XXXXXX";
+  const char* dir = mkdtemp(templ);
+  CHECK(dir != nullptr);
+  return dir;
+}
+
+void remove_dir(const std::string& dir) {
+  for (const char* name : {"/mission.state", "/mission.state.tmp"}) unlink((dir + name).c_str());
+  rmdir(dir.c_str());
+}
+
+std::string read_file(const std::string& path) {
+  std::string out;
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return out;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.append(buf, n);
+  std::fclose(f);
+  return out;
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  CHECK(f != nullptr);
+  std::fwrite(bytes.data(), 1, bytes.size(), f);
+  std::fclose(f);
+}
+
+}  // namespace
+
+TEST_GROUP(Persistence) {
+  std::string dir;
+  char error[256] = "";
+  void setup() override { dir = temp_dir(); }
+  void teardown() override { remove_dir(dir); }
+};
+
+TEST(Persistence, ComputesTheStandardCrc32) {
+  CHECK_EQUAL(0xCBF43926U, crc32("123456789", 9));
+  CHECK_EQUAL(0U, crc32("", 0));
+}
+
+TEST(Persistence, EncodesAndDecodesEveryFieldExactly) {
+  make_state(123, g_a);
+  const std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  CHECK(n > 0);
+  const char* why = "";
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
+  CHECK(g_a == g_b);
+  CHECK(g_b.has_goal);
+  CHECK_EQUAL(123U, g_b.log.size());
+}
+
+TEST(Persistence, HoldsAStateFilledToEveryCapacity) {
+  g_a.clear();
+  g_a.cycle = UINT64_MAX;
+  g_a.pose = {-1e30F, 1e-30F, -3.14159274F};
+  while (g_a.obstacles.push_back({-123456.789F, 1.17549435e-38F})) {
+  }
+  while (g_a.exploration.push_back({3.40282347e38F, -0.0F})) {
+  }
+  CHECK(g_a.set_model(std::string(MissionState::kMaxModelBytes, 'M')));
+  for (int i = 0; i < 500; ++i) g_a.add_log(static_cast<std::uint64_t>(i), std::string(200, '~'));
+  CHECK_EQUAL(MissionState::kMaxLogEntries, g_a.log.size());
+  CHECK_EQUAL(499U, g_a.log.back().cycle);
+  const std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  CHECK(n > 0);
+  const char* why = "";
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
+  CHECK(g_a == g_b);
+}
+
+TEST(Persistence, RejectsEveryTruncationOfAFile) {
+  make_state(5, g_a);
+  const std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  const char* why = "";
+  for (std::size_t len = 0; len < n; len += (len < 200 || n - len < 200) ? 1 : 97) {
+    CHECK_FALSE(decode_state({g_file, len}, g_b, &why));
+    CHECK_EQUAL(0U, g_b.cycle);  // nothing half-loaded
+    CHECK_EQUAL(0U, g_b.obstacles.size());
+  }
+}
+
+TEST(Persistence, RejectsAnyFlippedByte) {
+  make_state(9, g_a);
+  const std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  const char* why = "";
+  std::uint32_t x = 7;
+  for (int trial = 0; trial < 500; ++trial) {
+    x = x * 1664525U + 1013904223U;
+    const std::size_t at = x % n;
+    const char saved = g_file[at];
+    g_file[at] = static_cast<char>(saved ^ static_cast<char>(1 + (x >> 29)));
+    CHECK_FALSE(decode_state({g_file, n}, g_b, &why));
+    g_file[at] = saved;
+  }
+  CHECK(decode_state({g_file, n}, g_b, &why));
+}
+
+TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
+  // A file whose CRC is right but whose content is not valid (as from a buggy writer).
+  const char* why = "";
+  auto with_crc = [](std::string body) {
+    char line[32];
+    std::snprintf(line, sizeof line, "crc32 %08x\n", crc32(body.data(), body.size()));
+    return body + line;
+  };
+  const std::string head = "BOTICELLI-STATE 1\ncycle 3\nseed 1\npose 0 0 0\ngoal none\n";
+  const std::string tail = "exploration 0\nmodel 0\n\nlog 0\nend\n";
+  std::string f = with_crc(head + "obstacles 1\n1 2\n" + tail);
+  CHECK_TRUE_TEXT(decode_state(f, g_b, &why), why);
+  for (const std::string& body :
+       {head + "obstacles 3000\n" + tail, head + "obstacles 1\n1 nan\n" + tail,
+        head + "obstacles 1\n1 2 3\n" + tail, head + "obstacles 2\n1 2\n" + tail,
+        head + "obstacles -1\n" + tail, std::string("BOTICELLI-STATE 2\n") + "cycle 3\n",
+        head + "obstacles 0\nexploration 0\nmodel 5\nab\n\nlog 0\nend\n",
+        head + "obstacles 0\n" + tail + "extra\n", head + "obstacles 0\n" + tail.substr(0, 20),
+        std::string("cycle 3\n")}) {
+    f = with_crc(body);
+    CHECK_FALSE_TEXT(decode_state(f, g_b, &why), body.c_str());
+  }
+}
+
+TEST(Persistence, SavesAtomicallyAndLoadsBack) {
+  CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kMissing);
+  make_state(17, g_a);
+  CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  struct stat st {};
+  CHECK(stat((dir + "/mission.state.tmp").c_str(), &st) != 0);  // no temporary left behind
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+
+TEST(Persistence, ReportsACorruptOrTruncatedFileAndDoesNotLoadIt) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  make_state(40, g_a);
+  CHECK(g_store.save(g_a, error, sizeof error));
+  const std::string path = dir + "/mission.state";
+  const std::string good = read_file(path);
+  write_file(path, good.substr(0, good.size() / 2));
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kCorrupt);
+  STRCMP_CONTAINS("mission.state", error);
+  CHECK_EQUAL(0U, g_b.cycle);
+  std::string bad = good;
+  bad[bad.size() / 3] = static_cast<char>(bad[bad.size() / 3] ^ 0x20);
+  write_file(path, bad);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kCorrupt);
+  STRCMP_CONTAINS("checksum", error);
+  write_file(path, good + std::string(kMaxStateFileBytes, 'x'));
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kCorrupt);
+  write_file(path, good);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+}
+
+TEST(Persistence, AKilledRunResumesWithNothingLostAndNothingCorrupt) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  std::uint64_t last_loaded = 0;
+  // Kill the saving process at varied moments, several times, resuming each time.
+  for (int kill_round = 0; kill_round < 6; ++kill_round) {
+    int ready[2];
+    CHECK_EQUAL(0, pipe(ready));
+    const pid_t child = fork();
+    CHECK(child >= 0);
+    if (child == 0) {
+      close(ready[0]);
+      // Resume from the saved state (or start), then run cycles, saving after each.
+      MissionState& s = g_a;
+      std::uint64_t cycle = 0;
+      if (g_store.load(s, error, sizeof error) == LoadResult::kLoaded) cycle = s.cycle;
+      bool told = false;
+      for (;;) {
+        ++cycle;
+        make_state(cycle, s);
+        if (!g_store.save(s, error, sizeof error)) _exit(3);
+        if (!told) {
+          (void)!write(ready[1], "r", 1);
+          told = true;
+        }
+      }
+    }
+    close(ready[1]);
+    char c = 0;
+    CHECK_EQUAL(1, read(ready[0], &c, 1));  // at least one save of this run finished
+    close(ready[0]);
+    timespec pause{0, 3000000L + 7000000L * kill_round};
+    nanosleep(&pause, nullptr);
+    CHECK_EQUAL(0, kill(child, SIGKILL));
+    int status = 0;
+    CHECK_EQUAL(child, waitpid(child, &status, 0));
+    CHECK(WIFSIGNALED(status));
+
+    // The state on disk is exactly one of the completed cycles, later than the last resume.
+    CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+    CHECK(g_b.cycle > last_loaded);
+    make_state(g_b.cycle, g_a);
+    CHECK(g_a == g_b);
+    last_loaded = g_b.cycle;
+  }
+  CHECK(last_loaded >= 6U);
+}
