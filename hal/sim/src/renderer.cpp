@@ -20,6 +20,7 @@ struct Renderer::Candidate {
   Eigen::Matrix3f local_from_camera;  // rotation
   Eigen::Vector3f origin_local;       // the optical centre in the surface's frame [m]
   float min_x, min_y, max_x, max_y;   // bounds in normalised image coordinates
+  float min_z;                        // nearest z-depth of the bounds [m]
   bool visible;
 };
 
@@ -243,7 +244,9 @@ void Renderer::setup_frame(const RigidTransform& world_from_camera, FrameSetup& 
     c.min_y = kInf;
     c.max_x = -kInf;
     c.max_y = -kInf;
+    c.min_z = kInf;
     auto add = [&c](const Eigen::Vector3f& p) {
+      c.min_z = std::min(c.min_z, p.z());
       const float x = p.x() / p.z();
       const float y = p.y() / p.z();
       c.min_x = std::min(c.min_x, x);
@@ -276,7 +279,14 @@ void Renderer::tile_candidates(const FrameSetup& setup, std::uint32_t tile, std:
   for (std::size_t i = 0; i < world_->surface_count; ++i) {
     const Candidate& c = setup.surfaces[i];
     if (c.visible && c.max_x >= b[0] && c.min_x <= b[2] && c.max_y >= b[1] && c.min_y <= b[3]) {
-      list[count++] = static_cast<std::uint16_t>(i);
+      // Keep the list sorted by nearest depth, so a pixel can stop at the first surface
+      // that cannot be beaten.
+      std::size_t k = count++;
+      while (k > 0 && setup.surfaces[list[k - 1]].min_z > c.min_z) {
+        list[k] = list[k - 1];
+        --k;
+      }
+      list[k] = static_cast<std::uint16_t>(i);
     }
   }
 }
@@ -312,7 +322,11 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
             int best_surface = -1;
             for (std::size_t n = 0; n < count; ++n) {
               const Candidate& c = setup.surfaces[list[n]];
-              const Eigen::Vector3f d = c.local_from_camera * d_cam;
+              if (c.min_z >= best.t) break;  // every later surface is farther
+              // d_cam = (x, y, 1): two columns and a sum, no full product.
+              const Eigen::Vector3f d = c.local_from_camera.col(0) * d_cam.x() +
+                                        c.local_from_camera.col(1) * d_cam.y() +
+                                        c.local_from_camera.col(2);
               Hit hit;
               if (hit_surface(world.surfaces[list[n]], c.origin_local, d, best.t, hit)) {
                 best = hit;

@@ -1,0 +1,158 @@
+// SimWorld: simulated time and physics (robot base, PTU, contacts, e-stop) and the ground truth.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/geometry.h"
+#include "algo/stereo/rig.h"
+#include "hal/base.h"
+#include "hal/pan_tilt.h"
+#include "hal/sim/world.h"
+
+namespace boticelli::hal::sim {
+
+// PTU-D46-like axis behaviour (defaults: the D46's limits and its 185.1428" resolution).
+struct PtuParams {
+  PanTiltLimits limits{-2.7751F, 2.7751F, -0.8203F, 0.5411F, 8.9759e-4F, 8.9759e-4F};
+  float speed_rad_s = 1.0F;        // default speed of both axes
+  float max_speed_rad_s = 2.6F;    // fastest set_speed() accepted
+  float accel_rad_s2 = 4.0F;       // acceleration and deceleration of both axes
+};
+
+struct BaseParams {
+  float robot_radius_m = 0.25F;
+  float robot_height_m = 0.8F;
+  float track_width_m = 0.40F;
+  float max_speed_m_s = 0.3F;
+  float max_turn_rate_rad_s = 0.8F;
+  float wheel_accel_m_s2 = 1.0F;        // velocity ramp at the wheel rim (ODrive vel_ramp)
+  float odometry_noise = 0.0F;          // relative sd of each wheel's step distance (0 = off)
+  std::uint32_t startup_us = 50000;     // start-up until closed-loop control [µs]
+  float contact_margin_m = 0.01F;       // the bumper closes within this gap [m]
+  float floor_clearance_m = 0.01F;      // obstacles lower than this are driven over [m]
+};
+
+struct SimParams {
+  PtuParams ptu{};
+  BaseParams base{};
+  std::uint32_t physics_step_us = 1000;  // integration step [µs]
+  std::uint64_t seed = 1;                // odometry noise (the camera has its own seed)
+};
+
+// One PTU axis: trapezoidal motion to a quantised target.
+struct PtuAxis {
+  float position_rad = 0.0F;
+  float velocity_rad_s = 0.0F;
+  float target_rad = 0.0F;
+  float speed_rad_s = 1.0F;
+  bool moving() const { return position_rad != target_rad || velocity_rad_s != 0.0F; }
+};
+
+class SimWorld {
+ public:
+  // Places the robot at the world's start pose; false (with the reason) when the start pose
+  // collides. `world` and `rig` must outlive this object. Does not allocate.
+  bool init(const World& world, const stereo::RigModel& rig, const SimParams& params, char* error,
+            std::size_t error_size);
+
+  // ---- time ----
+  std::uint64_t now_us() const { return now_us_; }
+  // Steps the physics (PTU, base, contacts, scripted e-stop, watchdog) up to `deadline_us`.
+  void advance_to(std::uint64_t deadline_us);
+
+  // ---- ground truth (sim-only; the firmware sees none of this) ----
+  const World& world() const { return *world_; }
+  const SimParams& params() const { return params_; }
+  const stereo::RigModel& rig() const { return *rig_; }
+  core::Pose2 true_pose() const {
+    return {static_cast<float>(x_m_), static_cast<float>(y_m_), static_cast<float>(yaw_rad_)};
+  }
+  std::uint32_t collisions() const { return collisions_; }
+  const char* last_collision_model() const { return last_collision_model_; }
+  bool in_contact() const { return contact_; }
+  Eigen::Vector3f target_point_m() const { return world_->target_point_m; }
+  // Camera pose in the world for the PTU's current (true) pan and tilt.
+  RigidTransform camera_pose() const;
+  // Camera pose for a robot pose and PTU angles (the same kinematics, for tests).
+  RigidTransform camera_pose(const core::Pose2& robot, float pan_rad, float tilt_rad) const;
+  // Moves the robot (tests only); false and unchanged when it would collide.
+  bool teleport(const core::Pose2& pose);
+  // Distance from the robot's cylinder to the nearest obstacle it can hit [m] (< 0: overlap).
+  float clearance_m(double x_m, double y_m, const char** model = nullptr) const;
+
+  // ---- base (driven through BaseSim) ----
+  void base_start();
+  void base_set_velocity(float v_m_s, float omega_rad_s);
+  void base_stop(const char* reason);
+  bool base_resume();
+  BaseHealth base_health() const { return base_health_; }
+  const char* base_error() const { return base_error_; }
+  Odometry odometry() const { return odometry_; }
+
+  // ---- PTU (driven through PanTiltSim) ----
+  PtuAxis& pan() { return pan_; }
+  PtuAxis& tilt() { return tilt_; }
+  const PtuAxis& pan() const { return pan_; }
+  const PtuAxis& tilt() const { return tilt_; }
+
+  // ---- GPIO ----
+  void set_estop_pressed(bool pressed);
+  // Presses the e-stop at `press_us` for `duration_us` of simulated time (one pending script).
+  void schedule_estop(std::uint64_t press_us, std::uint64_t duration_us);
+  bool estop_pressed() const { return estop_; }
+  std::uint32_t estop_presses() const { return estop_presses_; }
+  std::uint32_t contacts() const { return contacts_; }  // bumper closures so far
+  void set_led(bool on);
+  bool led() const { return led_; }
+  std::uint32_t led_changes() const { return led_changes_; }
+
+  // ---- watchdog stand-in ----
+  void watchdog_start(std::uint32_t timeout_ms);
+  void watchdog_kick() { last_kick_us_ = now_us_; }
+  void watchdog_stop() { watchdog_armed_ = false; }
+  std::uint32_t watchdog_expirations() const { return watchdog_expirations_; }
+
+ private:
+  void step(std::uint32_t dt_us);
+  void step_axis(PtuAxis& axis, float dt_s) const;
+  void step_base(float dt_s);
+  float gaussian();
+
+  const World* world_ = nullptr;
+  const stereo::RigModel* rig_ = nullptr;
+  SimParams params_{};
+  std::uint64_t now_us_ = 0;
+  std::uint64_t rng_state_ = 0;
+  // Robot (true pose, double so long runs do not drift by rounding).
+  double x_m_ = 0.0, y_m_ = 0.0, yaw_rad_ = 0.0;
+  float wheel_left_m_s_ = 0.0F, wheel_right_m_s_ = 0.0F;
+  float target_left_m_s_ = 0.0F, target_right_m_s_ = 0.0F;
+  BaseHealth base_health_ = BaseHealth::kStopped;
+  const char* base_error_ = "not started";
+  std::uint64_t base_ready_at_us_ = 0;
+  bool base_started_ = false;
+  Odometry odometry_{};
+  std::uint32_t collisions_ = 0;
+  const char* last_collision_model_ = "";
+  char collision_error_[96] = {};
+  bool contact_ = false;
+  std::uint32_t contacts_ = 0;
+  // PTU.
+  PtuAxis pan_{};
+  PtuAxis tilt_{};
+  // GPIO.
+  bool estop_ = false;
+  std::uint32_t estop_presses_ = 0;
+  bool estop_scripted_ = false;
+  std::uint64_t estop_press_us_ = 0, estop_release_us_ = 0;
+  bool led_ = false;
+  std::uint32_t led_changes_ = 0;
+  // Watchdog.
+  bool watchdog_armed_ = false;
+  std::uint64_t watchdog_timeout_us_ = 0, last_kick_us_ = 0;
+  std::uint32_t watchdog_expirations_ = 0;
+};
+
+}  // namespace boticelli::hal::sim

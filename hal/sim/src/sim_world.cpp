@@ -1,0 +1,301 @@
+// SimWorld: fixed-step integration of the differential-drive base and the PTU axes, contacts of
+// the robot's cylinder with the world's obstacles, scripted e-stop, watchdog stand-in.
+#include "hal/sim/sim_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace boticelli::hal::sim {
+
+namespace {
+
+// Distance [m] from a point to a convex counter-clockwise polygon (negative inside: minus the
+// distance to the nearest edge).
+float distance_to_hull(const Collider& c, float px, float py) {
+  if (c.hull_size == 1) return std::hypot(px - c.hull[0].x_m, py - c.hull[0].y_m);
+  bool inside = c.hull_size >= 3;
+  float best = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < c.hull_size; ++i) {
+    const core::Point2 a = c.hull[i];
+    const core::Point2 b = c.hull[(i + 1) % c.hull_size];
+    const float ex = b.x_m - a.x_m;
+    const float ey = b.y_m - a.y_m;
+    const float len2 = ex * ex + ey * ey;
+    const float t = len2 > 0.0F ? std::clamp(((px - a.x_m) * ex + (py - a.y_m) * ey) / len2, 0.0F, 1.0F)
+                                : 0.0F;
+    best = std::min(best, std::hypot(px - a.x_m - t * ex, py - a.y_m - t * ey));
+    if (ex * (py - a.y_m) - ey * (px - a.x_m) < 0.0F) inside = false;  // right of an edge
+  }
+  return inside ? -best : best;
+}
+
+}  // namespace
+
+bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimParams& params,
+                    char* error, std::size_t error_size) {
+  world_ = &world;
+  rig_ = &rig;
+  params_ = params;
+  if (params_.physics_step_us == 0) params_.physics_step_us = 1000;
+  now_us_ = 0;
+  rng_state_ = params.seed * 0x9E3779B97F4A7C15ULL + 0x632BE59BD9B4E019ULL;
+  x_m_ = world.start.x_m;
+  y_m_ = world.start.y_m;
+  yaw_rad_ = world.start.yaw_rad;
+  wheel_left_m_s_ = wheel_right_m_s_ = target_left_m_s_ = target_right_m_s_ = 0.0F;
+  base_health_ = BaseHealth::kStopped;
+  base_error_ = "not started";
+  base_started_ = false;
+  odometry_ = Odometry{};
+  collisions_ = 0;
+  contacts_ = 0;
+  last_collision_model_ = "";
+  pan_ = PtuAxis{};
+  tilt_ = PtuAxis{};
+  pan_.speed_rad_s = tilt_.speed_rad_s = params_.ptu.speed_rad_s;
+  estop_ = estop_scripted_ = false;
+  estop_presses_ = 0;
+  led_ = false;
+  led_changes_ = 0;
+  watchdog_armed_ = false;
+  watchdog_expirations_ = 0;
+  const char* model = "";
+  const float gap = clearance_m(x_m_, y_m_, &model);
+  if (gap < 0.0F) {
+    std::snprintf(error, error_size,
+                  "the robot's start (%.2f, %.2f) overlaps model '%s' (robot radius %.2f m)",
+                  static_cast<double>(x_m_), static_cast<double>(y_m_), model,
+                  static_cast<double>(params_.base.robot_radius_m));
+    return false;
+  }
+  contact_ = gap <= params_.base.contact_margin_m;
+  return true;
+}
+
+float SimWorld::clearance_m(double x_m, double y_m, const char** model) const {
+  const float px = static_cast<float>(x_m);
+  const float py = static_cast<float>(y_m);
+  float best = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < world_->collider_count; ++i) {
+    const Collider& c = world_->colliders[i];
+    if (c.z_max_m <= params_.base.floor_clearance_m || c.z_min_m >= params_.base.robot_height_m) {
+      continue;
+    }
+    const float d = c.circle ? std::hypot(px - c.centre_x_m, py - c.centre_y_m) - c.radius_m
+                             : distance_to_hull(c, px, py);
+    if (d < best) {
+      best = d;
+      if (model != nullptr) *model = c.model;
+    }
+  }
+  return best - params_.base.robot_radius_m;
+}
+
+RigidTransform SimWorld::camera_pose(const core::Pose2& robot, float pan_rad,
+                                     float tilt_rad) const {
+  const stereo::CameraPose cam = rig_->camera_pose(pan_rad, tilt_rad);
+  RigidTransform world_from_ptu;
+  const float c = std::cos(robot.yaw_rad);
+  const float s = std::sin(robot.yaw_rad);
+  world_from_ptu.rotation << c, -s, 0.0F, s, c, 0.0F, 0.0F, 0.0F, 1.0F;
+  world_from_ptu.translation_m =
+      Eigen::Vector3f(robot.x_m, robot.y_m, rig_->params().ptu_height_m);
+  return world_from_ptu.then(RigidTransform{cam.rotation, cam.centre_m});
+}
+
+RigidTransform SimWorld::camera_pose() const {
+  return camera_pose(true_pose(), pan_.position_rad, tilt_.position_rad);
+}
+
+bool SimWorld::teleport(const core::Pose2& pose) {
+  const float gap = clearance_m(pose.x_m, pose.y_m);
+  if (gap < 0.0F) return false;
+  x_m_ = pose.x_m;
+  y_m_ = pose.y_m;
+  yaw_rad_ = pose.yaw_rad;
+  contact_ = gap <= params_.base.contact_margin_m;
+  return true;
+}
+
+void SimWorld::advance_to(std::uint64_t deadline_us) {
+  while (now_us_ < deadline_us) {
+    const std::uint64_t dt = std::min<std::uint64_t>(params_.physics_step_us, deadline_us - now_us_);
+    step(static_cast<std::uint32_t>(dt));
+  }
+}
+
+void SimWorld::step(std::uint32_t dt_us) {
+  const float dt_s = static_cast<float>(dt_us) * 1e-6F;
+  now_us_ += dt_us;
+  if (estop_scripted_) {
+    if (!estop_ && now_us_ >= estop_press_us_ && now_us_ < estop_release_us_) {
+      set_estop_pressed(true);
+    } else if (estop_ && now_us_ >= estop_release_us_) {
+      set_estop_pressed(false);
+      estop_scripted_ = false;
+    }
+  }
+  step_axis(pan_, dt_s);
+  step_axis(tilt_, dt_s);
+  if (base_started_ && base_health_ == BaseHealth::kStarting && now_us_ >= base_ready_at_us_) {
+    base_health_ = BaseHealth::kReady;
+    base_error_ = "";
+  }
+  step_base(dt_s);
+  if (watchdog_armed_ && now_us_ - last_kick_us_ > watchdog_timeout_us_) {
+    ++watchdog_expirations_;
+    last_kick_us_ = now_us_;  // a real board would reset here; count and carry on
+  }
+}
+
+// Trapezoidal profile: accelerate to the axis speed, brake in time to stop on the target.
+void SimWorld::step_axis(PtuAxis& axis, float dt_s) const {
+  if (!axis.moving()) return;
+  const float a = params_.ptu.accel_rad_s2;
+  const float error = axis.target_rad - axis.position_rad;
+  const float brake_speed = std::sqrt(2.0F * a * std::fabs(error));
+  const float desired = std::copysign(std::min(axis.speed_rad_s, brake_speed), error);
+  const float dv = std::clamp(desired - axis.velocity_rad_s, -a * dt_s, a * dt_s);
+  const float v0 = axis.velocity_rad_s;
+  axis.velocity_rad_s += dv;
+  axis.position_rad += 0.5F * (v0 + axis.velocity_rad_s) * dt_s;
+  const float after = axis.target_rad - axis.position_rad;
+  // Arrived (or passed the target): stop on it. Tiny remainders settle at once.
+  if ((after > 0.0F) != (error > 0.0F) || after == 0.0F ||
+      (std::fabs(after) < 1e-6F && std::fabs(axis.velocity_rad_s) < a * dt_s)) {
+    axis.position_rad = axis.target_rad;
+    axis.velocity_rad_s = 0.0F;
+  }
+}
+
+float SimWorld::gaussian() {
+  // splitmix64 → Box–Muller (one value per call; deterministic for the seed).
+  auto next = [this]() {
+    std::uint64_t z = (rng_state_ += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31U;
+    return (static_cast<double>(z >> 11U) + 0.5) * (1.0 / 9007199254740992.0);
+  };
+  const double u1 = next();
+  const double u2 = next();
+  return static_cast<float>(std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2));
+}
+
+void SimWorld::step_base(float dt_s) {
+  const BaseParams& b = params_.base;
+  const float dv = b.wheel_accel_m_s2 * dt_s;
+  wheel_left_m_s_ += std::clamp(target_left_m_s_ - wheel_left_m_s_, -dv, dv);
+  wheel_right_m_s_ += std::clamp(target_right_m_s_ - wheel_right_m_s_, -dv, dv);
+  const double dl = static_cast<double>(wheel_left_m_s_) * static_cast<double>(dt_s);
+  const double dr = static_cast<double>(wheel_right_m_s_) * static_cast<double>(dt_s);
+  if (dl != 0.0 || dr != 0.0) {
+    // Exact arc of a differential drive over the step.
+    const double track = b.track_width_m;
+    const double ds = 0.5 * (dl + dr);
+    const double dyaw = (dr - dl) / track;
+    const double mid = yaw_rad_ + 0.5 * dyaw;
+    const double chord = std::fabs(dyaw) > 1e-9 ? ds * std::sin(0.5 * dyaw) / (0.5 * dyaw) : ds;
+    const double nx = x_m_ + chord * std::cos(mid);
+    const double ny = y_m_ + chord * std::sin(mid);
+    const char* model = "";
+    const float gap = clearance_m(nx, ny, &model);
+    if (gap < 0.0F) {
+      // Collision: the robot stays where it was, the base stops, the event is counted.
+      ++collisions_;
+      last_collision_model_ = model;
+      std::snprintf(collision_error_, sizeof collision_error_, "collision with '%s'", model);
+      wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
+      base_stop(collision_error_);
+      if (!contact_) ++contacts_;
+      contact_ = true;
+    } else {
+      x_m_ = nx;
+      y_m_ = ny;
+      yaw_rad_ = std::remainder(yaw_rad_ + dyaw, 6.283185307179586);
+      const bool contact = gap <= b.contact_margin_m;
+      if (contact && !contact_) ++contacts_;
+      contact_ = contact;
+      // Wheel odometry (noise optional, off by default as in the thesis).
+      double ol = dl;
+      double orr = dr;
+      if (b.odometry_noise > 0.0F) {
+        ol *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
+        orr *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
+      }
+      const double ods = 0.5 * (ol + orr);
+      const double odyaw = (orr - ol) / track;
+      const double omid = odometry_.yaw_rad + 0.5 * odyaw;
+      const double ochord =
+          std::fabs(odyaw) > 1e-9 ? ods * std::sin(0.5 * odyaw) / (0.5 * odyaw) : ods;
+      odometry_.x_m += ochord * std::cos(omid);
+      odometry_.y_m += ochord * std::sin(omid);
+      odometry_.yaw_rad = std::remainder(odometry_.yaw_rad + odyaw, 6.283185307179586);
+    }
+  }
+  odometry_.v_m_s = 0.5F * (wheel_left_m_s_ + wheel_right_m_s_);
+  odometry_.omega_rad_s = (wheel_right_m_s_ - wheel_left_m_s_) / b.track_width_m;
+  odometry_.timestamp_us = now_us_;
+}
+
+void SimWorld::base_start() {
+  base_started_ = true;
+  base_health_ = BaseHealth::kStarting;
+  base_error_ = "starting";
+  base_ready_at_us_ = now_us_ + params_.base.startup_us;
+  odometry_ = Odometry{};
+  odometry_.timestamp_us = now_us_;
+}
+
+void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
+  if (base_health_ != BaseHealth::kReady || !std::isfinite(v_m_s) || !std::isfinite(omega_rad_s)) {
+    return;
+  }
+  const BaseParams& b = params_.base;
+  const float v = std::clamp(v_m_s, -b.max_speed_m_s, b.max_speed_m_s);
+  const float w = std::clamp(omega_rad_s, -b.max_turn_rate_rad_s, b.max_turn_rate_rad_s);
+  target_left_m_s_ = v - 0.5F * w * b.track_width_m;
+  target_right_m_s_ = v + 0.5F * w * b.track_width_m;
+}
+
+void SimWorld::base_stop(const char* reason) {
+  target_left_m_s_ = target_right_m_s_ = 0.0F;
+  wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
+  base_health_ = BaseHealth::kStopped;
+  base_error_ = reason;
+}
+
+bool SimWorld::base_resume() {
+  if (!base_started_) return false;
+  if (base_health_ == BaseHealth::kStopped) {
+    base_health_ = now_us_ >= base_ready_at_us_ ? BaseHealth::kReady : BaseHealth::kStarting;
+    base_error_ = base_health_ == BaseHealth::kReady ? "" : "starting";
+  }
+  return true;
+}
+
+void SimWorld::set_estop_pressed(bool pressed) {
+  if (pressed && !estop_) ++estop_presses_;
+  estop_ = pressed;
+}
+
+void SimWorld::schedule_estop(std::uint64_t press_us, std::uint64_t duration_us) {
+  estop_scripted_ = true;
+  estop_press_us_ = press_us;
+  estop_release_us_ = press_us + std::max<std::uint64_t>(duration_us, 1);
+}
+
+void SimWorld::set_led(bool on) {
+  if (on != led_) ++led_changes_;
+  led_ = on;
+}
+
+void SimWorld::watchdog_start(std::uint32_t timeout_ms) {
+  watchdog_armed_ = true;
+  watchdog_timeout_us_ = static_cast<std::uint64_t>(timeout_ms) * 1000U;
+  last_kick_us_ = now_us_;
+}
+
+}  // namespace boticelli::hal::sim
