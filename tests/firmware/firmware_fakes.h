@@ -101,3 +101,34 @@ class FakeWatchdog final : public hal::Watchdog {
 };
 
 }  // namespace boticelli::test
+
+namespace boticelli::test {
+
+// A camera that delivers a small grey frame every `every` polls.
+class FakeCamera final : public hal::Camera {
+ public:
+  bool init() override { return !fail_init; }
+  hal::CameraPoll poll(hal::Frame& frame) override {
+    if (fault) return hal::CameraPoll::kFault;
+    if (++polls % every != 0) return hal::CameraPoll::kNoFrame;
+    frame.data = pixels;
+    frame.width_px = 2;
+    frame.height_px = 2;
+    frame.stride_bytes = 4;
+    frame.sequence = sequence++;
+    return hal::CameraPoll::kFrame;
+  }
+  void release() override { ++releases; }
+  std::uint32_t width_px() const override { return 2; }
+  std::uint32_t height_px() const override { return 2; }
+  const char* error() const override { return fail_init ? "no such device" : ""; }
+  bool fail_init = false;
+  bool fault = false;
+  int every = 3;
+  int polls = 0;
+  int releases = 0;
+  std::uint32_t sequence = 0;
+  std::uint8_t pixels[8] = {128, 128, 128, 128, 128, 128, 128, 128};
+};
+
+}  // namespace boticelli::test

@@ -1,0 +1,195 @@
+// Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console shutdown, --state/--resume.
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "fake_clock.h"
+#include "fake_serial_port.h"
+#include "firmware/firmware_main.h"
+#include "firmware/persistence.h"
+#include "firmware_fakes.h"
+
+#include "CppUTest/TestHarness.h"
+
+using namespace boticelli::firmware;
+using namespace boticelli::test;
+
+namespace {
+
+class NullWatchdog final : public boticelli::hal::Watchdog {
+ public:
+  bool start(std::uint32_t) override { return false; }
+  void kick() override {}
+  void stop() override {}
+  const char* error() const override { return "no watchdog in tests"; }
+};
+
+// Everything fake; the clock moves only in sleep_until_us (lockstep, like the sim board).
+class FakeBoard final : public Board {
+ public:
+  const BoardInfo& info() const override { return kInfo; }
+  const BoardConfig& config() const override { return config_; }
+  bool init(const Options&, char* error, std::size_t size) override {
+    if (refuse) {
+      std::snprintf(error, size, "fake board refuses");
+      return false;
+    }
+    return true;
+  }
+  boticelli::hal::Hal& hal() override { return hal_; }
+
+  bool refuse = false;
+  BoardConfig config_{};
+  boticelli::fakes::FakeClock clock{1000};
+  boticelli::fakes::FakeSerialPort console;
+  FakeCamera camera;
+  FakePanTilt ptu;
+  FakeBase base{&clock};
+  FakeInput estop, bumper;
+  FakeOutput led;
+  NullWatchdog watchdog;
+
+ private:
+  static constexpr BoardInfo kInfo{"fake", "test board", false};
+  boticelli::hal::Hal hal_{camera, ptu, base, estop, bumper, led, console, clock, watchdog};
+};
+
+struct Run {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(int fd) {
+  std::string s;
+  char buf[4096];
+  ssize_t n = 0;
+  lseek(fd, 0, SEEK_SET);
+  while ((n = read(fd, buf, sizeof buf)) > 0) s.append(buf, static_cast<std::size_t>(n));
+  return s;
+}
+
+// Runs firmware_main in a child process (its objects are static, one run per process).
+template <typename Prepare>
+Run run_firmware(std::vector<const char*> args, Prepare prepare) {
+  args.insert(args.begin(), "boticelli");
+  char out_name[] = "/tmp/boticelli-out-XXXXXX";
+  char err_name[] = "/tmp/boticelli-err-XXXXXX";
+  const int out_fd = mkstemp(out_name);
+  const int err_fd = mkstemp(err_name);
+  unlink(out_name);
+  unlink(err_name);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t child = fork();
+  if (child == 0) {
+    dup2(out_fd, STDOUT_FILENO);
+    dup2(err_fd, STDERR_FILENO);
+    static FakeBoard board;
+    prepare(board);
+    const int code = firmware_main(static_cast<int>(args.size()), args.data(), board);
+    std::fflush(stdout);
+    std::fflush(stderr);
+    _exit(code);
+  }
+  Run r;
+  int status = 0;
+  waitpid(child, &status, 0);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out_fd);
+  r.err = slurp(err_fd);
+  close(out_fd);
+  close(err_fd);
+  return r;
+}
+
+Run run_firmware(std::vector<const char*> args) {
+  return run_firmware(std::move(args), [](FakeBoard&) {});
+}
+
+std::string last_line(const std::string& s) {
+  const std::size_t end = s.find_last_not_of('\n');
+  const std::size_t start = s.rfind('\n', end);
+  return s.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+}
+
+}  // namespace
+
+TEST_GROUP(FirmwareMain) {
+  std::string dir;
+  void setup() override {
+    char templ[] = "/tmp/boticelli-fw-XXXXXX";
+    dir = mkdtemp(templ);
+  }
+  void teardown() override {
+    unlink((dir + "/mission.state").c_str());
+    rmdir(dir.c_str());
+  }
+};
+
+TEST(FirmwareMain, RunsTheExecutiveUntilMaxCyclesAndPrintsTheMissionLineLast) {
+  const Run r = run_firmware({"--max-cycles", "3"});
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("boticelli 0.1.0 board=fake (test board)", r.out.c_str());
+  const std::string line = last_line(r.out);
+  STRCMP_CONTAINS("MISSION result=aborted cycles=3 collisions=0 sim_time_s=3.0", line.c_str());
+  STRCMP_CONTAINS("wall_time_s=", line.c_str());
+  STRCMP_CONTAINS("target_error_m=nan", line.c_str());
+}
+
+TEST(FirmwareMain, ExitsWithTheUsageCodeOnABadOption) {
+  const Run r = run_firmware({"--warp"});
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+  STRCMP_CONTAINS("unknown option '--warp'", r.err.c_str());
+}
+
+TEST(FirmwareMain, PrintsTheBoardsReasonWhenItsInitFails) {
+  const Run r = run_firmware({}, [](FakeBoard& b) { b.refuse = true; });
+  CHECK_EQUAL(kExitFailure, r.exit_code);
+  STRCMP_CONTAINS("boticelli: fake board refuses", r.err.c_str());
+  const Run cam = run_firmware({}, [](FakeBoard& b) { b.camera.fail_init = true; });
+  CHECK_EQUAL(kExitFailure, cam.exit_code);
+  STRCMP_CONTAINS("boticelli: camera: no such device", cam.err.c_str());
+}
+
+TEST(FirmwareMain, StopsOnTheConsolesQuitCommand) {
+  const Run r = run_firmware({}, [](FakeBoard& b) { b.console.feed("status\rquit\r"); });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("MISSION result=aborted cycles=0", last_line(r.out).c_str());
+}
+
+TEST(FirmwareMain, SavesEachCycleAndResumesFromTheStateDirectory) {
+  Run r = run_firmware({"--max-cycles", "4", "--state", dir.c_str(), "--seed", "9"});
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(4U, state.cycle);
+  CHECK_EQUAL(9U, state.seed);
+  CHECK_EQUAL(4U, state.log.size());
+
+  r = run_firmware({"--max-cycles", "2", "--state", dir.c_str(), "--resume"});
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("resumed from", r.err.c_str());
+  STRCMP_CONTAINS("MISSION result=aborted cycles=6", last_line(r.out).c_str());
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(6U, state.cycle);
+  CHECK_EQUAL(9U, state.seed);  // the mission's seed survives the resume
+  CHECK_EQUAL(6U, state.log.size());
+}
+
+TEST(FirmwareMain, RefusesToResumeFromACorruptState) {
+  FILE* f = std::fopen((dir + "/mission.state").c_str(), "wb");
+  std::fputs("BOTICELLI-STATE 1\ncycle 3\n", f);
+  std::fclose(f);
+  const Run r = run_firmware({"--state", dir.c_str(), "--resume"});
+  CHECK_EQUAL(kExitFailure, r.exit_code);
+  STRCMP_CONTAINS("boticelli: cannot resume:", r.err.c_str());
+}
