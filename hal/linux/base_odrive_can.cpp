@@ -1,0 +1,357 @@
+// BaseOdriveCan: SocketCAN transport, start-up sequence, setpoints, heartbeat watchdog, odometry.
+#include "hal/linux/base_odrive_can.h"
+
+#include <fcntl.h>
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "hal/linux/error_text.h"
+
+namespace boticelli::hal_linux {
+
+namespace odrive = codec::odrive;
+
+namespace {
+
+constexpr const char* kSide[2] = {"left", "right"};
+
+can_frame to_os(const odrive::CanFrame& f) {
+  can_frame out{};
+  out.can_id = f.id & (f.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
+  if (f.extended) out.can_id |= CAN_EFF_FLAG;
+  if (f.remote) out.can_id |= CAN_RTR_FLAG;
+  out.len = f.dlc;
+  std::memcpy(out.data, f.data.data(), 8);
+  return out;
+}
+
+odrive::CanFrame from_os(const can_frame& f) {
+  odrive::CanFrame out;
+  out.extended = (f.can_id & CAN_EFF_FLAG) != 0;
+  out.remote = (f.can_id & CAN_RTR_FLAG) != 0;
+  out.id = f.can_id & (out.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
+  out.dlc = f.len;
+  std::memcpy(out.data.data(), f.data, 8);
+  return out;
+}
+
+float clamp_abs(float v, float limit) {
+  return std::clamp(v, -limit, limit);
+}
+
+}  // namespace
+
+BaseOdriveCan::BaseOdriveCan(const BaseOdriveCanConfig& config, hal::Clock& clock)
+    : config_(config), clock_(clock), integrator_(config.geometry) {
+  axes_[0].node_id = config.left_node_id;
+  axes_[1].node_id = config.right_node_id;
+}
+
+BaseOdriveCan::~BaseOdriveCan() {
+  close_socket();
+}
+
+void BaseOdriveCan::close_socket() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+bool BaseOdriveCan::init() {
+  const auto& g = config_.geometry;
+  if (!(g.wheel_radius_m > 0.0F) || !(g.track_width_m > 0.0F) ||
+      config_.left_node_id > odrive::kMaxNodeId || config_.right_node_id > odrive::kMaxNodeId ||
+      config_.left_node_id == config_.right_node_id) {
+    set_error(error_, "base: bad configuration (wheel radius, track width or node ids)");
+    health_ = hal::BaseHealth::kStopped;
+    return false;
+  }
+  close_socket();
+  if (config_.socket_fd >= 0) {
+    fd_ = config_.socket_fd;
+    config_.socket_fd = -1;  // owned now; a second init() opens the interface
+  } else {
+    fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    if (fd_ < 0) {
+      set_error(error_, "base: cannot open a CAN socket", errno);
+      return false;
+    }
+    // Kernel filters: only frames from the two nodes (any command), plus error frames.
+    can_filter filters[2];
+    for (int i = 0; i < 2; ++i) {
+      filters[i].can_id = static_cast<canid_t>(axes_[i].node_id) << 5U;
+      filters[i].can_mask = (static_cast<canid_t>(odrive::kMaxNodeId) << 5U) | CAN_EFF_FLAG;
+    }
+    const can_err_mask_t err_mask = CAN_ERR_MASK;  // every error class
+    ifreq ifr{};
+    std::snprintf(ifr.ifr_name, IFNAMSIZ, "%s", config_.interface);
+    sockaddr_can addr{};
+    if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, filters, sizeof filters) != 0 ||
+        ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof err_mask) != 0) {
+      set_error(error_, "base: cannot set CAN filters", errno);
+      close_socket();
+      return false;
+    }
+    if (::ioctl(fd_, SIOCGIFINDEX, &ifr) != 0) {
+      set_error(error_, "base: no such CAN interface", errno);
+      close_socket();
+      return false;
+    }
+    addr.can_family = AF_CAN;
+    addr.can_ifindex = ifr.ifr_ifindex;
+    if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+      set_error(error_, "base: cannot bind the CAN socket", errno);
+      close_socket();
+      return false;
+    }
+  }
+  ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK);
+  integrator_ = codec::DiffDriveOdometry(config_.geometry);
+  odometry_ = {};
+  bus_off_ = false;
+  begin_startup(clock_.now_us());
+  return true;
+}
+
+void BaseOdriveCan::begin_startup(std::uint64_t now_us) {
+  health_ = hal::BaseHealth::kStarting;
+  error_[0] = '\0';
+  setpoint_turns_s_ = {};
+  for (Axis& a : axes_) {
+    a.heartbeat_seen = false;
+    a.encoder_fresh = false;
+  }
+  startup_deadline_us_ = now_us + std::uint64_t{config_.startup_timeout_ms} * 1000U;
+  send_startup_commands();
+  next_state_send_us_ = now_us + std::uint64_t{config_.state_resend_ms} * 1000U;
+}
+
+void BaseOdriveCan::send_startup_commands() {
+  for (const Axis& a : axes_) {
+    send(odrive::encode_clear_errors(a.node_id));
+    send(odrive::encode_set_controller_mode(a.node_id, odrive::ControlMode::kVelocityControl,
+                                            odrive::InputMode::kPassthrough));
+    send(odrive::encode_set_input_vel(a.node_id, 0.0F));
+    send(odrive::encode_set_axis_state(a.node_id, odrive::AxisState::kClosedLoopControl));
+  }
+}
+
+void BaseOdriveCan::send(const odrive::CanFrame& f) {
+  if (fd_ < 0) return;
+  const can_frame frame = to_os(f);
+  for (;;) {
+    const ssize_t n = ::write(fd_, &frame, sizeof frame);
+    if (n == static_cast<ssize_t>(sizeof frame)) {
+      ++sent_frames_;
+      return;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    // ENOBUFS / EAGAIN: the TX queue is full (no ACK on the bus, bus-off); the setpoint is
+    // re-sent next cycle anyway. Counted; the heartbeat watchdog decides about stopping.
+    ++send_failures_;
+    return;
+  }
+}
+
+void BaseOdriveCan::fault(const char* what, const char* side, std::uint32_t value) {
+  if (side != nullptr) {
+    std::snprintf(error_, sizeof error_, "base: %s axis: %s (0x%08x)", side, what,
+                  static_cast<unsigned>(value));
+  } else {
+    std::snprintf(error_, sizeof error_, "base: %s", what);
+  }
+  if (health_ != hal::BaseHealth::kStopped) {
+    for (const Axis& a : axes_) {
+      send(odrive::encode_set_input_vel(a.node_id, 0.0F));
+      send(odrive::encode_estop(a.node_id));
+    }
+  }
+  health_ = hal::BaseHealth::kStopped;
+  setpoint_turns_s_ = {};
+  odometry_.v_m_s = 0.0F;
+  odometry_.omega_rad_s = 0.0F;
+}
+
+void BaseOdriveCan::handle_error_frame(std::uint32_t can_id, const std::uint8_t* data) {
+  ++error_frames_;
+  if ((can_id & CAN_ERR_BUSOFF) != 0) {
+    bus_off_ = true;
+    fault("CAN bus-off (controller stopped transmitting)");
+    return;
+  }
+  if ((can_id & CAN_ERR_RESTARTED) != 0) bus_off_ = false;
+  if ((can_id & CAN_ERR_CRTL) != 0 &&
+      (data[1] & (CAN_ERR_CRTL_RX_OVERFLOW | CAN_ERR_CRTL_TX_OVERFLOW)) != 0) {
+    // Lost frames: not fatal by itself; the heartbeat watchdog catches a dead link.
+    return;
+  }
+}
+
+void BaseOdriveCan::receive(std::uint64_t now_us) {
+  if (fd_ < 0) return;
+  for (int i = 0; i < 64; ++i) {  // bounded: at 1 Mbit/s at most ~8 frames per ms arrive
+    can_frame frame{};
+    const ssize_t n = ::read(fd_, &frame, sizeof frame);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      if (errno != EAGAIN && errno != EWOULDBLOCK) {
+        char text[120];
+        set_error(text, "CAN read failed", errno);
+        fault(text);
+      }
+      return;
+    }
+    if (n != static_cast<ssize_t>(sizeof frame) || frame.len > CAN_MAX_DLEN) {
+      ++rejected_frames_;  // CAN FD or truncated: not CAN Simple
+      continue;
+    }
+    if ((frame.can_id & CAN_ERR_FLAG) != 0) {
+      handle_error_frame(frame.can_id, frame.data);
+      continue;
+    }
+    const odrive::CanFrame f = from_os(frame);
+    odrive::Message m;
+    const odrive::DecodeStatus st = odrive::decode(f, m);
+    int side = -1;
+    for (int k = 0; k < 2; ++k) {
+      if (!f.extended && m.node_id == axes_[k].node_id) side = k;
+    }
+    if (st != odrive::DecodeStatus::kOk || side < 0) {
+      ++rejected_frames_;  // unknown node or command, wrong length, NaN, RTR from others
+      continue;
+    }
+    Axis& a = axes_[side];
+    if (m.command == odrive::Command::kHeartbeat) {
+      a.heartbeat = m.heartbeat;
+      a.heartbeat_seen = true;
+      a.last_heartbeat_us = now_us;
+    } else if (m.command == odrive::Command::kGetEncoderEstimates) {
+      a.encoder = m.encoder;
+      a.encoder_seen = true;
+      a.encoder_fresh = true;
+    } else {
+      ++rejected_frames_;  // a host -> ODrive command seen on the bus (another master)
+    }
+  }
+}
+
+void BaseOdriveCan::update_odometry(std::uint64_t now_us) {
+  if (!axes_[0].encoder_seen || !axes_[1].encoder_seen) return;
+  if (!axes_[0].encoder_fresh && !axes_[1].encoder_fresh) return;
+  axes_[0].encoder_fresh = axes_[1].encoder_fresh = false;
+  integrator_.update({axes_[0].encoder.pos_turns, axes_[1].encoder.pos_turns});
+  odometry_.x_m = integrator_.x_m();
+  odometry_.y_m = integrator_.y_m();
+  odometry_.yaw_rad = integrator_.yaw_rad();
+  codec::wheels_to_body({axes_[0].encoder.vel_turns_s, axes_[1].encoder.vel_turns_s},
+                        config_.geometry, odometry_.v_m_s, odometry_.omega_rad_s);
+  odometry_.timestamp_us = now_us;
+}
+
+void BaseOdriveCan::update() {
+  if (fd_ < 0) return;
+  const std::uint64_t now = clock_.now_us();
+  receive(now);
+  update_odometry(now);
+  if (health_ == hal::BaseHealth::kStarting) {
+    bool ready = true;
+    for (const Axis& a : axes_) {
+      ready = ready && a.heartbeat_seen && a.heartbeat.axis_error == 0 &&
+              a.heartbeat.axis_state ==
+                  static_cast<std::uint8_t>(odrive::AxisState::kClosedLoopControl);
+    }
+    if (ready) {
+      health_ = hal::BaseHealth::kReady;
+    } else if (now >= startup_deadline_us_) {
+      for (int k = 0; k < 2; ++k) {
+        const Axis& a = axes_[k];
+        if (!a.heartbeat_seen) {
+          fault("no heartbeat during start-up", kSide[k], 0);
+          return;
+        }
+        if (a.heartbeat.axis_error != 0) {
+          fault("error during start-up", kSide[k], a.heartbeat.axis_error);
+          return;
+        }
+        if (a.heartbeat.axis_state !=
+            static_cast<std::uint8_t>(odrive::AxisState::kClosedLoopControl)) {
+          fault("did not enter closed loop; axis state", kSide[k], a.heartbeat.axis_state);
+          return;
+        }
+      }
+      return;
+    } else if (now >= next_state_send_us_) {
+      send_startup_commands();
+      next_state_send_us_ = now + std::uint64_t{config_.state_resend_ms} * 1000U;
+      return;
+    }
+  }
+  if (health_ != hal::BaseHealth::kReady) return;
+  for (int k = 0; k < 2; ++k) {
+    const Axis& a = axes_[k];
+    if (now - a.last_heartbeat_us > std::uint64_t{config_.heartbeat_timeout_ms} * 1000U) {
+      fault("heartbeat lost", kSide[k], 0);
+      return;
+    }
+    if (a.heartbeat.axis_error != 0) {
+      fault("ODrive reports an axis error", kSide[k], a.heartbeat.axis_error);
+      return;
+    }
+    if (a.heartbeat.axis_state !=
+        static_cast<std::uint8_t>(odrive::AxisState::kClosedLoopControl)) {
+      fault("left closed-loop control; axis state", kSide[k], a.heartbeat.axis_state);
+      return;
+    }
+  }
+  // Re-sent every cycle: the ODrive's watchdog (if configured) stops the motor otherwise.
+  send(odrive::encode_set_input_vel(axes_[0].node_id, setpoint_turns_s_.left));
+  send(odrive::encode_set_input_vel(axes_[1].node_id, setpoint_turns_s_.right));
+  if (config_.request_encoder) {
+    for (const Axis& a : axes_) send(odrive::encode_encoder_request(a.node_id));
+  }
+}
+
+void BaseOdriveCan::set_velocity(float v_m_s, float omega_rad_s) {
+  if (health_ != hal::BaseHealth::kReady) return;
+  if (!std::isfinite(v_m_s) || !std::isfinite(omega_rad_s)) return;
+  codec::WheelTurns w = codec::body_to_wheels(v_m_s, omega_rad_s, config_.geometry);
+  // Clamp both wheels by the same factor, so the path's curvature is kept.
+  const float peak = std::max(std::fabs(w.left), std::fabs(w.right));
+  if (peak > config_.max_wheel_turns_s) {
+    const float scale = config_.max_wheel_turns_s / peak;
+    w.left *= scale;
+    w.right *= scale;
+  }
+  setpoint_turns_s_.left = clamp_abs(w.left, config_.max_wheel_turns_s);
+  setpoint_turns_s_.right = clamp_abs(w.right, config_.max_wheel_turns_s);
+}
+
+void BaseOdriveCan::stop() {
+  if (health_ == hal::BaseHealth::kStopped) {
+    // Already stopped (maybe by a fault): still tell the axes, the link may be back.
+    for (const Axis& a : axes_) send(odrive::encode_estop(a.node_id));
+    return;
+  }
+  fault("stopped by request");
+}
+
+bool BaseOdriveCan::resume() {
+  if (fd_ < 0) return false;
+  if (health_ != hal::BaseHealth::kStopped) return true;
+  bus_off_ = false;  // a bus-off controller restarts (restart-ms); the heartbeats will tell
+  integrator_.reset_reference();
+  begin_startup(clock_.now_us());
+  return true;
+}
+
+}  // namespace boticelli::hal_linux

@@ -1,0 +1,91 @@
+// BaseOdriveCan: hal::Base for two ODrive axes (left and right wheel) on SocketCAN, "CAN Simple".
+#pragma once
+
+#include <cstdint>
+
+#include "hal/base.h"
+#include "hal/clock.h"
+#include "hal/codec/diff_drive.h"
+#include "hal/codec/odrive_can_codec.h"
+
+namespace boticelli::hal_linux {
+
+struct BaseOdriveCanConfig {
+  const char* interface = "can0";  // SocketCAN interface (can0, vcan0)
+  // An already-open socket carrying struct can_frame (a test's socketpair); −1 = open a raw
+  // CAN socket on `interface`. The driver owns and closes it.
+  int socket_fd = -1;
+  std::uint8_t left_node_id = 0;  // ODrive axis node ids (0..63)
+  std::uint8_t right_node_id = 1;
+  codec::DiffDriveGeometry geometry{0.08F, 0.40F, 1.0F, -1.0F};  // wheel radius, track [m]
+  float max_wheel_turns_s = 8.0F;            // motor setpoints are clamped to ± this [turns/s]
+  std::uint32_t heartbeat_timeout_ms = 300;  // no heartbeat from an axis that long: stop
+  std::uint32_t startup_timeout_ms = 3000;   // both axes in closed loop by then, or stop
+  std::uint32_t state_resend_ms = 250;       // Set_Axis_State repeated while starting
+  bool request_encoder = false;              // send an RTR for Get_Encoder_Estimates every update()
+                                             // (when the ODrives do not send it cyclically)
+};
+
+// Non-blocking: update() drains the socket (bounded), runs the start-up sequence
+// (Clear_Errors, Set_Controller_Mode velocity/passthrough, Set_Input_Vel 0, Set_Axis_State
+// closed loop, then both heartbeats must report closed loop without error), re-sends the
+// velocity setpoint every call (so the ODrive's own watchdog stays fed) and integrates the
+// odometry from Get_Encoder_Estimates. A missing heartbeat, an axis leaving closed loop, an
+// axis error or a bus-off error frame stop the base (Estop to both axes) and set error().
+class BaseOdriveCan final : public hal::Base {
+ public:
+  BaseOdriveCan(const BaseOdriveCanConfig& config, hal::Clock& clock);
+  ~BaseOdriveCan() override;
+
+  bool init() override;
+  void update() override;
+  void set_velocity(float v_m_s, float omega_rad_s) override;
+  void stop() override;
+  bool resume() override;
+  hal::BaseHealth health() const override { return health_; }
+  hal::Odometry odometry() const override { return odometry_; }
+  const char* error() const override { return error_; }
+
+  // Diagnostics.
+  std::uint32_t rejected_frames() const { return rejected_frames_; }
+  std::uint32_t error_frames() const { return error_frames_; }
+  std::uint32_t sent_frames() const { return sent_frames_; }
+
+ private:
+  struct Axis {
+    std::uint8_t node_id = 0;
+    std::uint64_t last_heartbeat_us = 0;
+    bool heartbeat_seen = false;
+    codec::odrive::Heartbeat heartbeat{};
+    codec::odrive::EncoderEstimates encoder{};
+    bool encoder_seen = false;
+    bool encoder_fresh = false;
+  };
+  void send(const codec::odrive::CanFrame& frame);
+  void receive(std::uint64_t now_us);
+  void handle_error_frame(std::uint32_t can_id, const std::uint8_t* data);
+  void begin_startup(std::uint64_t now_us);
+  void send_startup_commands();
+  void fault(const char* what, const char* side = nullptr, std::uint32_t value = 0);
+  void update_odometry(std::uint64_t now_us);
+  void close_socket();
+
+  BaseOdriveCanConfig config_;
+  hal::Clock& clock_;
+  int fd_ = -1;
+  Axis axes_[2];  // left, right
+  hal::BaseHealth health_ = hal::BaseHealth::kStopped;
+  std::uint64_t startup_deadline_us_ = 0;
+  std::uint64_t next_state_send_us_ = 0;
+  codec::WheelTurns setpoint_turns_s_{};
+  codec::DiffDriveOdometry integrator_;
+  hal::Odometry odometry_{};
+  bool bus_off_ = false;
+  std::uint32_t rejected_frames_ = 0;
+  std::uint32_t error_frames_ = 0;
+  std::uint32_t sent_frames_ = 0;
+  std::uint32_t send_failures_ = 0;
+  char error_[160] = "not initialised";
+};
+
+}  // namespace boticelli::hal_linux

@@ -1,0 +1,88 @@
+// OdriveCanEmulator: two ODrive axes on the far end of a fake CAN bus (a SOCK_SEQPACKET
+// socketpair).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hal/codec/odrive_can_codec.h"
+
+namespace boticelli::fakes {
+
+struct OdriveCanEmulatorConfig {
+  std::uint8_t node_ids[2] = {0, 1};
+  std::uint64_t heartbeat_period_us = 100000;  // the ODrive default is 100 ms
+  std::uint64_t encoder_period_us = 10000;     // cyclic Get_Encoder_Estimates (0 = only on RTR)
+  std::uint64_t closed_loop_delay_us = 50000;  // time from Set_Axis_State to closed loop
+  std::uint64_t watchdog_timeout_us = 0;       // ODrive axis watchdog (0 = disabled)
+};
+
+// service(now) reads what the driver sent, integrates each axis's position from its velocity
+// setpoint (exactly, as a perfect velocity controller) and sends heartbeats and encoder
+// estimates on time. The test can silence heartbeats, inject axis errors, bus-off error
+// frames and malformed frames.
+class OdriveCanEmulator {
+ public:
+  static constexpr std::uint32_t kErrorWatchdogExpired =
+      0x00000800;                                                    // 0.5.x WATCHDOG_TIMER_EXPIRED
+  static constexpr std::uint32_t kErrorEstopRequested = 0x00004000;  // 0.5.x ESTOP_REQUESTED
+
+  explicit OdriveCanEmulator(const OdriveCanEmulatorConfig& config = {});
+  ~OdriveCanEmulator();
+  OdriveCanEmulator(const OdriveCanEmulator&) = delete;
+  OdriveCanEmulator& operator=(const OdriveCanEmulator&) = delete;
+
+  // Creates the bus; driver_fd() is handed to the driver (which then owns it).
+  bool open();
+  int driver_fd() const { return driver_fd_; }
+  void service(std::uint64_t now_us);
+
+  // Fault injection.
+  void silence_heartbeats(int axis, bool silent) { axes_[axis].silent = silent; }
+  void set_axis_error(int axis, std::uint32_t error);
+  void send_bus_off();
+  void send_frame(const codec::odrive::CanFrame& frame);
+  void send_bytes(const void* data, std::size_t size);  // arbitrary (malformed) datagram
+
+  // Inspection.
+  std::uint8_t axis_state(int axis) const { return axes_[axis].state; }
+  std::uint32_t axis_error(int axis) const { return axes_[axis].error; }
+  float vel_setpoint(int axis) const { return axes_[axis].vel_setpoint; }
+  double pos_turns(int axis) const { return axes_[axis].pos; }
+  std::uint32_t control_mode(int axis) const { return axes_[axis].control_mode; }
+  std::uint32_t input_mode(int axis) const { return axes_[axis].input_mode; }
+  std::uint32_t count(int axis, codec::odrive::Command c) const;
+  std::uint32_t estops(int axis) const { return count(axis, codec::odrive::Command::kEstop); }
+  std::uint32_t undecodable_frames() const { return undecodable_; }
+
+ private:
+  struct AxisSim {
+    std::uint8_t node = 0;
+    std::uint8_t state = 1;  // idle
+    std::uint32_t error = 0;
+    std::uint32_t control_mode = 0;
+    std::uint32_t input_mode = 0;
+    float vel_setpoint = 0.0F;
+    double pos = 0.0;
+    bool silent = false;
+    bool closed_loop_pending = false;
+    std::uint64_t closed_loop_at_us = 0;
+    std::uint64_t last_input_us = 0;
+    std::uint64_t next_heartbeat_us = 0;
+    std::uint64_t next_encoder_us = 0;
+    std::vector<std::uint32_t> counts = std::vector<std::uint32_t>(32, 0);
+  };
+  void handle(const codec::odrive::CanFrame& f, std::uint64_t now_us);
+  void send_heartbeat(AxisSim& a);
+  void send_encoder(AxisSim& a);
+
+  OdriveCanEmulatorConfig config_;
+  int fd_ = -1;
+  int driver_fd_ = -1;
+  AxisSim axes_[2];
+  std::uint64_t last_us_ = 0;
+  bool have_time_ = false;
+  std::uint32_t undecodable_ = 0;
+};
+
+}  // namespace boticelli::fakes

@@ -1,0 +1,291 @@
+// Tests of BaseOdriveCan against two emulated ODrive axes on a fake CAN bus (socketpair).
+#include <linux/can.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <numbers>
+#include <string>
+
+#include "fake_clock.h"
+#include "hal/linux/base_odrive_can.h"
+#include "odrive_can_emulator.h"
+
+#include "CppUTest/TestHarness.h"
+#include "alloc_guard.h"
+
+using boticelli::fakes::FakeClock;
+using boticelli::fakes::OdriveCanEmulator;
+using boticelli::fakes::OdriveCanEmulatorConfig;
+using boticelli::hal::BaseHealth;
+using boticelli::hal_linux::BaseOdriveCan;
+using boticelli::hal_linux::BaseOdriveCanConfig;
+namespace od = boticelli::codec::odrive;
+
+namespace {
+
+constexpr int kLeft = 0;
+constexpr int kRight = 1;
+
+// One cycle = driver update, emulator service, 10 ms of fake time (a 100 Hz executive).
+// The socketpair delivers at once, so the whole rig is deterministic.
+struct Rig {
+  explicit Rig(const OdriveCanEmulatorConfig& ec = {}, BaseOdriveCanConfig bc = config())
+      : emu(ec), clock(5000000) {
+    CHECK_TRUE(emu.open());
+    bc.socket_fd = emu.driver_fd();
+    base = std::make_unique<BaseOdriveCan>(bc, clock);
+  }
+  static BaseOdriveCanConfig config() {
+    BaseOdriveCanConfig c;
+    c.left_node_id = 3;
+    c.right_node_id = 4;
+    c.geometry = {0.1F, 0.5F, 1.0F, -1.0F};
+    c.heartbeat_timeout_ms = 300;
+    c.startup_timeout_ms = 1000;
+    return c;
+  }
+  static OdriveCanEmulatorConfig emu_config() {
+    OdriveCanEmulatorConfig c;
+    c.node_ids[0] = 3;
+    c.node_ids[1] = 4;
+    return c;
+  }
+  void cycle() {
+    base->update();
+    emu.service(clock.peek_us());
+    clock.advance_us(10000);
+  }
+  bool run_until(const std::function<bool()>& done, int max_cycles = 1000) {
+    for (int i = 0; i < max_cycles; ++i) {
+      if (done()) return true;
+      cycle();
+    }
+    return done();
+  }
+  bool start() {
+    emu.service(clock.peek_us());
+    if (!base->init()) return false;
+    return run_until([&] { return base->health() == BaseHealth::kReady; });
+  }
+  OdriveCanEmulator emu;
+  FakeClock clock;
+  std::unique_ptr<BaseOdriveCan> base;
+};
+
+}  // namespace
+
+TEST_GROUP(BaseOdriveCan){};
+
+TEST(BaseOdriveCan, StartUpPutsBothAxesInClosedLoopVelocityControl) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.base->init());
+  CHECK(rig.base->health() == BaseHealth::kStarting);
+  CHECK_TRUE_TEXT(rig.run_until([&] { return rig.base->health() == BaseHealth::kReady; }),
+                  rig.base->error());
+  for (int axis : {kLeft, kRight}) {
+    CHECK_EQUAL(8, rig.emu.axis_state(axis));
+    CHECK_EQUAL(2U, rig.emu.control_mode(axis));
+    CHECK_EQUAL(1U, rig.emu.input_mode(axis));
+    CHECK(rig.emu.count(axis, od::Command::kClearErrors) >= 1U);
+  }
+  STRCMP_EQUAL("", rig.base->error());
+}
+
+TEST(BaseOdriveCan, VelocityCommandsBecomeWheelTurnsPerSecond) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.4F);
+  rig.cycle();
+  rig.cycle();
+  // v_l = 0.5 − 0.4·0.25 = 0.4 m/s, v_r = 0.6 m/s; r = 0.1 m; right motor mirrored.
+  const double per_turn = 2.0 * std::numbers::pi * 0.1;
+  DOUBLES_EQUAL(0.4 / per_turn, rig.emu.vel_setpoint(kLeft), 1e-5);
+  DOUBLES_EQUAL(-0.6 / per_turn, rig.emu.vel_setpoint(kRight), 1e-5);
+}
+
+TEST(BaseOdriveCan, SetpointsAreClampedKeepingTheCurvature) {
+  BaseOdriveCanConfig bc = Rig::config();
+  bc.max_wheel_turns_s = 1.0F;
+  Rig rig(Rig::emu_config(), bc);
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(10.0F, 10.0F);  // far beyond 1 turn/s
+  rig.cycle();
+  rig.cycle();
+  const float l = rig.emu.vel_setpoint(kLeft);
+  const float r = rig.emu.vel_setpoint(kRight);
+  DOUBLES_EQUAL(1.0, std::max(std::fabs(l), std::fabs(r)), 1e-5);
+  // v_l : v_r = (10 − 2.5) : (10 + 2.5)
+  DOUBLES_EQUAL(7.5 / 12.5, std::fabs(l / r), 1e-4);
+}
+
+TEST(BaseOdriveCan, TheSetpointIsResentEveryCycleSoTheOdriveWatchdogStaysFed) {
+  OdriveCanEmulatorConfig ec = Rig::emu_config();
+  ec.watchdog_timeout_us = 50000;  // 5 cycles without a setpoint trips it
+  Rig rig(ec);
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.2F, 0.0F);
+  const std::uint32_t before = rig.emu.count(kLeft, od::Command::kSetInputVel);
+  for (int i = 0; i < 300; ++i) rig.cycle();  // 3 s
+  CHECK_EQUAL(before + 300U, rig.emu.count(kLeft, od::Command::kSetInputVel));
+  CHECK_EQUAL(0U, rig.emu.axis_error(kLeft));
+  CHECK(rig.base->health() == BaseHealth::kReady);
+}
+
+TEST(BaseOdriveCan, OdometryFollowsTheEncoderEstimates) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 200; ++i) rig.cycle();  // 2 s at 0.5 m/s
+  const auto odo = rig.base->odometry();
+  DOUBLES_EQUAL(1.0, odo.x_m, 0.02);  // one cycle of latency at most
+  DOUBLES_EQUAL(0.0, odo.y_m, 1e-6);
+  DOUBLES_EQUAL(0.5, odo.v_m_s, 1e-4);
+  DOUBLES_EQUAL(0.0, odo.omega_rad_s, 1e-4);
+  CHECK(odo.timestamp_us > 5000000U);
+  rig.base->set_velocity(0.0F, 0.5F);  // a quarter turn in place: π s
+  for (int i = 0; i < 314; ++i) rig.cycle();
+  DOUBLES_EQUAL(std::numbers::pi / 2, rig.base->odometry().yaw_rad, 0.02);
+  DOUBLES_EQUAL(1.0, rig.base->odometry().x_m, 0.03);
+}
+
+TEST(BaseOdriveCan, EncoderRequestsAreSentWhenConfigured) {
+  OdriveCanEmulatorConfig ec = Rig::emu_config();
+  ec.encoder_period_us = 0;  // the ODrives only answer requests
+  BaseOdriveCanConfig bc = Rig::config();
+  bc.request_encoder = true;
+  Rig rig(ec, bc);
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 100; ++i) rig.cycle();
+  CHECK(rig.emu.count(kRight, od::Command::kGetEncoderEstimates) >= 99U);
+  DOUBLES_EQUAL(0.5, rig.base->odometry().x_m, 0.02);
+}
+
+TEST(BaseOdriveCan, ALostHeartbeatStopsTheBaseAndSaysWhich) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.3F, 0.0F);
+  rig.cycle();
+  rig.emu.silence_heartbeats(kRight, true);
+  const std::uint64_t t0 = rig.clock.peek_us();
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }));
+  CHECK(rig.clock.peek_us() - t0 >= 200000U);  // not before the timeout (300 ms after the last)
+  STRCMP_CONTAINS("right axis: heartbeat lost", rig.base->error());
+  rig.cycle();
+  CHECK(rig.emu.estops(kLeft) >= 1U);
+  CHECK_EQUAL(0.0F, rig.emu.vel_setpoint(kLeft));
+  // Commands are ignored while stopped.
+  rig.base->set_velocity(1.0F, 0.0F);
+  rig.cycle();
+  CHECK_EQUAL(0.0F, rig.emu.vel_setpoint(kLeft));
+}
+
+TEST(BaseOdriveCan, ABusOffErrorFrameStopsTheBase) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.3F, 0.0F);
+  rig.cycle();
+  rig.emu.send_bus_off();
+  rig.cycle();
+  CHECK(rig.base->health() == BaseHealth::kStopped);
+  STRCMP_CONTAINS("bus-off", rig.base->error());
+  CHECK_EQUAL(1U, rig.base->error_frames());
+}
+
+TEST(BaseOdriveCan, AnAxisErrorStopsTheBaseWithTheErrorCode) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.emu.set_axis_error(kLeft, 0x40);
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }));
+  STRCMP_CONTAINS("left axis", rig.base->error());
+  STRCMP_CONTAINS("0x00000040", rig.base->error());
+}
+
+TEST(BaseOdriveCan, StopIsImmediateAndResumeRunsTheStartUpAgain) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.3F, 0.0F);
+  rig.cycle();
+  rig.base->stop();
+  CHECK(rig.base->health() == BaseHealth::kStopped);
+  rig.cycle();
+  CHECK_EQUAL(1U, rig.emu.estops(kLeft));
+  CHECK_EQUAL(1U, rig.emu.estops(kRight));
+  CHECK_EQUAL(1, rig.emu.axis_state(kLeft));  // the ODrive disarmed
+  CHECK_TRUE(rig.base->resume());
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kReady; }));
+  CHECK_EQUAL(0U, rig.emu.axis_error(kLeft));      // Clear_Errors cleared the estop error
+  CHECK_EQUAL(0.0F, rig.emu.vel_setpoint(kLeft));  // the old setpoint was not kept
+}
+
+TEST(BaseOdriveCan, AStartUpWithoutOdrivesTimesOut) {
+  Rig rig(Rig::emu_config());
+  rig.emu.silence_heartbeats(kLeft, true);
+  CHECK_TRUE(rig.base->init());
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }));
+  STRCMP_CONTAINS("left axis: no heartbeat during start-up", rig.base->error());
+  CHECK(rig.emu.count(kLeft, od::Command::kSetAxisState) >= 3U);  // re-sent while waiting
+}
+
+TEST(BaseOdriveCan, MalformedFramesAreCountedAndChangeNothing) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 20; ++i) rig.cycle();
+  const auto before = rig.base->odometry();
+  const std::uint32_t rejected = rig.base->rejected_frames();
+  od::CanFrame f = od::encode_encoder_estimates(3, {1000.0F, 50.0F});
+  f.dlc = 4;  // wrong length
+  rig.emu.send_frame(f);
+  f = od::encode_encoder_estimates(3, {std::nanf(""), 0.0F});  // NaN
+  rig.emu.send_frame(f);
+  f = od::encode_encoder_estimates(9, {1000.0F, 50.0F});  // another node
+  rig.emu.send_frame(f);
+  f.id = od::make_id(3, od::Command{0x1E});  // unknown command
+  rig.emu.send_frame(f);
+  f = od::encode_heartbeat(4, {0xFFFF, 1, 0, false});
+  f.extended = true;  // extended id
+  rig.emu.send_frame(f);
+  const std::uint8_t junk[5] = {1, 2, 3, 4, 5};
+  rig.emu.send_bytes(junk, sizeof junk);  // truncated datagram
+  rig.base->update();
+  CHECK_EQUAL(rejected + 6U, rig.base->rejected_frames());
+  CHECK(rig.base->health() == BaseHealth::kReady);
+  DOUBLES_EQUAL(before.x_m, rig.base->odometry().x_m, 0.02);
+}
+
+TEST(BaseOdriveCan, BadGeometryIsRefusedAtInit) {
+  BaseOdriveCanConfig bc = Rig::config();
+  bc.geometry.wheel_radius_m = 0.0F;
+  Rig rig(Rig::emu_config(), bc);
+  CHECK_FALSE(rig.base->init());
+  STRCMP_CONTAINS("bad configuration", rig.base->error());
+  ::close(rig.emu.driver_fd());  // not taken over by the driver
+}
+
+TEST(BaseOdriveCan, AMissingInterfaceIsAClearError) {
+  BaseOdriveCanConfig bc = Rig::config();
+  bc.interface = "nosuchcan7";
+  FakeClock clock;
+  BaseOdriveCan base(bc, clock);
+  CHECK_FALSE(base.init());
+  // Without CAN support in the kernel the socket itself fails; with it, the interface lookup.
+  CHECK(std::string(base.error()).find("CAN") != std::string::npos);
+}
+
+TEST(BaseOdriveCan, TheCyclicCallsDoNotAllocate) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  for (int i = 0; i < 100; ++i) {
+    CHECK_NO_ALLOCATION(rig.base->set_velocity(0.2F, 0.1F));
+    CHECK_NO_ALLOCATION(rig.base->update());
+    CHECK_NO_ALLOCATION((void)rig.base->odometry());
+    rig.emu.service(rig.clock.peek_us());
+    rig.clock.advance_us(10000);
+  }
+  CHECK(rig.base->health() == BaseHealth::kReady);
+  CHECK_NO_ALLOCATION(rig.base->stop());
+}
