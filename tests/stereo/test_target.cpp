@@ -65,7 +65,8 @@ TEST(Target, CornerIsFoundFromHalfAMetreToFourMetres) {
     test::Patch paper =
         test::facing_wall(pose.centre_m, forward, distance, 0.15F, test::Surface::kTarget, 1);
     // On the optical axis (the camera may be tilted), shifted within the view.
-    paper.centre_m = pose.centre_m + distance * forward + rng.range(-0.2F, 0.2F) * distance * paper.right +
+    paper.centre_m = pose.centre_m + distance * forward +
+                     rng.range(-0.2F, 0.2F) * distance * paper.right +
                      rng.range(-0.1F, 0.1F) * distance * paper.up;
     scene.add(paper);
     const image::TargetDetection d = render_and_detect(rig, pose, scene, 77);

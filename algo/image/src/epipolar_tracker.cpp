@@ -141,19 +141,17 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
   }
   const int bu = row_best_u[static_cast<std::size_t>(best_row)];
   const int bv = row_far + best_row * step;
-  float du = 0.0F;
   float dv = 0.0F;
   if (window_fits(second, bu, bv - 1) && window_fits(second, bu, bv + 1)) {
     dv = parabola_offset(error_against(feature, second, bu, bv - 1), best_e,
                          error_against(feature, second, bu, bv + 1));
   }
-  if (window_fits(second, bu - 1, bv) && window_fits(second, bu + 1, bv)) {
-    du = parabola_offset(error_against(feature, second, bu - 1, bv), best_e,
-                         error_against(feature, second, bu + 1, bv));
-  }
+  // The column follows the epipolar line at the refined row (a separate horizontal
+  // parabola would be biased by oblique texture at the integer row).
+  const float v_sub = static_cast<float>(bv) + dv;
   track.found = true;
-  track.u_px = static_cast<float>(bu) + du;
-  track.v_px = static_cast<float>(bv) + dv;
+  track.u_px = segment.far_u_px + slope * (v_sub - segment.far_v_px);
+  track.v_px = v_sub;
   return track;
 }
 

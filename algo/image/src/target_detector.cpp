@@ -133,13 +133,15 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
       }
       const int cr = int{frame.chroma_v[i]} - 128;
       darkest_cr = std::min(darkest_cr, cr);
-      if (labels_[i - 1] == label && labels_[i + 1] == label && labels_[i - w] == label && labels_[i + w] == label) {
+      if (labels_[i - 1] == label && labels_[i + 1] == label && labels_[i - w] == label &&
+          labels_[i + w] == label) {
         interior_cr += cr;
         ++interior;
       }
     }
   }
-  const double reference_cr = interior > 0 ? interior_cr / interior : static_cast<double>(darkest_cr);
+  const double reference_cr =
+      interior > 0 ? interior_cr / interior : static_cast<double>(darkest_cr);
   if (!(reference_cr < 0.0)) {
     return out;
   }

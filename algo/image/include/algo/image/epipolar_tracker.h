@@ -41,7 +41,8 @@ struct Track {
 
 // Searches along the segment, row by row (the motion is close to vertical: |K| ≤ 0.03,
 // App. A), in a band around the line i' = K·j' + B, keeps the best match below E_thresh and
-// refines it to sub-pixel by a parabola through E at the neighbouring rows (and columns).
+// refines its row to sub-pixel by a parabola through E at the neighbouring rows; the
+// column is the line's at that row.
 Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
                     const LowResFrame& second, const EpipolarSegment& segment,
                     const TrackParams& params);
