@@ -75,10 +75,19 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   g_state.clear();
   g_state.seed = options.seed;
   if (options.resume) {
+    // Nothing saved yet (first start of a service that always passes --resume): a new
+    // mission. A file that is there but corrupt is never loaded and stops the start.
     const LoadResult loaded = g_store.load(g_state, error, sizeof error);
-    if (loaded != LoadResult::kLoaded) return fail("cannot resume", error);
-    std::fprintf(stderr, "boticelli: resumed from %s at cycle %llu\n", g_store.path(),
-                 static_cast<unsigned long long>(g_state.cycle));
+    if (loaded == LoadResult::kMissing) {
+      g_state.clear();
+      g_state.seed = options.seed;
+      std::fprintf(stderr, "boticelli: %s: starting a new mission\n", error);
+    } else if (loaded != LoadResult::kLoaded) {
+      return fail("cannot resume", error);
+    } else {
+      std::fprintf(stderr, "boticelli: resumed from %s at cycle %llu\n", g_store.path(),
+                   static_cast<unsigned long long>(g_state.cycle));
+    }
   }
 
   // Devices.

@@ -185,6 +185,13 @@ TEST(FirmwareMain, SavesEachCycleAndResumesFromTheStateDirectory) {
   CHECK_EQUAL(6U, state.log.size());
 }
 
+TEST(FirmwareMain, StartsANewMissionWhenThereIsNothingToResume) {
+  const Run r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("starting a new mission", r.err.c_str());
+  STRCMP_CONTAINS("MISSION result=aborted cycles=1", last_line(r.out).c_str());
+}
+
 TEST(FirmwareMain, RefusesToResumeFromACorruptState) {
   FILE* f = std::fopen((dir + "/mission.state").c_str(), "wb");
   std::fputs("BOTICELLI-STATE 1\ncycle 3\n", f);
