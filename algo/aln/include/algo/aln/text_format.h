@@ -412,6 +412,7 @@ bool read_text(const char* text, std::size_t length, Aln<Scalar, N, MaxPieces>& 
   };
   std::array<Frame, MaxPieces> stack{};
   std::array<typename Model::Node, Model::kMaxNodes> nodes{};
+  std::array<bool, MaxPieces> used{};
   std::size_t node_count = 0;
   std::size_t top = 0;
   int root = -1;
@@ -451,6 +452,8 @@ bool read_text(const char* text, std::size_t length, Aln<Scalar, N, MaxPieces>& 
     if (tok.kind != Tok::kNumber) return fail("expected MIN, MAX or a form's index");
     if (!count(piece, MaxPieces, "expected a form's index")) return false;
     if (piece >= forms) return fail("no linear form with this index");
+    if (used[piece]) return fail("linear form used twice in the block");
+    used[piece] = true;
     const int leaf = add({NodeKind::kPiece, static_cast<std::uint16_t>(piece), 0});
     if (leaf < 0) return fail("too many nodes");
     if (!deliver(leaf)) return false;
