@@ -137,19 +137,30 @@ TEST(RaySamples, ZeroPadsStayInTheirRegionAndRepeatForTheSameSeed) {
   DOUBLES_EQUAL(samples[57].r_m, again[57].r_m, 0.0);
 }
 
-TEST(RaySamples, FeaturelessPadsGoOnlyWhereNoReadingWasSeen) {
-  // Readings cover α ∈ [0, π) only; the other half is featureless.
+TEST(RaySamples, FeaturelessPadsGoOnlyInDirectionsWithoutReadings) {
+  // Readings cover α ∈ [0, π) at elevations within ±0.3 rad; the rest is featureless.
   core::FixedVector<Reading, 64> readings;
   for (int i = 0; i < 64; ++i) {
     const float a = 3.1F * static_cast<float>(i) / 64.0F;
-    (void)readings.push_back({a, -0.9F + 1.8F * static_cast<float>(i % 8) / 8.0F, 2.0F, 0.9F});
+    const float el = -0.25F + 0.5F * static_cast<float>(i % 8) / 8.0F;
+    (void)readings.push_back({a, 2.0F * std::sin(el), 2.0F, 0.9F});
   }
-  PadRegion region{};
-  FeaturelessPadParams pads{8, 1, 5};
+  PadRegion region{};  // α ∈ [0, 2π), h ∈ [−1, 1] m, r ∈ [0, 4.5] m
+  FeaturelessPadParams pads;
+  pads.alpha_bins = 8;
+  pads.elevation_bins = 4;
+  pads.elevation_min_rad = -0.6F;
+  pads.elevation_max_rad = 0.6F;
+  pads.pads_per_empty_cell = 5;
   PadRandom random{7U};
   const std::size_t added = append_featureless_pads(readings.span(), region, pads, random, samples);
-  LONGS_EQUAL(4 * 5, added);
+  // Seen: α bins 0..3 x elevation bins 1, 2 (|el| < 0.3). Empty: 32 − 8 cells.
+  LONGS_EQUAL(24 * 5, added);
   for (const RaySample& s : samples) {
-    CHECK(s.alpha_rad >= core::kPi<float> - 1e-4F);
+    const float el = std::asin(s.h_m / s.r_m);
+    const bool seen_dir = s.alpha_rad < core::kPi<float> && std::fabs(el) < 0.3F;
+    CHECK_FALSE(seen_dir);
+    CHECK(s.h_m >= -1.0F - 1e-5F && s.h_m <= 1.0F + 1e-5F);  // never below the floor
+    DOUBLES_EQUAL(0.0, s.occupancy, 1e-12);
   }
 }

@@ -46,7 +46,28 @@ struct Quality {
   double false_free = 0.0;  // share of test points called free that are not (unsafe)
   double false_occupied = 0.0;
   std::size_t points = 0;
+  // The same over the "clear" test points only: those outside the sensor model's own
+  // uncertainty band [r_s − 3δr, r_s + δr] (δr = 0.1 r_s) around the first surface r_s on
+  // the point's line of sight, where even a perfect fit of the ray samples is in between.
+  double correct_clear = 0.0;
+  double false_free_clear = 0.0;
+  double clear_share = 0.0;
 };
+
+// True if p lies outside the sensor model's band around the first surface along its ray.
+bool clear_of_surfaces(const SyntheticRoom& room, const Vec3& p) {
+  const Vec3 s = room.sensor();
+  const Vec3 d{p.x - s.x, p.y - s.y, p.z - s.z};
+  const double dist = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+  if (dist < 1e-9) {
+    return true;
+  }
+  const SyntheticRoom::Hit hit = room.cast_from_sensor({d.x / dist, d.y / dist, d.z / dist});
+  if (!std::isfinite(hit.distance_m)) {
+    return true;
+  }
+  return dist < 0.7 * hit.distance_m || dist > 1.1 * hit.distance_m;
+}
 
 // Classifies every test point of the room's bounding box with `is_free`.
 template <typename IsFree>
@@ -56,6 +77,9 @@ Quality classify(const SyntheticRoom& room, IsFree&& is_free) {
   std::size_t correct = 0;
   std::size_t false_free = 0;
   std::size_t false_occ = 0;
+  std::size_t clear = 0;
+  std::size_t clear_correct = 0;
+  std::size_t clear_false_free = 0;
   const auto steps = [](double lo, double hi) {
     return static_cast<int>(std::floor((hi - lo) / kTestSpacingM + 1e-9));
   };
@@ -69,6 +93,11 @@ Quality classify(const SyntheticRoom& room, IsFree&& is_free) {
                      b.min.z + (iz + 0.5) * kTestSpacingM};
         const bool truth = room.visible_free(p);
         const bool said = is_free(p);
+        if (clear_of_surfaces(room, p)) {
+          ++clear;
+          clear_correct += truth == said ? 1U : 0U;
+          clear_false_free += (said && !truth) ? 1U : 0U;
+        }
         if (truth == said) {
           ++correct;
         } else if (said) {
@@ -84,7 +113,16 @@ Quality classify(const SyntheticRoom& room, IsFree&& is_free) {
   q.correct = static_cast<double>(correct) / n;
   q.false_free = static_cast<double>(false_free) / n;
   q.false_occupied = static_cast<double>(false_occ) / n;
+  const double nc = static_cast<double>(clear > 0 ? clear : 1);
+  q.correct_clear = static_cast<double>(clear_correct) / nc;
+  q.false_free_clear = static_cast<double>(clear_false_free) / nc;
+  q.clear_share = static_cast<double>(clear) / n;
   return q;
+}
+
+std::size_t env_size(const char* name, std::size_t fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr && *v != '\0' ? std::strtoul(v, nullptr, 10) : fallback;
 }
 
 void configure_model(Model& model, const SyntheticRoom& room) {
@@ -95,7 +133,8 @@ void configure_model(Model& model, const SyntheticRoom& room) {
   model.set_input_range(2, 0.0F, static_cast<float>(room.spec().max_range_m * 1.2));
   model.set_output_range(0.0F, 1.0F);
   // Eq 4.28: |∂F/∂α| < 1 per rad; |∂F/∂h| < 1 per dm = 10 per m (units.h).
-  model.set_weight_bounds(0, -1.0F, 1.0F);
+  const float a_bound = static_cast<float>(env_size("BOTICELLI_THESIS_ABOUND", 1));
+  model.set_weight_bounds(0, -a_bound, a_bound);
   model.set_weight_bounds(1, -10.0F, 10.0F);
   // Eq 4.27: c_l > 0 (monotone in r), a small positive lower bound; no upper bound.
   model.set_weight_bounds(2, 1e-4F, std::numeric_limits<float>::infinity());
@@ -104,9 +143,41 @@ void configure_model(Model& model, const SyntheticRoom& room) {
 struct RunSpec {
   aln::SplitRule rule;
   aln::RobustWeighting robust;
+  bool pads;
   const char* rule_name;
   const char* robust_name;
 };
+
+// Ray samples: 5 per feature (Fig 4.2b), optionally zero pads in featureless directions
+// (§4.9.1), then the seam copies (§4.9.1); converted to the ALN's sample type.
+std::vector<AlnSample> build_samples(const SyntheticRoom& room,
+                                     const std::vector<evidence::Reading>& readings, bool pads,
+                                     std::size_t* pad_count) {
+  g_ray_samples.clear();
+  const evidence::RaySampleParams params;
+  (void)evidence::append_ray_samples(readings, params, evidence::OccupancyBound::kPlausibility,
+                                     g_ray_samples);
+  *pad_count = 0;
+  if (pads) {
+    evidence::PadRegion region;
+    region.h_min_m = static_cast<float>(-room.sensor().z);
+    region.h_max_m = static_cast<float>(room.spec().wall_height_m - room.sensor().z);
+    region.r_min_m = 0.0F;
+    region.r_max_m = static_cast<float>(room.spec().max_range_m);
+    const evidence::FeaturelessPadParams pad_params;
+    evidence::PadRandom random{12345U};
+    *pad_count =
+        evidence::append_featureless_pads(readings, region, pad_params, random, g_ray_samples);
+  }
+  (void)evidence::append_seam_copies(g_ray_samples, kSeamMarginRad);
+  std::vector<AlnSample> samples(g_ray_samples.size());
+  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
+    const evidence::RaySample& s = g_ray_samples[i];
+    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
+    samples[i].y = s.occupancy;
+  }
+  return samples;
+}
 
 int parse_feature_list(std::size_t* out, int max) {
   const char* env = std::getenv("BOTICELLI_THESIS_FEATURES");
@@ -141,19 +212,6 @@ int run_thesis_table() {
       const std::size_t features = feature_counts[fc];
       const std::vector<evidence::Reading> readings = room.generate_readings(features, 2000U);
 
-      // Ray samples: 5 per feature (Fig 4.2b) plus the seam copies (§4.9.1).
-      g_ray_samples.clear();
-      evidence::RaySampleParams params;
-      (void)evidence::append_ray_samples(readings, params, evidence::OccupancyBound::kPlausibility,
-                                         g_ray_samples);
-      (void)evidence::append_seam_copies(g_ray_samples, kSeamMarginRad);
-      std::vector<AlnSample> samples(g_ray_samples.size());
-      for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
-        const evidence::RaySample& s = g_ray_samples[i];
-        samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
-        samples[i].y = s.occupancy;
-      }
-
       // Grid baseline at 0.1 m on the same readings.
       const Bounds3 b = room.bounds();
       g_grid.set_box(
@@ -174,21 +232,31 @@ int run_thesis_table() {
             {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
       });
 
-      RunSpec runs[4] = {
-          {aln::SplitRule::kPieceRms, aln::RobustWeighting::kNone, "piece_rms", "none"},
-          {aln::SplitRule::kOverallRms, aln::RobustWeighting::kNone, "overall_rms", "none"},
-          {aln::SplitRule::kPieceRms, aln::RobustWeighting::kTukey, "piece_rms", "tukey"},
-          {aln::SplitRule::kOverallRms, aln::RobustWeighting::kTukey, "overall_rms", "tukey"},
+      // The thesis's setting first (no pads, plain least squares), then what robust
+      // weights change on the outlier rows, then the featureless pads for classification.
+      const RunSpec runs[] = {
+          {aln::SplitRule::kPieceRms, aln::RobustWeighting::kNone, false, "piece_rms", "none"},
+          {aln::SplitRule::kOverallRms, aln::RobustWeighting::kNone, false, "overall_rms", "none"},
+          {aln::SplitRule::kPieceRms, aln::RobustWeighting::kTukey, false, "piece_rms", "tukey"},
+          {aln::SplitRule::kOverallRms, aln::RobustWeighting::kTukey, false, "overall_rms",
+           "tukey"},
+          {aln::SplitRule::kPieceRms, aln::RobustWeighting::kNone, true, "piece_rms", "none"},
+          {aln::SplitRule::kOverallRms, aln::RobustWeighting::kNone, true, "overall_rms", "none"},
       };
-      const int n_runs = spec.outlier_fraction > 0.0 ? 4 : 2;
-      for (int k = 0; k < n_runs; ++k) {
+      for (const RunSpec& run : runs) {
+        if (run.robust != aln::RobustWeighting::kNone && !(spec.outlier_fraction > 0.0)) {
+          continue;
+        }
+        std::size_t pad_count = 0;
+        const std::vector<AlnSample> samples = build_samples(room, readings, run.pads, &pad_count);
         configure_model(g_model, room);
         aln::TrainerConfig cfg;
         cfg.epsilon = kEpsilon;
-        cfg.max_iterations = 10;
+        cfg.max_iterations = env_size("BOTICELLI_THESIS_ITERATIONS", 10);
+        cfg.max_refit_passes = env_size("BOTICELLI_THESIS_PASSES", 8);
         cfg.max_pieces = kMaxPieces;
-        cfg.split_rule = runs[k].rule;
-        cfg.robust = runs[k].robust;
+        cfg.split_rule = run.rule;
+        cfg.robust = run.robust;
         g_trainer.configure(cfg);
         const std::int64_t t0 = now_ns();
         (void)g_trainer.train(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model);
@@ -203,8 +271,9 @@ int run_thesis_table() {
             .integer("samples", static_cast<std::int64_t>(samples.size()))
             .num("outliers", spec.outlier_fraction)
             .num("epsilon", kEpsilon)
-            .text("split_rule", runs[k].rule_name)
-            .text("robust", runs[k].robust_name)
+            .text("split_rule", run.rule_name)
+            .text("robust", run.robust_name)
+            .integer("pads", static_cast<std::int64_t>(pad_count))
             .integer("thesis_pieces", spec.thesis_pieces)
             .integer("pieces", static_cast<std::int64_t>(st.pieces))
             .integer("iterations", static_cast<std::int64_t>(st.iterations))
@@ -215,8 +284,12 @@ int run_thesis_table() {
             .integer("test_points", static_cast<std::int64_t>(q.points))
             .num("aln_correct", q.correct)
             .num("aln_false_free", q.false_free)
+            .num("aln_correct_clear", q.correct_clear)
+            .num("aln_false_free_clear", q.false_free_clear)
             .num("grid_correct", grid_q.correct)
             .num("grid_false_free", grid_q.false_free)
+            .num("grid_correct_clear", grid_q.correct_clear)
+            .num("clear_share", q.clear_share)
             .integer("grid_cells", static_cast<std::int64_t>(g_grid.cells()))
             .integer("grid_updates", static_cast<std::int64_t>(grid_updates))
             .num("grid_s", static_cast<double>(g1 - g0) * 1e-9)

@@ -1,6 +1,7 @@
 // Ray samples of the visual sensor model: placement along the ray, seam copies and pads.
 #include "algo/evidence/ray_samples.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -149,38 +150,54 @@ std::size_t append_featureless_pads(std::span<const Reading> readings, const Pad
                                     const FeaturelessPadParams& params, PadRandom& random,
                                     RaySampleBuffer& out) {
   const std::size_t na = params.alpha_bins;
-  const std::size_t nh = params.h_bins;
+  const std::size_t ne = params.elevation_bins;
   const float alpha_span = region.alpha_max_rad - region.alpha_min_rad;
-  const float h_span = region.h_max_m - region.h_min_m;
-  if (na == 0 || nh == 0 || na > kMaxPadBins || nh > kMaxPadBins || !(alpha_span > 0.0F) ||
-      !(h_span > 0.0F)) {
+  const float el_span = params.elevation_max_rad - params.elevation_min_rad;
+  if (na == 0 || ne == 0 || na > kMaxPadBins || ne > kMaxPadBins || !(alpha_span > 0.0F) ||
+      !(el_span > 0.0F) || !(region.r_max_m > region.r_min_m)) {
     return 0;
   }
   std::array<bool, kMaxPadBins * kMaxPadBins> seen{};
   const float naf = static_cast<float>(na);
-  const float nhf = static_cast<float>(nh);
+  const float nef = static_cast<float>(ne);
   for (const Reading& reading : readings) {
-    const float ta = (reading.alpha_rad - region.alpha_min_rad) / alpha_span;
-    const float th = (reading.h_m - region.h_min_m) / h_span;
-    if (ta < 0.0F || ta >= 1.0F || th < 0.0F || th >= 1.0F) {
+    if (!(reading.r_m > 0.0F)) {
       continue;
     }
-    const auto ia = static_cast<std::size_t>(ta * naf);
-    const auto ih = static_cast<std::size_t>(th * nhf);
-    seen[(ia < na ? ia : na - 1) * nh + (ih < nh ? ih : nh - 1)] = true;
+    const float sin_el = std::clamp(reading.h_m / reading.r_m, -1.0F, 1.0F);
+    const float ta = (reading.alpha_rad - region.alpha_min_rad) / alpha_span;
+    const float te = (std::asin(sin_el) - params.elevation_min_rad) / el_span;
+    if (ta < 0.0F || ta >= 1.0F || te < 0.0F || te >= 1.0F) {
+      continue;
+    }
+    const auto ia = std::min(static_cast<std::size_t>(ta * naf), na - 1);
+    const auto ie = std::min(static_cast<std::size_t>(te * nef), ne - 1);
+    seen[ia * ne + ie] = true;
   }
   std::size_t added = 0;
   for (std::size_t ia = 0; ia < na; ++ia) {
-    for (std::size_t ih = 0; ih < nh; ++ih) {
-      if (seen[ia * nh + ih]) {
+    for (std::size_t ie = 0; ie < ne; ++ie) {
+      if (seen[ia * ne + ie]) {
         continue;
       }
       for (std::size_t p = 0; p < params.pads_per_empty_cell; ++p) {
         const float a =
             region.alpha_min_rad + alpha_span * (static_cast<float>(ia) + random.uniform()) / naf;
-        const float h = region.h_min_m + h_span * (static_cast<float>(ih) + random.uniform()) / nhf;
-        const float r = lerp(region.r_min_m, region.r_max_m, random.uniform());
-        if (!out.push_back({a, h, r, 0.0F})) {
+        const float el =
+            params.elevation_min_rad + el_span * (static_cast<float>(ie) + random.uniform()) / nef;
+        const float sin_el = std::sin(el);
+        // The farthest distance whose height stays inside [h_min, h_max].
+        float r_far = region.r_max_m;
+        if (sin_el > 0.0F && region.h_max_m < r_far * sin_el) {
+          r_far = region.h_max_m / sin_el;
+        } else if (sin_el < 0.0F && region.h_min_m > r_far * sin_el) {
+          r_far = region.h_min_m / sin_el;
+        }
+        if (!(r_far > region.r_min_m)) {
+          continue;
+        }
+        const float r = lerp(region.r_min_m, r_far, random.uniform());
+        if (!out.push_back({a, r * sin_el, r, 0.0F})) {
           return added;
         }
         ++added;

@@ -93,14 +93,18 @@ struct PadRegion {
 std::size_t append_zero_pads(const PadRegion& region, std::size_t count, PadRandom& random,
                              RaySampleBuffer& out);
 
-// Pads only where there is nothing to say: the region's α × h is cut into alpha_bins ×
-// h_bins cells and the cells that hold no reading get pads_per_empty_cell zero samples,
-// with r uniform in [r_min, r_max] (a featureless direction is taken as empty up to
-// r_max, which is what the thesis's pads do). Cells with readings keep their ray samples
-// only, so the pads never contradict a feature. Returns the pads appended.
+// Pads only where there is nothing to say (§4.9.1 "lack of features"): the directions of
+// view, pan α in [alpha_min, alpha_max) x elevation asin(h/r) in [elevation_min,
+// elevation_max), are cut into alpha_bins x elevation_bins cells; each cell that holds no
+// reading gets pads_per_empty_cell zero samples on rays of that cell, at distances uniform
+// in [r_min, r_max] but never beyond the height range [h_min, h_max] of the region (e.g.
+// the floor). A featureless direction is taken as empty, which is what the thesis's pads
+// do; cells with readings keep their ray samples only, so pads never contradict a feature.
 struct FeaturelessPadParams {
-  std::size_t alpha_bins = 32;  // ≤ kMaxPadBins
-  std::size_t h_bins = 8;       // ≤ kMaxPadBins
+  std::size_t alpha_bins = 32;      // ≤ kMaxPadBins
+  std::size_t elevation_bins = 16;  // ≤ kMaxPadBins
+  float elevation_min_rad = -1.2F;
+  float elevation_max_rad = 1.2F;
   std::size_t pads_per_empty_cell = 4;
 };
 inline constexpr std::size_t kMaxPadBins = 64;
