@@ -19,7 +19,7 @@ void CameraTask::run(std::uint64_t now_us) {
       break;
     case hal::CameraPoll::kFault:
       ++faults_;
-      healthy_ = false;
+      if (now_us - last_frame_us_ > stall_us_) healthy_ = false;
       break;
     case hal::CameraPoll::kNoFrame:
       if (now_us - last_frame_us_ > stall_us_) healthy_ = false;

@@ -442,3 +442,31 @@ TEST(WatchdogTask, KicksOnlyWhileEveryTaskIsHealthy) {
   for (int i = 0; i < 50; ++i) exec.run_frame();
   CHECK_EQUAL(10, watchdog.kicks);
 }
+
+TEST_GROUP(CameraTask) {
+  FakeCamera camera;
+  CameraTask task{camera, 2000000};
+};
+
+TEST(CameraTask, HandsEachFrameBackAndTurnsUnhealthyOnlyAfterAStall) {
+  class Counter final : public FrameConsumer {
+   public:
+    void on_frame(const boticelli::hal::Frame& f) override { last_sequence = f.sequence; ++frames; }
+    std::uint32_t last_sequence = 0;
+    int frames = 0;
+  } consumer;
+  task.set_consumer(&consumer);
+  std::uint64_t t = 0;
+  for (int i = 0; i < 30; ++i, t += 10000) task.run(t);
+  CHECK_EQUAL(10, consumer.frames);
+  CHECK_EQUAL(10, camera.releases);
+  CHECK(task.healthy());
+  camera.fault = true;  // the driver re-opens the device meanwhile
+  for (; t < 290000 + 1900000; t += 10000) task.run(t);
+  CHECK(task.healthy());
+  for (; t < 290000 + 2200000; t += 10000) task.run(t);
+  CHECK_FALSE(task.healthy());
+  camera.fault = false;
+  for (int i = 0; i < 3; ++i, t += 10000) task.run(t);
+  CHECK(task.healthy());
+}

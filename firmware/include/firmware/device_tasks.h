@@ -58,7 +58,8 @@ class FrameConsumer {
   FrameConsumer& operator=(const FrameConsumer&) = default;
 };
 
-// Polls the camera; unhealthy after a fault or when no frame came for stall_us.
+// Polls the camera; unhealthy when no frame came for stall_us (a fault the driver recovers
+// from quickly, e.g. a re-opened device, does not count against the watchdog).
 class CameraTask final : public Task {
  public:
   explicit CameraTask(hal::Camera& camera, std::uint64_t stall_us = 2000000)
