@@ -16,6 +16,7 @@ help:
 	@echo "make check     build and test the sim preset only (fast iteration)"
 	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
+	@echo "make package-rpi4 / make deploy HOST=user@robot   build the arm64 .deb / install it over ssh"
 	@echo "make format    clang-format every C++ file; make format-check only reports"
 
 deps:
@@ -67,6 +68,16 @@ format:
 	@git ls-files '*.h' '*.hpp' '*.cpp' | xargs clang-format -i
 format-check:
 	@git ls-files '*.h' '*.hpp' '*.cpp' | xargs clang-format --dry-run --Werror
+
+# The rpi4 .deb (CPack, arm64) and its installation on the robot over ssh (docs/flashing.md).
+.PHONY: package-rpi4 deploy
+package-rpi4: rpi4
+	cd build/rpi4 && cpack -G DEB
+deploy: package-rpi4
+	@test -n "$(HOST)" || { echo "usage: make deploy HOST=user@robot" >&2; exit 2; }
+	deb=$$(ls -t build/rpi4/boticelli_*_arm64.deb | head -n1) && \
+	  scp "$$deb" $(HOST):/tmp/ && \
+	  ssh $(HOST) "sudo apt-get install -y --allow-downgrades /tmp/$$(basename $$deb)"
 
 clean:
 	rm -rf build
