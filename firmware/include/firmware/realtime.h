@@ -15,7 +15,7 @@ struct RealtimeConfig {
 struct RealtimeReport {
   bool memory_locked = false;
   bool fifo = false;
-  char message[320] = "";  // one line for the log: what was set up and what was refused, and why
+  char message[512] = "";  // one line for the log: what was set up and what was refused, and why
 };
 
 // Applies what it can; refusals (no CAP_IPC_LOCK / RLIMIT_MEMLOCK, no CAP_SYS_NICE /
