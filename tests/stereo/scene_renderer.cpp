@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 
 namespace boticelli::test {
 
@@ -23,20 +24,41 @@ float unit_hash(std::int32_t x, std::int32_t y, std::uint32_t seed) {
   return static_cast<float>(hash3(x, y, seed) >> 8) * (1.0F / 16777216.0F);
 }
 
+// Random lattice values, built once (lookups are much cheaper than hashing per sample,
+// which matters under emulation and sanitizers).
+constexpr std::int32_t kLattice = 512;
+const std::array<float, kLattice * kLattice>& lattice() {
+  static std::array<float, kLattice * kLattice> table{};
+  static const bool filled = [] {
+    for (std::int32_t y = 0; y < kLattice; ++y) {
+      for (std::int32_t x = 0; x < kLattice; ++x) {
+        table[static_cast<std::size_t>(y * kLattice + x)] = unit_hash(x, y, 0x51ED27U);
+      }
+    }
+    return true;
+  }();
+  (void)filled;
+  return table;
+}
+
 // Smooth value noise in [0, 1] with lattice spacing 1.
 float value_noise(float x, float y, std::uint32_t seed) {
   const float fx = std::floor(x);
   const float fy = std::floor(y);
-  const auto ix = static_cast<std::int32_t>(fx);
-  const auto iy = static_cast<std::int32_t>(fy);
+  const auto ix = static_cast<std::int32_t>(fx) + static_cast<std::int32_t>((seed * 97U) % 509U);
+  const auto iy = static_cast<std::int32_t>(fy) + static_cast<std::int32_t>((seed * 61U) % 503U);
   float tx = x - fx;
   float ty = y - fy;
   tx = tx * tx * (3.0F - 2.0F * tx);
   ty = ty * ty * (3.0F - 2.0F * ty);
-  const float a = unit_hash(ix, iy, seed);
-  const float b = unit_hash(ix + 1, iy, seed);
-  const float c = unit_hash(ix, iy + 1, seed);
-  const float d = unit_hash(ix + 1, iy + 1, seed);
+  const auto& t = lattice();
+  const auto at = [&t](std::int32_t lx, std::int32_t ly) {
+    return t[static_cast<std::size_t>((ly & (kLattice - 1)) * kLattice + (lx & (kLattice - 1)))];
+  };
+  const float a = at(ix, iy);
+  const float b = at(ix + 1, iy);
+  const float c = at(ix, iy + 1);
+  const float d = at(ix + 1, iy + 1);
   return (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
 }
 
@@ -87,7 +109,7 @@ Eigen::Vector3f surface_colour(const Patch& p, float x_m, float y_m) {
 }
 
 std::uint8_t to_byte(float v) {
-  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0F, 255.0F)));
+  return static_cast<std::uint8_t>(std::clamp(v, 0.0F, 255.0F) + 0.5F);
 }
 
 }  // namespace
@@ -138,23 +160,66 @@ Eigen::Vector3f SceneRenderer::shade(const Eigen::Vector3f& origin_m,
 void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::CameraPose& pose,
                                 std::uint8_t* yuyv, std::uint32_t noise_seed,
                                 float noise_sigma) const {
+  // Per-patch constants for this eye, so a pixel costs a few multiplications per patch.
+  struct Prepared {
+    const Patch* patch;
+    Eigen::Vector3f normal;
+    float numerator;  // n·(c − o)
+    float eye_x;      // (o − c)·right
+    float eye_y;      // (o − c)·up
+  };
+  std::array<Prepared, 32> prepared{};
+  std::size_t count = 0;
+  for (const Patch& p : patches_) {
+    if (count == prepared.size()) break;
+    const Eigen::Vector3f normal = p.right.cross(p.up);
+    const Eigen::Vector3f offset = pose.centre_m - p.centre_m;
+    prepared[count++] = {&p, normal, -normal.dot(offset), offset.dot(p.right), offset.dot(p.up)};
+  }
   const stereo::CameraIntrinsics& cam = rig.camera();
+  const bool pinhole = cam.radial_k1 == 0.0F;
   const auto w = static_cast<std::int32_t>(cam.width_px);
   const auto h = static_cast<std::int32_t>(cam.height_px);
   for (std::int32_t v = 0; v < h; ++v) {
     std::uint8_t* row = yuyv + static_cast<std::ptrdiff_t>(v) * w * 2;
+    // Without distortion the (unnormalised) ray is R·(x_n, y_n, 1), linear along a row.
+    const Eigen::Vector3f row_dir =
+        pose.rotation * Eigen::Vector3f(-cam.principal_x_px / cam.focal_px,
+                                        (static_cast<float>(v) - cam.principal_y_px) / cam.focal_px,
+                                        1.0F);
+    const Eigen::Vector3f column_step = pose.rotation.col(0) / cam.focal_px;
     for (std::int32_t u = 0; u < w; u += 2) {
       float ys[2];
       float cb = 0.0F;
       float cr = 0.0F;
       for (std::int32_t k = 0; k < 2; ++k) {
-        const Eigen::Vector2f pixel(static_cast<float>(u + k), static_cast<float>(v));
-        const Eigen::Vector3f rgb =
-            255.0F * shade(pose.centre_m, stereo::RigModel::ray_ptu(pose, cam, pixel));
-        // Noise: sum of three uniforms (variance 3/12 per unit), scaled to noise_sigma.
-        const float n = unit_hash(u + k, v, noise_seed) + unit_hash(u + k, v, noise_seed + 101) +
-                        unit_hash(u + k, v, noise_seed + 202) - 1.5F;
-        ys[k] = 0.299F * rgb.x() + 0.587F * rgb.y() + 0.114F * rgb.z() + 2.0F * noise_sigma * n;
+        const Eigen::Vector3f dir =
+            pinhole
+                ? Eigen::Vector3f(row_dir + static_cast<float>(u + k) * column_step)
+                : stereo::RigModel::ray_ptu(
+                      pose, cam, Eigen::Vector2f(static_cast<float>(u + k), static_cast<float>(v)));
+        Eigen::Vector3f colour = background;
+        float nearest = 0.0F;
+        for (std::size_t i = 0; i < count; ++i) {
+          const Prepared& q = prepared[i];
+          const float denom = q.normal.dot(dir);
+          if (std::fabs(denom) < 1e-9F) continue;
+          const float t = q.numerator / denom;
+          if (!(t > 1e-4F) || (nearest > 0.0F && t >= nearest)) continue;
+          const float x = q.eye_x + t * dir.dot(q.patch->right);
+          const float y = q.eye_y + t * dir.dot(q.patch->up);
+          if (std::fabs(x) > q.patch->half_width_m || std::fabs(y) > q.patch->half_height_m)
+            continue;
+          nearest = t;
+          colour = surface_colour(*q.patch, x, y);
+        }
+        const Eigen::Vector3f rgb = 255.0F * colour;
+        // Noise: sum of two uniforms from one hash (standard deviation 0.408), scaled to
+        // noise_sigma.
+        const std::uint32_t hash = hash3(u + k, v, noise_seed);
+        const float n =
+            static_cast<float>((hash & 0xFFFFU) + (hash >> 16)) * (1.0F / 65536.0F) - 1.0F;
+        ys[k] = 0.299F * rgb.x() + 0.587F * rgb.y() + 0.114F * rgb.z() + 2.449F * noise_sigma * n;
         cb += 0.5F * (-0.168736F * rgb.x() - 0.331264F * rgb.y() + 0.5F * rgb.z());
         cr += 0.5F * (0.5F * rgb.x() - 0.418688F * rgb.y() - 0.081312F * rgb.z());
       }
