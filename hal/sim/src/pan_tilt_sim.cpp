@@ -1,6 +1,7 @@
 // PanTiltSim: command checking and quantisation of the simulated PTU-D46 (motion is in SimWorld).
 #include "hal/sim/pan_tilt_sim.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -36,20 +37,24 @@ bool PanTiltSim::move_to(float pan_rad, float tilt_rad) {
   const float pan = quantise(pan_rad, l.pan_resolution_rad);
   const float tilt = quantise(tilt_rad, l.tilt_resolution_rad);
   // The unit answers "!" to a position beyond its limits and does not move.
-  if (!std::isfinite(pan_rad) || pan < l.pan_min_rad || pan > l.pan_max_rad) {
+  // Compare in whole steps (limits are whole steps), with a hair of tolerance for rounding.
+  const float pan_eps = 1e-3F * l.pan_resolution_rad;
+  const float tilt_eps = 1e-3F * l.tilt_resolution_rad;
+  if (!std::isfinite(pan_rad) || pan < l.pan_min_rad - pan_eps || pan > l.pan_max_rad + pan_eps) {
     std::snprintf(error_, sizeof error_, "! pan %.4f rad outside [%.4f, %.4f]",
                   static_cast<double>(pan_rad), static_cast<double>(l.pan_min_rad),
                   static_cast<double>(l.pan_max_rad));
     return false;
   }
-  if (!std::isfinite(tilt_rad) || tilt < l.tilt_min_rad || tilt > l.tilt_max_rad) {
+  if (!std::isfinite(tilt_rad) || tilt < l.tilt_min_rad - tilt_eps ||
+      tilt > l.tilt_max_rad + tilt_eps) {
     std::snprintf(error_, sizeof error_, "! tilt %.4f rad outside [%.4f, %.4f]",
                   static_cast<double>(tilt_rad), static_cast<double>(l.tilt_min_rad),
                   static_cast<double>(l.tilt_max_rad));
     return false;
   }
-  world_.pan().target_rad = pan;
-  world_.tilt().target_rad = tilt;
+  world_.pan().target_rad = std::clamp(pan, l.pan_min_rad, l.pan_max_rad);
+  world_.tilt().target_rad = std::clamp(tilt, l.tilt_min_rad, l.tilt_max_rad);
   error_[0] = '\0';
   return true;
 }

@@ -381,7 +381,7 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
                 constexpr float kSqrt3 = 1.7320508F;
                 if (b >= -0.5F * circumradius && kSqrt3 * a + b <= circumradius &&
                     -kSqrt3 * a + b <= circumradius) {
-                  albedo = Eigen::Vector3f(0.12F, 0.62F, 0.18F);
+                  albedo = Eigen::Vector3f(0.05F, 0.60F, 0.10F);
                 }
               }
               if (settings_.shading) {
@@ -422,27 +422,33 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
   }
 }
 
-bool Renderer::trace_pixel(const RigidTransform& world_from_camera, std::uint32_t u,
-                           std::uint32_t v, std::size_t& surface, float& depth_m) const {
-  if (u >= width_ || v >= height_) return false;
-  const std::size_t pix = static_cast<std::size_t>(v) * width_ + u;
-  const Eigen::Vector3f d_cam(rays_[2 * pix], rays_[2 * pix + 1], 1.0F);
-  const Eigen::Vector3f d_world = world_from_camera.rotation * d_cam;
+bool cast_ray(const World& world, const Eigen::Vector3f& origin_m,
+              const Eigen::Vector3f& direction, std::size_t& surface, float& t) {
   Hit best;
   bool found = false;
-  for (std::size_t i = 0; i < world_->surface_count; ++i) {
-    const Surface& s = world_->surfaces[i];
+  for (std::size_t i = 0; i < world.surface_count; ++i) {
+    const Surface& s = world.surfaces[i];
     const Eigen::Matrix3f rs_t = s.world_from_local.rotation.transpose();
-    const Eigen::Vector3f o = rs_t * (world_from_camera.translation_m - s.world_from_local.translation_m);
+    const Eigen::Vector3f o = rs_t * (origin_m - s.world_from_local.translation_m);
     Hit hit;
-    if (hit_surface(s, o, rs_t * d_world, best.t, hit)) {
+    if (hit_surface(s, o, rs_t * direction, best.t, hit)) {
       best = hit;
       surface = i;
       found = true;
     }
   }
-  depth_m = best.t;
+  t = best.t;
   return found;
+}
+
+bool Renderer::trace_pixel(const RigidTransform& world_from_camera, std::uint32_t u,
+                           std::uint32_t v, std::size_t& surface, float& depth_m) const {
+  if (u >= width_ || v >= height_) return false;
+  const std::size_t pix = static_cast<std::size_t>(v) * width_ + u;
+  const Eigen::Vector3f d_cam(rays_[2 * pix], rays_[2 * pix + 1], 1.0F);
+  // The ray (x, y, 1) has unit z, so its parameter is the z-depth.
+  return cast_ray(*world_, world_from_camera.translation_m, world_from_camera.rotation * d_cam,
+                  surface, depth_m);
 }
 
 }  // namespace boticelli::hal::sim

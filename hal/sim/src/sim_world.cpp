@@ -39,6 +39,16 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   rig_ = &rig;
   params_ = params;
   if (params_.physics_step_us == 0) params_.physics_step_us = 1000;
+  // The unit's limits are whole steps: round them inwards.
+  PanTiltLimits& l = params_.ptu.limits;
+  if (l.pan_resolution_rad > 0.0F) {
+    l.pan_min_rad = std::ceil(l.pan_min_rad / l.pan_resolution_rad) * l.pan_resolution_rad;
+    l.pan_max_rad = std::floor(l.pan_max_rad / l.pan_resolution_rad) * l.pan_resolution_rad;
+  }
+  if (l.tilt_resolution_rad > 0.0F) {
+    l.tilt_min_rad = std::ceil(l.tilt_min_rad / l.tilt_resolution_rad) * l.tilt_resolution_rad;
+    l.tilt_max_rad = std::floor(l.tilt_max_rad / l.tilt_resolution_rad) * l.tilt_resolution_rad;
+  }
   now_us_ = 0;
   rng_state_ = params.seed * 0x9E3779B97F4A7C15ULL + 0x632BE59BD9B4E019ULL;
   x_m_ = world.start.x_m;
@@ -150,12 +160,17 @@ void SimWorld::step(std::uint32_t dt_us) {
   }
 }
 
-// Trapezoidal profile: accelerate to the axis speed, brake in time to stop on the target.
+// Trapezoidal profile: accelerate to the axis speed, brake in time to stop on the target. The
+// braking speed is the one to have at the END of this step so that constant deceleration then
+// stops exactly on the target (v1² = 2a(e − (v0 + v1)·dt/2)), which keeps the move time exact
+// to the step (an explicit sqrt(2ae) would arrive early).
 void SimWorld::step_axis(PtuAxis& axis, float dt_s) const {
   if (!axis.moving()) return;
   const float a = params_.ptu.accel_rad_s2;
   const float error = axis.target_rad - axis.position_rad;
-  const float brake_speed = std::sqrt(2.0F * a * std::fabs(error));
+  const float remaining = std::max(0.0F, std::fabs(error) - 0.5F * std::fabs(axis.velocity_rad_s) * dt_s);
+  const float brake_speed =
+      std::max(0.0F, 0.5F * (-a * dt_s + std::sqrt(a * a * dt_s * dt_s + 8.0F * a * remaining)));
   const float desired = std::copysign(std::min(axis.speed_rad_s, brake_speed), error);
   const float dv = std::clamp(desired - axis.velocity_rad_s, -a * dt_s, a * dt_s);
   const float v0 = axis.velocity_rad_s;

@@ -21,6 +21,11 @@ struct RenderSettings {
   Rgb background{0.05F, 0.05F, 0.06F};  // rays that hit nothing
 };
 
+// First surface hit by the ray origin + t·direction, t > 0 (direction need not be unit; t is
+// in its units). False when nothing is hit. For ground truth (visibility of the target).
+bool cast_ray(const World& world, const Eigen::Vector3f& origin_m,
+              const Eigen::Vector3f& direction, std::size_t& surface, float& t);
+
 class Renderer {
  public:
   // Precomputes the per-pixel rays (with the radial distortion) and the vignetting; allocates,
