@@ -14,7 +14,9 @@
 
 namespace boticelli::aln {
 
-// compile() partitions the model's input box by thresholds on one input at a time. In each
+// compile() first cuts the model's input box into a regular grid (at most MaxGridCells
+// cells, found by arithmetic, no branches), then partitions each cell by thresholds on one
+// input at a time. In each
 // block, a MIN/MAX child that is dominated over the whole block (its bounds over the block
 // cannot win, with a rounding margin) is dropped, so the block keeps a small MIN/MAX tree of
 // the pieces that can be active there. A block is split further (at the midpoint of the input
@@ -23,19 +25,33 @@ namespace boticelli::aln {
 // about N + 1 pieces per query (thesis §4.7.2). Exact (same value and piece as
 // Aln::evaluate) for inputs inside the model's input box; callers clamp inputs to it.
 // Storage: MaxSplits threshold nodes, MaxBlocks blocks, MaxBlockNodes nodes over all blocks.
-template <typename Scalar, int N, std::size_t MaxPieces, std::size_t MaxBlocks = 2048,
-          std::size_t MaxBlockNodes = 32768>
+template <typename Scalar, int N, std::size_t MaxPieces, std::size_t MaxBlocks = 8192,
+          std::size_t MaxBlockNodes = 65536, std::size_t MaxGridCells = 512>
 class Dtree {
  public:
   using Model = Aln<Scalar, N, MaxPieces>;
   using Vec = Eigen::Matrix<Scalar, N, 1>;
   static constexpr std::size_t kMaxSplits = MaxBlocks - 1;
+  static constexpr std::size_t kGridPerAxis = [] {
+    std::size_t g = 1;
+    while (true) {
+      std::size_t cells = 1;
+      for (int i = 0; i < N; ++i) cells *= g + 1;
+      if (cells > MaxGridCells) return g;
+      ++g;
+    }
+  }();
+  static constexpr std::size_t kGridCells = [] {
+    std::size_t cells = 1;
+    for (int i = 0; i < N; ++i) cells *= kGridPerAxis;
+    return cells;
+  }();
   static_assert(MaxBlocks >= 1 && MaxBlocks < (1U << 30), "block capacity");
   static_assert(MaxBlockNodes < (1U << 31), "block node capacity");
 
   // Compiles `model`; max_depth bounds the number of thresholds on a query's path (and the
   // compiler's recursion). False if the capacities were too small (the DTREE is then empty).
-  bool compile(const Model& model, std::size_t max_depth = 14) {
+  bool compile(const Model& model, std::size_t max_depth = 10) {
     model_ = &model;
     splits_used_ = 0;
     blocks_used_ = 0;
@@ -50,7 +66,27 @@ class Dtree {
       weight_[p] = model.piece(p).weight;
       bias_[p] = model.piece(p).bias;
     }
-    root_ = build(lo_, hi_, 0, max_depth);
+    for (int i = 0; i < N; ++i) {
+      const double w = hi_(i) - lo_(i);
+      cell_scale_(i) =
+          w > 0.0 ? static_cast<Scalar>(static_cast<double>(kGridPerAxis) / w) : Scalar(0);
+      cell_origin_(i) = static_cast<Scalar>(lo_(i));
+    }
+    for (std::size_t cell = 0; cell < kGridCells && ok_; ++cell) {
+      // The cell's box, widened a little so rounding in the cell index cannot route a
+      // query to a cell whose pruning did not consider it.
+      VecD lo = lo_;
+      VecD hi = hi_;
+      std::size_t rest = cell;
+      for (int i = 0; i < N; ++i) {
+        const std::size_t c = rest % kGridPerAxis;
+        rest /= kGridPerAxis;
+        const double w = (hi_(i) - lo_(i)) / static_cast<double>(kGridPerAxis);
+        lo(i) = lo_(i) + w * static_cast<double>(c) - 1e-3 * w;
+        hi(i) = lo_(i) + w * static_cast<double>(c + 1) + 1e-3 * w;
+      }
+      cell_root_[cell] = build(lo, hi, 0, max_depth);
+    }
     if (!ok_) {
       splits_used_ = 0;
       blocks_used_ = 0;
@@ -61,7 +97,16 @@ class Dtree {
   }
 
   [[nodiscard]] EvalResult<Scalar> evaluate(const Vec& x) const {
-    std::int32_t c = root_;
+    std::size_t cell = 0;
+    std::size_t stride = 1;
+    for (int i = 0; i < N; ++i) {
+      const Scalar u = (x(i) - cell_origin_(i)) * cell_scale_(i);
+      std::size_t c = u > Scalar(0) ? static_cast<std::size_t>(u) : 0;
+      c = c < kGridPerAxis ? c : kGridPerAxis - 1;
+      cell += c * stride;
+      stride *= kGridPerAxis;
+    }
+    std::int32_t c = cell_root_[cell];
     while (c >= 0) {
       const Split& s = splits_[static_cast<std::size_t>(c)];
       c = x(s.axis) < s.threshold ? s.below : s.above;
@@ -225,11 +270,14 @@ class Dtree {
     return true;
   }
 
-  std::int32_t build(const VecD& lo, const VecD& hi, std::size_t depth, std::size_t max_depth) {
+  // Blocks = grid cells + splits, so a split is allowed only while a block is left for it.
+  std::int32_t build(const VecD& lo, const VecD& hi, std::size_t depth, std::size_t max_depth,
+                     std::size_t stale = 0) {
     if (!ok_) return -1;
     const std::size_t here = analyse(lo, hi);
     const std::size_t target = static_cast<std::size_t>(N) + 1;
-    if (here <= target || depth >= max_depth || splits_used_ >= kMaxSplits) {
+    if (here <= target || depth >= max_depth || splits_used_ >= kMaxSplits ||
+        kGridCells + splits_used_ + 1 > MaxBlocks) {
       std::int32_t code = -1;
       if (!emit_block(code)) ok_ = false;
       return code;
@@ -250,7 +298,9 @@ class Dtree {
         best = cost;
       }
     }
-    if (axis < 0 || best >= 2 * here) {
+    // A split that drops nothing is allowed twice in a row (the next one may), no more.
+    const bool reduced = best < 2 * here;
+    if (axis < 0 || (!reduced && stale >= 2)) {
       analyse(lo, hi);
       std::int32_t code = -1;
       if (!emit_block(code)) ok_ = false;
@@ -266,8 +316,9 @@ class Dtree {
     h1(axis) = t;
     VecD l2 = lo;
     l2(axis) = t;
-    const std::int32_t below = build(lo, h1, depth + 1, max_depth);
-    const std::int32_t above = build(l2, hi, depth + 1, max_depth);
+    const std::size_t next_stale = reduced ? 0 : stale + 1;
+    const std::int32_t below = build(lo, h1, depth + 1, max_depth, next_stale);
+    const std::int32_t above = build(l2, hi, depth + 1, max_depth, next_stale);
     splits_[s].below = below;
     splits_[s].above = above;
     return static_cast<std::int32_t>(s);
@@ -275,7 +326,9 @@ class Dtree {
 
   const Model* model_ = nullptr;
   bool ok_ = false;
-  std::int32_t root_ = -1;
+  std::array<std::int32_t, kGridCells> cell_root_{};
+  Vec cell_origin_ = Vec::Zero();
+  Vec cell_scale_ = Vec::Zero();
   VecD lo_ = VecD::Zero();
   VecD hi_ = VecD::Zero();
   std::array<Split, kMaxSplits> splits_{};

@@ -104,7 +104,10 @@ class Trainer {
     scale_[0] = std::numeric_limits<double>::infinity();
     cursor_ = 0;
     pass_in_round_ = 0;
-    prev_objective_ = 0.0;
+    best_objective_ = 0.0;
+    stall_ = 0;
+    split_limit_ = 0;
+    last_made_ = 0;
     begin_pass();
     stats_.pieces = 1;
     return true;
@@ -149,8 +152,10 @@ class Trainer {
     double sse = 0.0;        // robust-weighted squared residuals
     double sse_plain = 0.0;  // sample-weighted squared residuals
     double sw_plain = 0.0;
-    VecD srd = VecD::Zero();  // sum w r d_j^2 (d normalised by the input range width)
-    VecD sd = VecD::Zero();   // sum w d_j^2
+    // For the split: |d_j| = |x_j - centroid_j| / width_j (the V a split would add).
+    VecD sra = VecD::Zero();  // sum w r |d_j|
+    VecD sa = VecD::Zero();   // sum w |d_j|
+    VecD saa = VecD::Zero();  // sum w d_j^2
     double sr = 0.0;          // sum w r
   };
   using Accumulators = std::array<Accumulator, MaxPieces>;
@@ -203,14 +208,15 @@ class Trainer {
     a.sw += w;
     a.sx += w * x;
     a.sy += w * y;
-    a.sxx.template selfadjointView<Eigen::Lower>().rankUpdate(x, w);
+    a.sxx.noalias() += (w * x) * x.transpose();
     a.sxy += (w * y) * x;
     a.sse += w * r * r;
     a.sr += w * r;
     for (int j = 0; j < N; ++j) {
-      const double d = x(j) / width(j);
-      a.sd(j) += w * d * d;
-      a.srd(j) += w * r * d * d;
+      const double d = std::fabs(x(j)) / width(j);
+      a.sa(j) += w * d;
+      a.saa(j) += w * d * d;
+      a.sra(j) += w * r * d;
     }
   }
 
@@ -220,8 +226,7 @@ class Trainer {
     PieceType& piece = model_->piece(p);
     const VecD xbar = a.sx / a.sw;
     const double ybar = a.sy / a.sw;
-    MatD c = a.sxx.template selfadjointView<Eigen::Lower>();
-    c = c / a.sw - xbar * xbar.transpose();
+    MatD c = a.sxx / a.sw - xbar * xbar.transpose();
     VecD g = a.sxy / a.sw - xbar * ybar;
     // A tiny ridge towards the current slopes keeps directions without data where they were.
     const VecD w_now = piece.weight.template cast<double>();
@@ -241,50 +246,38 @@ class Trainer {
     piece.set(w.template cast<Scalar>(), centroid, cy);
   }
 
+  // After a pass over the samples: keep the best model of this round, then either refit
+  // (one Lloyd step) or, when the error has stopped falling, end the round.
   void finish_pass() {
     stats_.passes += 1;
-    Accumulators& acc = *current_;
     const std::size_t pieces = model_->piece_count();
-    double sse = 0.0;
-    double sw = 0.0;
-    double sse_plain = 0.0;
-    double sw_plain = 0.0;
-    for (std::size_t p = 0; p < pieces; ++p) {
-      sse += acc[p].sse;
-      sw += acc[p].sw;
-      sse_plain += acc[p].sse_plain;
-      sw_plain += acc[p].sw_plain;
-    }
-    const double objective = sse;
-    const bool worse = pass_in_round_ > 0 && objective > prev_objective_;
-    const bool converged = worse || pass_in_round_ >= config_.max_refit_passes ||
-                           (pass_in_round_ > 0 && objective >= prev_objective_ * (1.0 - 1e-4));
-    if (worse) {
-      // The last refit made things worse: go back to the model before it, and its sums.
+    double objective = 0.0;
+    for (std::size_t p = 0; p < pieces; ++p) objective += (*current_)[p].sse;
+    const bool improved = pass_in_round_ == 0 || objective < best_objective_ * (1.0 - 1e-4);
+    if (improved) {
+      best_objective_ = objective;
       for (std::size_t p = 0; p < pieces; ++p) {
-        model_->piece(p) = backup_[p];
-        scale_[p] = backup_scale_[p];
+        best_pieces_[p] = model_->piece(p);
+        best_scale_[p] = scale_[p];
       }
-      std::swap(current_, previous_);
+      std::swap(current_, best_);  // *best_ now holds the sums of the best model
+      stall_ = 0;
+    } else {
+      ++stall_;
+    }
+    const Accumulators& evaluated = improved ? *best_ : *current_;
+    if (stall_ >= 2 || pass_in_round_ >= config_.max_refit_passes) {
+      for (std::size_t p = 0; p < pieces; ++p) {
+        model_->piece(p) = best_pieces_[p];
+        scale_[p] = best_scale_[p];
+      }
+      std::swap(current_, best_);  // the best model's sums become the current ones
       finish_round();
       return;
     }
-    stats_.rms = sw_plain > 0.0 ? std::sqrt(sse_plain / sw_plain) : 0.0;
-    stats_.robust_rms = sw > 0.0 ? std::sqrt(sse / sw) : 0.0;
-    if (converged) {
-      finish_round();
-      return;
-    }
-    // Refit every piece; keep the evaluated model and its sums in case the refit is worse.
-    for (std::size_t p = 0; p < pieces; ++p) {
-      backup_[p] = model_->piece(p);
-      backup_scale_[p] = scale_[p];
-    }
-    update_scales(acc);
-    for (std::size_t p = 0; p < pieces; ++p) refit(p, acc[p]);
-    prev_objective_ = objective;
+    update_scales(evaluated);
+    for (std::size_t p = 0; p < pieces; ++p) refit(p, evaluated[p]);
     pass_in_round_ += 1;
-    std::swap(current_, previous_);
     next_pass();
   }
 
@@ -303,21 +296,27 @@ class Trainer {
 
   // The current model and the sums in *current_ belong together: prune, split or stop.
   void finish_round() {
-    Accumulators& acc = *current_;
-    double sse = 0.0;
-    double sw = 0.0;
-    double sse_plain = 0.0;
-    double sw_plain = 0.0;
-    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
-      sse += acc[p].sse;
-      sw += acc[p].sw;
-      sse_plain += acc[p].sse_plain;
-      sw_plain += acc[p].sw_plain;
+    double objective = 0.0;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) objective += (*current_)[p].sse;
+    if (split_limit_ > 0 && objective >= saved_objective_ * (1.0 - 1e-4)) {
+      // The last round's splits did not lower the error: undo them and try fewer (the
+      // worst pieces first), so the error never rises from one round to the next.
+      *model_ = saved_model_;
+      *current_ = saved_acc_;
+      scale_ = saved_scale_;
+      objective = saved_objective_;
+      split_limit_ = last_made_ / 2;
+      if (split_limit_ == 0) {
+        finish_stats(*current_);
+        stats_.done = true;
+        return;
+      }
+    } else {
+      split_limit_ = MaxPieces;
+      prune(*current_);
     }
-    stats_.rms = sw_plain > 0.0 ? std::sqrt(sse_plain / sw_plain) : 0.0;
-    stats_.robust_rms = sw > 0.0 ? std::sqrt(sse / sw) : 0.0;
-    prune(acc);
-    stats_.pieces = model_->piece_count();
+    Accumulators& acc = *current_;
+    finish_stats(acc);
     if (stats_.iterations >= config_.max_iterations || model_->piece_count() >= cap_) {
       stats_.done = true;
       return;
@@ -338,7 +337,7 @@ class Trainer {
         }
       }
     } else if (stats_.robust_rms > config_.epsilon) {
-      const double mean_sse = sse / static_cast<double>(pieces);
+      const double mean_sse = objective / static_cast<double>(pieces);
       for (std::size_t p = 0; p < pieces; ++p) {
         if (enough(acc[p]) && acc[p].sse >= mean_sse) {
           want[p] = 1;
@@ -351,9 +350,13 @@ class Trainer {
       return;
     }
     update_scales(acc);
-    // Split the worst first until the cap.
+    saved_model_ = *model_;
+    saved_acc_ = acc;
+    saved_scale_ = scale_;
+    saved_objective_ = objective;
+    // Split the worst first until the cap or the limit.
     std::size_t made = 0;
-    while (model_->piece_count() < cap_) {
+    while (model_->piece_count() < cap_ && made < split_limit_) {
       std::size_t best = MaxPieces;
       for (std::size_t p = 0; p < pieces; ++p) {
         if (want[p] != 0 && (best == MaxPieces || acc[p].sse > acc[best].sse)) best = p;
@@ -363,60 +366,82 @@ class Trainer {
       if (split(best, acc[best])) ++made;
     }
     if (made == 0) {
+      split_limit_ = 0;
       stats_.done = true;
       return;
     }
+    last_made_ = made;
     stats_.iterations += 1;
     stats_.pieces = model_->piece_count();
     pass_in_round_ = 0;
-    prev_objective_ = 0.0;
+    stall_ = 0;
     next_pass();
   }
 
-  // Splits piece p into kind(A, B): two copies tilted up and down along the input where the
-  // residuals curve most, crossing at the centroid of the piece's samples.
+  void finish_stats(const Accumulators& acc) {
+    double sse = 0.0;
+    double sw = 0.0;
+    double sse_plain = 0.0;
+    double sw_plain = 0.0;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+      sse += acc[p].sse;
+      sw += acc[p].sw;
+      sse_plain += acc[p].sse_plain;
+      sw_plain += acc[p].sw_plain;
+    }
+    stats_.rms = sw_plain > 0.0 ? std::sqrt(sse_plain / sw_plain) : 0.0;
+    stats_.robust_rms = sw > 0.0 ? std::sqrt(sse / sw) : 0.0;
+    stats_.pieces = model_->piece_count();
+  }
+
+  // Splits piece p into kind(A, B): two copies of it tilted up and down along one input,
+  // crossing at its centroid, so kind(A, B) = piece + c0 + k |x_j - c_j|. For each input j,
+  // k and c0 are the least-squares fit of the residuals r ~ c0 + k |d_j|; the input with the
+  // largest reduction cov(r, |d_j|)^2 / var(|d_j|) is used, and MAX if k > 0 (the data rise
+  // above the piece towards the rim of its region: convex), MIN if k < 0 (concave).
   bool split(std::size_t p, const Accumulator& a) {
     const PieceType old = model_->piece(p);
-    const VecD mean = a.sx / a.sw;
     const double rbar = a.sr / a.sw;
-    const double rms = std::sqrt(a.sse / a.sw);
     int axis = -1;
-    double best_score = -1.0;
-    double best_cov = 0.0;
+    double best_gain = -1.0;
+    double best_k = 0.0;
+    double best_c0 = 0.0;
     for (int j = 0; j < N; ++j) {
-      const double var = a.sxx(j, j) / a.sw - mean(j) * mean(j);
-      const bool room =
-          hi(j) > static_cast<double>(old.weight(j)) || lo(j) < static_cast<double>(old.weight(j));
-      if (!(var > 0.0) || !room) continue;
-      const double cov = a.srd(j) / a.sw - rbar * (a.sd(j) / a.sw);
-      const double score = std::fabs(cov) + 1e-12 * var / (width(j) * width(j));
-      if (score > best_score) {
-        best_score = score;
-        best_cov = cov;
+      const double mean_a = a.sa(j) / a.sw;
+      const double var_a = a.saa(j) / a.sw - mean_a * mean_a;
+      const double w = static_cast<double>(old.weight(j));
+      const bool room = hi(j) > w || lo(j) < w;
+      if (!(var_a > 1e-12) || !room) continue;
+      const double cov = a.sra(j) / a.sw - rbar * mean_a;
+      const double gain = cov * cov / var_a;
+      if (gain > best_gain) {
+        best_gain = gain;
+        best_k = cov / var_a;
+        best_c0 = rbar - best_k * mean_a;
         axis = j;
       }
     }
     if (axis < 0) return false;
-    const double var = a.sxx(axis, axis) / a.sw - mean(axis) * mean(axis);
-    const double jitter = 0.75 + 0.5 * static_cast<double>(next_random() >> 8) / 16777216.0;
-    const double tilt = jitter * 2.0 * std::max(rms, 1e-6) / std::sqrt(var);
+    // A little seeded jitter in the tilt keeps the copies from being exactly symmetric.
+    const double jitter = 0.9 + 0.2 * static_cast<double>(next_random() >> 8) / 16777216.0;
+    double tilt = jitter * std::fabs(best_k) / width(axis);  // output units per input unit
+    if (!(tilt > 0.0)) tilt = 1e-6 / width(axis);
     const double w = static_cast<double>(old.weight(axis));
-    const double up = std::min(tilt, hi(axis) - w);
-    const double down = std::min(tilt, w - lo(axis));
+    const double up = std::max(std::min(tilt, hi(axis) - w), 0.0);
+    const double down = std::max(std::min(tilt, w - lo(axis)), 0.0);
     if (!(up + down > 0.0)) return false;
-    const Vec centroid = old.centroid + mean.template cast<Scalar>();
-    const Scalar cy = old.value(centroid);
     Vec wa = old.weight;
     Vec wb = old.weight;
-    wa(axis) = static_cast<Scalar>(std::max(up, 0.0) + w);
-    wb(axis) = static_cast<Scalar>(w - std::max(down, 0.0));
-    wa(axis) = std::clamp(wa(axis), model_->weight_lo(axis), model_->weight_hi(axis));
-    wb(axis) = std::clamp(wb(axis), model_->weight_lo(axis), model_->weight_hi(axis));
+    wa(axis) =
+        std::clamp(static_cast<Scalar>(w + up), model_->weight_lo(axis), model_->weight_hi(axis));
+    wb(axis) =
+        std::clamp(static_cast<Scalar>(w - down), model_->weight_lo(axis), model_->weight_hi(axis));
+    const Scalar cy = old.centroid_output + static_cast<Scalar>(best_c0);
     PieceType first{};
     PieceType second{};
-    first.set(wa, centroid, cy);
-    second.set(wb, centroid, cy);
-    const NodeKind kind = best_cov > 0.0 ? NodeKind::kMax : NodeKind::kMin;
+    first.set(wa, old.centroid, cy);
+    second.set(wb, old.centroid, cy);
+    const NodeKind kind = best_k > 0.0 ? NodeKind::kMax : NodeKind::kMin;
     const std::size_t q = model_->piece_count();
     if (!model_->split_piece(p, kind, first, second)) return false;
     scale_[q] = scale_[p];
@@ -491,16 +516,24 @@ class Trainer {
   std::size_t cap_ = MaxPieces;
   std::size_t cursor_ = 0;
   std::size_t pass_in_round_ = 0;
-  double prev_objective_ = 0.0;
+  double best_objective_ = 0.0;
+  std::size_t stall_ = 0;
+  // The model before the last round's splits, to undo them if they did not help.
+  Model saved_model_{};
+  Accumulators saved_acc_{};
+  std::array<double, MaxPieces> saved_scale_{};
+  double saved_objective_ = 0.0;
+  std::size_t split_limit_ = 0;  // 0: no split to judge yet
+  std::size_t last_made_ = 0;
   std::uint32_t rng_ = 1;
   Accumulators acc_a_{};
   Accumulators acc_b_{};
   Accumulators tmp_acc_{};
   Accumulators* current_ = &acc_a_;
-  Accumulators* previous_ = &acc_b_;
-  std::array<PieceType, MaxPieces> backup_{};
+  Accumulators* best_ = &acc_b_;
+  std::array<PieceType, MaxPieces> best_pieces_{};
   std::array<double, MaxPieces> scale_{};
-  std::array<double, MaxPieces> backup_scale_{};
+  std::array<double, MaxPieces> best_scale_{};
   std::array<PieceType, MaxPieces> tmp_pieces_{};
   std::array<typename Model::Node, Model::kMaxNodes> tmp_nodes_{};
   std::array<double, MaxPieces> tmp_scale_{};
