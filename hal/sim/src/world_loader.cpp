@@ -64,7 +64,9 @@ class Errors {
     if (failed_) return false;
     failed_ = true;
     if (size_ == 0) return false;
-    const int n = std::snprintf(buffer_, size_, "%s:%d: ", file_, line);
+    // Problems with the file as a whole (it cannot be read) have no line.
+    const int n = line > 0 ? std::snprintf(buffer_, size_, "%s:%d: ", file_, line)
+                           : std::snprintf(buffer_, size_, "%s: ", file_);
     if (n >= 0 && static_cast<std::size_t>(n) < size_) {
       va_list args;
       va_start(args, fmt);

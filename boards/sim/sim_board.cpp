@@ -1,0 +1,46 @@
+// SimBoard: wiring of the sim HAL from board_config.h and the world file (see sim_board.h).
+#include "sim_board.h"
+
+#include <cstdio>
+
+namespace boticelli::boards::sim {
+
+SimBoard::SimBoard()
+    : config_(make_config()),
+      settings_(make_settings(config_, 1)),
+      camera_(sim_, renderer_),
+      pan_tilt_(sim_),
+      base_(sim_),
+      estop_(sim_),
+      bumper_(sim_),
+      status_led_(sim_),
+      clock_(sim_),
+      watchdog_(sim_),
+      console_(config_.console_baud),
+      hal_{camera_, pan_tilt_, base_, estop_, bumper_, status_led_, console_, clock_, watchdog_} {}
+
+bool SimBoard::init(const firmware::Options& options, char* error, std::size_t error_size) {
+  const char* path = options.world_file != nullptr ? options.world_file : BOTICELLI_SIM_DEFAULT_WORLD;
+  if (!hal::sim::load_world(path, world_, error, error_size)) return false;
+  char why[200] = "";
+  if (!textures_.build(world_, why, sizeof why)) {
+    std::snprintf(error, error_size, "%s: %s", path, why);
+    return false;
+  }
+  // The seed drives the sensor noise and the odometry noise; the rest is deterministic.
+  settings_.render.seed = options.seed;
+  settings_.physics.seed = options.seed;
+  rig_.emplace(make_rig_params(config_));
+  if (!sim_.init(world_, *rig_, settings_.physics, why, sizeof why)) {
+    std::snprintf(error, error_size, "%s: %s", path, why);
+    return false;
+  }
+  if (!renderer_.init(world_, textures_, rig_->camera(), settings_.render, error, error_size)) {
+    return false;
+  }
+  if (!camera_.setup(settings_.camera_fps, error, error_size)) return false;
+  console_.select(options.console, options.console_path);
+  return true;
+}
+
+}  // namespace boticelli::boards::sim

@@ -1,0 +1,68 @@
+// SimBoard: the host simulation board — sim HAL devices on one SimWorld loaded from --world.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "board_config.h"
+#include "firmware/board.h"
+#include "hal/hal.h"
+#include "hal/sim/base_sim.h"
+#include "hal/sim/camera_sim.h"
+#include "hal/sim/clock_sim.h"
+#include "hal/sim/gpio_sim.h"
+#include "hal/sim/pan_tilt_sim.h"
+#include "hal/sim/renderer.h"
+#include "hal/sim/sim_world.h"
+#include "hal/sim/textures.h"
+#include "hal/sim/watchdog_sim.h"
+#include "hal/sim/world.h"
+#include "sim_console.h"
+
+namespace boticelli::boards::sim {
+
+// One static instance (it holds the world and its textures, a few MB): main.cpp's, or a
+// test's. init() loads the world (--world, else the shipped thesis room), builds textures,
+// rig, physics and renderer; the firmware then calls init()/open() of each device. The
+// sim-only accessors give tests the ground truth the firmware never sees.
+class SimBoard final : public firmware::Board {
+ public:
+  SimBoard();
+  const firmware::BoardInfo& info() const override { return kInfo; }
+  const firmware::BoardConfig& config() const override { return config_; }
+  bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
+  hal::Hal& hal() override { return hal_; }
+
+  // ---- sim-only: ground truth and scripting (valid after a successful init) ----
+  hal::sim::SimWorld& sim() { return sim_; }  // true pose, collisions, target, e-stop script
+  const hal::sim::World& world() const { return world_; }
+  hal::sim::CameraSim& camera() { return camera_; }  // depth of the last frame, its pose
+  const hal::sim::Renderer& renderer() const { return renderer_; }
+  const stereo::RigModel& rig() const { return *rig_; }
+  // Settings used by the next init() (tests may change noise, rates, physics).
+  SimSettings& settings() { return settings_; }
+
+ private:
+  static constexpr firmware::BoardInfo kInfo{"sim", "host simulation board", true};
+
+  firmware::BoardConfig config_;
+  SimSettings settings_;
+  hal::sim::World world_;
+  hal::sim::TextureBank textures_;
+  std::optional<stereo::RigModel> rig_;
+  hal::sim::SimWorld sim_;
+  hal::sim::Renderer renderer_;
+  hal::sim::CameraSim camera_;
+  hal::sim::PanTiltSim pan_tilt_;
+  hal::sim::BaseSim base_;
+  hal::sim::EstopInputSim estop_;
+  hal::sim::BumperInputSim bumper_;
+  hal::sim::LedOutputSim status_led_;
+  hal::sim::ClockSim clock_;
+  hal::sim::WatchdogSim watchdog_;
+  SimConsole console_;
+  hal::Hal hal_;
+
+};
+
+}  // namespace boticelli::boards::sim
