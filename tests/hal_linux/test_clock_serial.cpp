@@ -1,5 +1,7 @@
 // Tests of ClockPosix (CLOCK_MONOTONIC) and SerialTermios / SerialStdio on a pseudo-terminal.
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -36,6 +38,34 @@ TEST(ClockPosix, SleepsUntilTheAbsoluteDeadline) {
   const std::uint64_t deadline = c.now_us() + 20000;
   c.sleep_until_us(deadline);
   CHECK(c.now_us() >= deadline);
+}
+
+namespace {
+volatile sig_atomic_t g_alarms = 0;
+void on_alarm(int) {
+  g_alarms = g_alarms + 1;
+}
+}  // namespace
+
+TEST(ClockPosix, SignalsDuringTheSleepDoNotCutItShort) {
+  struct sigaction sa {};
+  sa.sa_handler = on_alarm;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: the sleep sees EINTR
+  struct sigaction old {};
+  CHECK_EQUAL(0, ::sigaction(SIGALRM, &sa, &old));
+  itimerval every_5ms{{0, 5000}, {0, 5000}};
+  g_alarms = 0;
+  ClockPosix c;
+  const std::uint64_t deadline = c.now_us() + 60000;
+  CHECK_EQUAL(0, ::setitimer(ITIMER_REAL, &every_5ms, nullptr));
+  c.sleep_until_us(deadline);
+  const std::uint64_t woke = c.now_us();
+  itimerval off{};
+  ::setitimer(ITIMER_REAL, &off, nullptr);
+  ::sigaction(SIGALRM, &old, nullptr);
+  CHECK(g_alarms >= 1);     // the sleep was interrupted at least once ...
+  CHECK(woke >= deadline);  // ... and still lasted until the deadline
 }
 
 TEST(ClockPosix, ReturnsAtOnceForAPastDeadline) {
