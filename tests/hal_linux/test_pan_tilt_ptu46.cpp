@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fake_clock.h"
+#include "fake_serial_port.h"
 #include "hal/linux/pan_tilt_ptu46.h"
 #include "hal/linux/serial_termios.h"
 #include "ptu46_emulator.h"
@@ -16,6 +17,7 @@
 #include "alloc_guard.h"
 
 using boticelli::fakes::FakeClock;
+using boticelli::fakes::FakeSerialPort;
 using boticelli::fakes::Ptu46Emulator;
 using boticelli::fakes::Ptu46EmulatorConfig;
 using boticelli::hal_linux::PanTiltPtu46;
@@ -259,4 +261,67 @@ TEST(PanTiltPtu46, TheCyclicCallsDoNotAllocate) {
   }
   CHECK_FALSE(rig.ptu->state().moving);
   CHECK_NO_ALLOCATION(rig.ptu->halt());
+}
+
+TEST(PanTiltPtu46, OneCommandIsOutstandingAtATimeAndPartialWritesAreCompleted) {
+  FakeSerialPort port;
+  FakeClock clock;
+  PanTiltPtu46 ptu(port, clock);
+  port.set_write_limit(2);  // a nearly full line: two bytes per write
+  CHECK_TRUE(ptu.init());
+  for (int i = 0; i < 5; ++i) ptu.update();
+  STRCMP_EQUAL("FT ", port.written().c_str());  // complete, and nothing after it yet
+  port.feed("*\r\n");
+  for (int i = 0; i < 5; ++i) ptu.update();
+  STRCMP_EQUAL("FT ED ", port.written().c_str());
+  port.feed("* 12\r\n");  // a reply with a value where none is needed is still an OK
+  for (int i = 0; i < 5; ++i) ptu.update();
+  STRCMP_EQUAL("FT ED CI ", port.written().c_str());
+  port.feed("!");  // half a line: not a reply yet
+  for (int i = 0; i < 5; ++i) ptu.update();
+  STRCMP_EQUAL("FT ED CI ", port.written().c_str());
+  port.feed(" Illegal Command\r\n");
+  ptu.update();
+  CHECK_TRUE(ptu.state().fault);  // an error during start-up is a fault ...
+  STRCMP_CONTAINS("'CI ' rejected: ! Illegal Command", ptu.error());
+  clock.advance_us(2000001);  // ... and the sequence starts again after the backoff
+  port.clear_written();
+  port.set_write_limit(100);
+  ptu.update();
+  STRCMP_EQUAL("FT ", port.written().c_str());
+}
+
+TEST(PanTiltPtu46, ImplausibleStartUpAnswersAreRefused) {
+  FakeSerialPort port;
+  FakeClock clock;
+  PanTiltPtu46 ptu(port, clock);
+  CHECK_TRUE(ptu.init());
+  const char* answers[] = {"*", "*", "*", "* 0"};  // a resolution of 0 arc-seconds per count
+  for (const char* a : answers) {
+    ptu.update();
+    port.feed(a);
+    port.feed("\r\n");
+  }
+  ptu.update();
+  CHECK_TRUE(ptu.state().fault);
+  STRCMP_CONTAINS("implausible resolution", ptu.error());
+  CHECK_FALSE(ptu.ready());
+}
+
+TEST(PanTiltPtu46, ALimitAnswerOutsideTheQueriedRangeIsAStartUpFault) {
+  FakeSerialPort port;
+  FakeClock clock;
+  PanTiltPtu46 ptu(port, clock);
+  CHECK_TRUE(ptu.init());
+  // FT ED CI PR TR PN PX TN TX PU TU PP TP; PN answers above PX.
+  const char* answers[] = {"*",     "*",    "*",      "* 185.1428", "* 46.2857", "* 100", "* -100",
+                           "* -10", "* 10", "* 2000", "* 2000",     "* 0",       "* 0"};
+  for (const char* a : answers) {
+    ptu.update();
+    port.feed(a);
+    port.feed("\r\n");
+  }
+  ptu.update();
+  CHECK_FALSE(ptu.ready());
+  STRCMP_CONTAINS("inconsistent limits", ptu.error());
 }
