@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <vector>
 
 namespace boticelli::test {
 
@@ -158,8 +159,8 @@ Eigen::Vector3f SceneRenderer::shade(const Eigen::Vector3f& origin_m,
 }
 
 void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::CameraPose& pose,
-                                std::uint8_t* yuyv, std::uint32_t noise_seed,
-                                float noise_sigma) const {
+                                std::uint8_t* yuyv, std::uint32_t noise_seed, float noise_sigma,
+                                std::uint32_t sample_step) const {
   // Per-patch constants for this eye, so a pixel costs a few multiplications per patch.
   struct Prepared {
     const Patch* patch;
@@ -177,45 +178,50 @@ void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::Camer
     prepared[count++] = {&p, normal, -normal.dot(offset), offset.dot(p.right), offset.dot(p.up)};
   }
   const stereo::CameraIntrinsics& cam = rig.camera();
-  const bool pinhole = cam.radial_k1 == 0.0F;
+  const auto colour_at = [&](float pu, float pv) {
+    const Eigen::Vector3f dir =
+        cam.radial_k1 == 0.0F
+            ? Eigen::Vector3f(pose.rotation *
+                              Eigen::Vector3f((pu - cam.principal_x_px) / cam.focal_px,
+                                              (pv - cam.principal_y_px) / cam.focal_px, 1.0F))
+            : stereo::RigModel::ray_ptu(pose, cam, Eigen::Vector2f(pu, pv));
+    Eigen::Vector3f colour = background;
+    float nearest = 0.0F;
+    for (std::size_t i = 0; i < count; ++i) {
+      const Prepared& q = prepared[i];
+      const float denom = q.normal.dot(dir);
+      if (std::fabs(denom) < 1e-9F) continue;
+      const float t = q.numerator / denom;
+      if (!(t > 1e-4F) || (nearest > 0.0F && t >= nearest)) continue;
+      const float x = q.eye_x + t * dir.dot(q.patch->right);
+      const float y = q.eye_y + t * dir.dot(q.patch->up);
+      if (std::fabs(x) > q.patch->half_width_m || std::fabs(y) > q.patch->half_height_m) continue;
+      nearest = t;
+      colour = surface_colour(*q.patch, x, y);
+    }
+    return Eigen::Vector3f(255.0F * colour);
+  };
   const auto w = static_cast<std::int32_t>(cam.width_px);
   const auto h = static_cast<std::int32_t>(cam.height_px);
+  const std::int32_t step = sample_step == 2 ? 2 : 1;
+  std::vector<Eigen::Vector3f> block_colours(static_cast<std::size_t>(w / 2));
   for (std::int32_t v = 0; v < h; ++v) {
     std::uint8_t* row = yuyv + static_cast<std::ptrdiff_t>(v) * w * 2;
-    // Without distortion the (unnormalised) ray is R·(x_n, y_n, 1), linear along a row.
-    const Eigen::Vector3f row_dir =
-        pose.rotation * Eigen::Vector3f(-cam.principal_x_px / cam.focal_px,
-                                        (static_cast<float>(v) - cam.principal_y_px) / cam.focal_px,
-                                        1.0F);
-    const Eigen::Vector3f column_step = pose.rotation.col(0) / cam.focal_px;
+    if (step == 2 && v % 2 == 0) {
+      for (std::int32_t b = 0; b < w / 2; ++b) {
+        block_colours[static_cast<std::size_t>(b)] =
+            colour_at(static_cast<float>(2 * b) + 0.5F, static_cast<float>(v) + 0.5F);
+      }
+    }
     for (std::int32_t u = 0; u < w; u += 2) {
       float ys[2];
       float cb = 0.0F;
       float cr = 0.0F;
       for (std::int32_t k = 0; k < 2; ++k) {
-        const Eigen::Vector3f dir =
-            pinhole
-                ? Eigen::Vector3f(row_dir + static_cast<float>(u + k) * column_step)
-                : stereo::RigModel::ray_ptu(
-                      pose, cam, Eigen::Vector2f(static_cast<float>(u + k), static_cast<float>(v)));
-        Eigen::Vector3f colour = background;
-        float nearest = 0.0F;
-        for (std::size_t i = 0; i < count; ++i) {
-          const Prepared& q = prepared[i];
-          const float denom = q.normal.dot(dir);
-          if (std::fabs(denom) < 1e-9F) continue;
-          const float t = q.numerator / denom;
-          if (!(t > 1e-4F) || (nearest > 0.0F && t >= nearest)) continue;
-          const float x = q.eye_x + t * dir.dot(q.patch->right);
-          const float y = q.eye_y + t * dir.dot(q.patch->up);
-          if (std::fabs(x) > q.patch->half_width_m || std::fabs(y) > q.patch->half_height_m)
-            continue;
-          nearest = t;
-          colour = surface_colour(*q.patch, x, y);
-        }
-        const Eigen::Vector3f rgb = 255.0F * colour;
-        // Noise: sum of two uniforms from one hash (standard deviation 0.408), scaled to
-        // noise_sigma.
+        const Eigen::Vector3f rgb =
+            step == 2 ? block_colours[static_cast<std::size_t>(u / 2)]
+                      : colour_at(static_cast<float>(u + k), static_cast<float>(v));
+        // Noise per pixel: two uniforms from one hash (standard deviation 0.408), scaled.
         const std::uint32_t hash = hash3(u + k, v, noise_seed);
         const float n =
             static_cast<float>((hash & 0xFFFFU) + (hash >> 16)) * (1.0F / 65536.0F) - 1.0F;

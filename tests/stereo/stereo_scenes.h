@@ -20,9 +20,9 @@ struct WallPair {
 };
 
 // Wall distances from 0.3 m to 4.5 m, alternating value-noise texture and camouflage,
-// at varied pan and tilt, rendered with luma noise.
+// at varied pan and tilt, rendered with luma noise (sample_step: see render_yuyv).
 std::vector<float> wall_distances_m();
 void render_wall_pair(const stereo::RigModel& rig, std::size_t index, float distance_m,
-                      WallPair& out);
+                      WallPair& out, std::uint32_t sample_step = 1);
 
 }  // namespace boticelli::test

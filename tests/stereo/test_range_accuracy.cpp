@@ -42,7 +42,7 @@ TEST(RangeAccuracy, MedianErrorIsUnderHalfAPixelOfQuantisationInEveryBand) {
   const std::vector<float> distances = test::wall_distances_m();
   std::size_t features = 0;
   for (std::size_t k = 0; k < distances.size(); ++k) {
-    test::render_wall_pair(rig, k, distances[k], pair);
+    test::render_wall_pair(rig, k, distances[k], pair, 2);
     readings.clear();
     const stereo::PairPose pose{pair.pan_rad, pair.first_tilt_rad,
                                 pair.first_tilt_rad - rig.params().tilt_step_rad};
@@ -93,7 +93,7 @@ TEST(RangeAccuracy, EvidenceOfEveryReadingIsEq38OfItsMatchError) {
   static core::FixedVector<evidence::Reading, 4096> readings;
   readings.clear();
   test::WallPair pair;
-  test::render_wall_pair(rig, 3, 1.2F, pair);
+  test::render_wall_pair(rig, 3, 1.2F, pair, 2);
   const stereo::PairPose pose{pair.pan_rad, pair.first_tilt_rad,
                               pair.first_tilt_rad - rig.params().tilt_step_rad};
   const std::size_t n = proc.process_yuyv(pair.first_yuyv.data(), pair.second_yuyv.data(),
@@ -128,7 +128,7 @@ TEST(RangeAccuracy, FastTriangulationGivesTheSameRangesAsTheExactOne) {
   a.clear();
   b.clear();
   test::WallPair pair;
-  test::render_wall_pair(rig, 4, 0.8F, pair);
+  test::render_wall_pair(rig, 4, 0.8F, pair, 2);
   const stereo::PairPose pose{pair.pan_rad, pair.first_tilt_rad,
                               pair.first_tilt_rad - rig.params().tilt_step_rad};
   exact.process_yuyv(pair.first_yuyv.data(), pair.second_yuyv.data(), rig.camera().width_px * 2,
@@ -152,7 +152,7 @@ TEST(RangeAccuracy, AFramePairIsProcessedWithoutHeapAllocation) {
   static core::FixedVector<evidence::Reading, 4096> readings;
   readings.clear();
   test::WallPair pair;
-  test::render_wall_pair(rig, 5, 1.5F, pair);
+  test::render_wall_pair(rig, 5, 1.5F, pair, 2);
   const stereo::PairPose pose{pair.pan_rad, pair.first_tilt_rad,
                               pair.first_tilt_rad - rig.params().tilt_step_rad};
   std::size_t n = 0;

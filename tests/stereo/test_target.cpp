@@ -34,7 +34,7 @@ image::TargetDetection render_and_detect(const stereo::RigModel& rig,
                                          const stereo::CameraPose& pose,
                                          const test::SceneRenderer& scene, std::uint32_t seed) {
   std::vector<std::uint8_t> yuyv(std::size_t{rig.camera().width_px} * rig.camera().height_px * 2);
-  scene.render_yuyv(rig, pose, yuyv.data(), seed, 1.5F);
+  scene.render_yuyv(rig, pose, yuyv.data(), seed, 1.5F, 2);
   CHECK(image::downsample_yuyv(yuyv.data(), rig.camera().width_px, rig.camera().height_px,
                                rig.camera().width_px * 2, 4, frame()));
   static image::TargetDetector detector;
