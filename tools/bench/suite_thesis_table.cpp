@@ -144,12 +144,24 @@ void configure_model(Model& model, const SyntheticRoom& room) {
 }
 
 // RMS of a model over the samples: plain, or (robust runs) over the 95% smallest
-// residuals, so that a round is not preferred for fitting the outliers.
-double model_rms(const Model& model, const std::vector<AlnSample>& samples, bool trimmed) {
+// residuals, so that a round is not preferred for fitting the outliers; and the number of
+// pieces responsible for at least one sample (the pieces the trainer would keep).
+struct Residuals {
+  double rms = 0.0;
+  std::size_t live_pieces = 0;
+};
+Residuals model_rms(const Model& model, const std::vector<AlnSample>& samples, bool trimmed) {
   std::vector<double> r2(samples.size());
+  std::vector<bool> used(kMaxPieces, false);
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    const double r = static_cast<double>(model(samples[i].x) - samples[i].y);
+    const aln::EvalResult<float> e = model.evaluate_alpha_beta(samples[i].x);
+    used[e.piece] = true;
+    const double r = static_cast<double>(e.value - samples[i].y);
     r2[i] = r * r;
+  }
+  Residuals out;
+  for (const bool u : used) {
+    out.live_pieces += u ? 1U : 0U;
   }
   std::size_t n = r2.size();
   if (trimmed && n > 20) {
@@ -160,7 +172,8 @@ double model_rms(const Model& model, const std::vector<AlnSample>& samples, bool
   for (std::size_t i = 0; i < n; ++i) {
     sum += r2[i];
   }
-  return n > 0 ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+  out.rms = n > 0 ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+  return out;
 }
 
 struct BestRound {
@@ -180,9 +193,9 @@ BestRound train_keeping_best(const std::vector<AlnSample>& samples, bool trimmed
     return best;
   }
   const auto consider = [&](const Model& m, std::size_t iteration) {
-    const double rms = model_rms(m, samples, trimmed);
-    if (rms < best.rms) {
-      best = {rms, m.piece_count(), iteration};
+    const Residuals r = model_rms(m, samples, trimmed);
+    if (r.rms < best.rms) {
+      best = {r.rms, r.live_pieces, iteration};
       g_best = m;
     }
   };
