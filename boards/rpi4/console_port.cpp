@@ -1,0 +1,67 @@
+// ConsolePort: console selection and pseudo-terminal set-up for the rpi4 board (see console_port.h).
+#include "console_port.h"
+
+#include <fcntl.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace boticelli::boards::rpi4 {
+ConsolePort::ConsolePort(const char* uart_device, std::uint32_t baud)
+    : uart_device_(uart_device), baud_(baud) {}
+
+ConsolePort::~ConsolePort() {
+  if (pty_slave_fd_ >= 0) ::close(pty_slave_fd_);
+}
+
+void ConsolePort::select(firmware::ConsoleKind kind, const char* path) {
+  kind_ = kind;
+  switch (kind) {
+    case firmware::ConsoleKind::kStdio:
+      active_ = &stdio_;
+      break;
+    case firmware::ConsoleKind::kPty:
+      // Opening the multiplexer creates a new pair; the termios port holds the master.
+      tty_.emplace(hal_linux::SerialConfig{"/dev/ptmx", baud_});
+      active_ = &*tty_;
+      break;
+    case firmware::ConsoleKind::kPath:
+      tty_.emplace(hal_linux::SerialConfig{path != nullptr ? path : uart_device_, baud_});
+      active_ = &*tty_;
+      break;
+  }
+}
+
+bool ConsolePort::open() {
+  if (!active_->open()) return false;
+  if (kind_ != firmware::ConsoleKind::kPty) return true;
+  const int master = tty_->fd();
+  char slave[128] = "";
+  if (::grantpt(master) != 0 || ::unlockpt(master) != 0 ||
+      ::ptsname_r(master, slave, sizeof slave) != 0) {
+    std::snprintf(error_, sizeof error_, "pty: %s", std::strerror(errno));
+    return false;
+  }
+  pty_slave_fd_ = ::open(slave, O_RDWR | O_NOCTTY | O_CLOEXEC);
+  if (pty_slave_fd_ < 0) {
+    std::snprintf(error_, sizeof error_, "pty %s: %s", slave, std::strerror(errno));
+    return false;
+  }
+  std::fprintf(stderr, "boticelli: console on %s\n", slave);
+  return true;
+}
+
+std::ptrdiff_t ConsolePort::read(std::uint8_t* buffer, std::size_t max) {
+  return active_->read(buffer, max);
+}
+
+std::ptrdiff_t ConsolePort::write(const std::uint8_t* data, std::size_t size) {
+  return active_->write(data, size);
+}
+
+const char* ConsolePort::error() const { return error_[0] != '\0' ? error_ : active_->error(); }
+
+}  // namespace boticelli::boards::rpi4

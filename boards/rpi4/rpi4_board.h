@@ -1,0 +1,48 @@
+// Rpi4Board: the Raspberry Pi 4 reference robot — Linux HAL drivers wired from board_config.h.
+#pragma once
+
+#include <cstddef>
+
+#include "board_config.h"
+#include "console_port.h"
+#include "firmware/board.h"
+#include "hal/hal.h"
+#include "hal/linux/base_odrive_can.h"
+#include "hal/linux/camera_v4l2.h"
+#include "hal/linux/clock_posix.h"
+#include "hal/linux/gpio_gpiod.h"
+#include "hal/linux/pan_tilt_ptu46.h"
+#include "hal/linux/serial_termios.h"
+#include "hal/linux/watchdog_linux.h"
+
+namespace boticelli::boards::rpi4 {
+
+// One static instance (main.cpp). The constructor only stores configuration; init() picks
+// the console and requests the GPIO lines (without its e-stop line the robot must not run);
+// the firmware then calls init()/open() of the camera, PTU, base and console.
+class Rpi4Board final : public firmware::Board {
+ public:
+  Rpi4Board();
+  const firmware::BoardInfo& info() const override { return kInfo; }
+  const firmware::BoardConfig& config() const override { return config_; }
+  bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
+  hal::Hal& hal() override { return hal_; }
+
+ private:
+  static constexpr firmware::BoardInfo kInfo{"rpi4", "Raspberry Pi 4 reference robot", false};
+
+  firmware::BoardConfig config_;
+  hal_linux::ClockPosix clock_;
+  hal_linux::SerialTermios ptu_port_;
+  hal_linux::PanTiltPtu46 pan_tilt_;
+  hal_linux::BaseOdriveCan base_;
+  hal_linux::CameraV4l2 camera_;
+  hal_linux::DigitalInGpiod estop_;
+  hal_linux::DigitalInGpiod bumper_;
+  hal_linux::DigitalOutGpiod status_led_;
+  hal_linux::WatchdogLinux watchdog_;
+  ConsolePort console_;
+  hal::Hal hal_;
+};
+
+}  // namespace boticelli::boards::rpi4
