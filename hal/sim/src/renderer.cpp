@@ -198,6 +198,18 @@ bool Renderer::init(const World& world, const TextureBank& textures,
     target_up_local_ = rt * f.up;
     target_right_local_ = rt * f.right;
   }
+  face_light_.reset(new Eigen::Vector3f[6 * kMaxSurfaces]);
+  const Eigen::Vector3f ambient(world.ambient.r, world.ambient.g, world.ambient.b);
+  const Eigen::Vector3f light(world.light_diffuse.r, world.light_diffuse.g, world.light_diffuse.b);
+  for (std::size_t i = 0; i < world.surface_count; ++i) {
+    for (int f = 0; f < 6; ++f) {
+      Eigen::Vector3f n_local = Eigen::Vector3f::Zero();
+      n_local[f / 2] = (f % 2 == 0) ? 1.0F : -1.0F;
+      const Eigen::Vector3f n_world = world.surfaces[i].world_from_local.rotation * n_local;
+      const float lambert = std::max(0.0F, -n_world.dot(world.light_direction));
+      face_light_[6 * i + static_cast<std::size_t>(f)] = ambient + lambert * light;
+    }
+  }
   set_settings(settings);
   return true;
 }
@@ -320,6 +332,7 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
             const Eigen::Vector3f d_cam(rays_[2 * pix], rays_[2 * pix + 1], 1.0F);
             Hit best;
             int best_surface = -1;
+            Eigen::Vector3f best_d = Eigen::Vector3f::Zero();  // the ray in that surface's frame
             for (std::size_t n = 0; n < count; ++n) {
               const Candidate& c = setup.surfaces[list[n]];
               if (c.min_z >= best.t) break;  // every later surface is farther
@@ -331,6 +344,7 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
               if (hit_surface(world.surfaces[list[n]], c.origin_local, d, best.t, hit)) {
                 best = hit;
                 best_surface = list[n];
+                best_d = d;
               }
             }
             if (depth_m != nullptr) depth_m[pix] = best.t;
@@ -342,7 +356,7 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
             } else {
               const Surface& s = world.surfaces[static_cast<std::size_t>(best_surface)];
               const Candidate& c = setup.surfaces[static_cast<std::size_t>(best_surface)];
-              const Eigen::Vector3f d = c.local_from_camera * d_cam;
+              const Eigen::Vector3f& d = best_d;
               const Eigen::Vector3f p = c.origin_local + best.t * d;
               Eigen::Vector3f n_local = Eigen::Vector3f::Zero();
               float su = 0.0F;  // surface coordinates [m]; sv runs "up" on vertical faces
@@ -357,7 +371,12 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
                 su = axis == 0 ? p.y() : p.x();
                 sv = axis == 2 ? p.y() : p.z();
               }
-              if (n_local.dot(d) > 0.0F) n_local = -n_local;  // planes are seen from both sides
+              // Planes are seen from both sides: light the side facing the camera.
+              int face = best.face;
+              if (n_local.dot(d) > 0.0F) {
+                n_local = -n_local;
+                face ^= 1;
+              }
               Eigen::Vector3f albedo(s.diffuse.r, s.diffuse.g, s.diffuse.b);
               switch (s.pattern) {
                 case Pattern::kPlain:
@@ -384,12 +403,16 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
                   albedo = Eigen::Vector3f(0.05F, 0.60F, 0.10F);
                 }
               }
-              if (settings_.shading) {
+              if (!settings_.shading) {
+                radiance = albedo;
+              } else if (s.shape == Shape::kCylinder && best.face == 0) {
                 const Eigen::Vector3f n_world = s.world_from_local.rotation * n_local;
                 const float lambert = std::max(0.0F, -n_world.dot(light_dir));
                 radiance = albedo.cwiseProduct(ambient + lambert * light);
               } else {
-                radiance = albedo;
+                radiance = albedo.cwiseProduct(
+                    face_light_[6 * static_cast<std::size_t>(best_surface) +
+                                static_cast<std::size_t>(face)]);
               }
             }
             radiance *= gain * vignette_[pix];

@@ -98,12 +98,17 @@ bool TextureBank::build(World& world, char* error, std::size_t error_size) {
 
 float TextureBank::sample(int texture, float u, float v) const {
   const std::uint8_t* t = texels_[static_cast<std::size_t>(texture)];
-  const float fu = std::floor(u);
-  const float fv = std::floor(v);
-  // Wrap into the period through a 32-bit int (u, v are bounded by the world's 1000 m).
+  // floor() through a 32-bit int (u, v are bounded: the world is within 1000 m and a texel
+  // is at least 0.6 mm, so |u|, |v| < 2e6); then wrap into the period.
+  std::int32_t iu = static_cast<std::int32_t>(u);
+  std::int32_t iv = static_cast<std::int32_t>(v);
+  iu -= static_cast<float>(iu) > u ? 1 : 0;
+  iv -= static_cast<float>(iv) > v ? 1 : 0;
+  const float fu = static_cast<float>(iu);
+  const float fv = static_cast<float>(iv);
   constexpr std::uint32_t kMask = kTextureSize - 1U;
-  const std::uint32_t x0 = static_cast<std::uint32_t>(static_cast<std::int32_t>(fu)) & kMask;
-  const std::uint32_t y0 = static_cast<std::uint32_t>(static_cast<std::int32_t>(fv)) & kMask;
+  const std::uint32_t x0 = static_cast<std::uint32_t>(iu) & kMask;
+  const std::uint32_t y0 = static_cast<std::uint32_t>(iv) & kMask;
   const std::uint32_t x1 = (x0 + 1U) & kMask;
   const std::uint32_t y1 = (y0 + 1U) & kMask;
   const float tx = u - fu;

@@ -72,6 +72,9 @@ class Renderer {
   std::unique_ptr<float[]> vignette_;  // per pixel brightness factor
   // Per tile: bounds of its pixels' normalised rays (min x, min y, max x, max y).
   std::unique_ptr<float[]> tile_bounds_;
+  // Ambient + Lambert light of each flat face (box faces 0..5, plane and caps use 4 and 5),
+  // per surface: the world is static, so this is computed once.
+  std::unique_ptr<Eigen::Vector3f[]> face_light_;
   // The target triangle in its surface's frame (centre of the face, in-face unit axes).
   Eigen::Vector3f target_centre_local_ = Eigen::Vector3f::Zero();
   Eigen::Vector3f target_up_local_ = Eigen::Vector3f::UnitZ();
