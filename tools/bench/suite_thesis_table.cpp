@@ -56,21 +56,34 @@ struct Quality {
   double correct_clear = 0.0;
   double false_free_clear = 0.0;
   double clear_share = 0.0;
+  // Clear points whose line of sight ends on a surface with features within the sensor's
+  // range, so the sensor says something about them (the rest lie in directions with
+  // nothing to see: over the walls, where there is no ceiling, or towards the bare floor).
+  double correct_seen = 0.0;
+  double seen_share = 0.0;
 };
 
-// True if p lies outside the sensor model's band around the first surface along its ray.
-bool clear_of_surfaces(const SyntheticRoom& room, const Vec3& p) {
+enum class TestPointKind { kInBand, kClearSeen, kClearUnseen };
+
+// Where p lies relative to the first surface r_s on its line of sight: inside the sensor
+// model's band [r_s − 3δr, r_s + δr] (δr = 0.1 r_s), or clear of it, and then whether that
+// surface has features within the sensor's range.
+TestPointKind test_point_kind(const SyntheticRoom& room, const Vec3& p) {
   const Vec3 s = room.sensor();
   const Vec3 d{p.x - s.x, p.y - s.y, p.z - s.z};
   const double dist = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
   if (dist < 1e-9) {
-    return true;
+    return TestPointKind::kClearSeen;
   }
   const SyntheticRoom::Hit hit = room.cast_from_sensor({d.x / dist, d.y / dist, d.z / dist});
+  const bool seen = hit.featured && hit.distance_m <= room.spec().max_range_m;
   if (!std::isfinite(hit.distance_m)) {
-    return true;
+    return TestPointKind::kClearUnseen;
   }
-  return dist < 0.7 * hit.distance_m || dist > 1.1 * hit.distance_m;
+  if (dist >= 0.7 * hit.distance_m && dist <= 1.1 * hit.distance_m) {
+    return TestPointKind::kInBand;
+  }
+  return seen ? TestPointKind::kClearSeen : TestPointKind::kClearUnseen;
 }
 
 // Classifies every test point of the room's bounding box with `is_free`.
@@ -84,6 +97,8 @@ Quality classify(const SyntheticRoom& room, IsFree&& is_free) {
   std::size_t clear = 0;
   std::size_t clear_correct = 0;
   std::size_t clear_false_free = 0;
+  std::size_t seen = 0;
+  std::size_t seen_correct = 0;
   const auto steps = [](double lo, double hi) {
     return static_cast<int>(std::floor((hi - lo) / kTestSpacingM + 1e-9));
   };
@@ -97,7 +112,12 @@ Quality classify(const SyntheticRoom& room, IsFree&& is_free) {
                      b.min.z + (iz + 0.5) * kTestSpacingM};
         const bool truth = room.visible_free(p);
         const bool said = is_free(p);
-        if (clear_of_surfaces(room, p)) {
+        const TestPointKind kind = test_point_kind(room, p);
+        if (kind == TestPointKind::kClearSeen) {
+          ++seen;
+          seen_correct += truth == said ? 1U : 0U;
+        }
+        if (kind != TestPointKind::kInBand) {
           ++clear;
           clear_correct += truth == said ? 1U : 0U;
           clear_false_free += (said && !truth) ? 1U : 0U;
@@ -121,6 +141,8 @@ Quality classify(const SyntheticRoom& room, IsFree&& is_free) {
   q.correct_clear = static_cast<double>(clear_correct) / nc;
   q.false_free_clear = static_cast<double>(clear_false_free) / nc;
   q.clear_share = static_cast<double>(clear) / n;
+  q.correct_seen = static_cast<double>(seen_correct) / static_cast<double>(seen > 0 ? seen : 1);
+  q.seen_share = static_cast<double>(seen) / n;
   return q;
 }
 
@@ -389,10 +411,13 @@ int run_thesis_table() {
             .num("aln_false_free", q.false_free)
             .num("aln_correct_clear", q.correct_clear)
             .num("aln_false_free_clear", q.false_free_clear)
+            .num("aln_correct_seen", q.correct_seen)
             .num("grid_correct", grid_q.correct)
             .num("grid_false_free", grid_q.false_free)
             .num("grid_correct_clear", grid_q.correct_clear)
+            .num("grid_correct_seen", grid_q.correct_seen)
             .num("clear_share", q.clear_share)
+            .num("seen_share", q.seen_share)
             .integer("grid_cells", static_cast<std::int64_t>(g_grid.cells()))
             .integer("grid_updates", static_cast<std::int64_t>(grid_updates))
             .num("grid_s", static_cast<double>(g1 - g0) * 1e-9)
