@@ -64,6 +64,105 @@ float parabola_offset(float a, float b, float c) {
   return offset < -0.5F ? -0.5F : (offset > 0.5F ? 0.5F : offset);
 }
 
+float bilinear(const LowResFrame& frame, float x, float y) {
+  const auto x0 = static_cast<int>(x);
+  const auto y0 = static_cast<int>(y);
+  const float fx = x - static_cast<float>(x0);
+  const float fy = y - static_cast<float>(y0);
+  const auto w = static_cast<int>(frame.width);
+  const float* p = frame.luma.data() + y0 * w + x0;
+  const float top = p[0] + fx * (p[1] - p[0]);
+  const float bottom = p[w] + fx * (p[w + 1] - p[w]);
+  return top + fy * (bottom - top);
+}
+
+// Gauss-Newton refinement of the match along the epipolar line (a Lucas-Kanade step in
+// one dimension, with a brightness offset): minimises Σ (I2(x + s·d) − T(x) − b)² over the
+// 5x5 window, d = (K, 1) the line direction per row. The template gradient stands in for
+// the image's (inverse compositional), so the 2x2 normal matrix is built once. Returns
+// false (v unchanged) if the window leaves the image or the step does not settle.
+bool refine_along_line(const LowResFrame& first, int fu, int fv, const LowResFrame& second,
+                       const EpipolarSegment& segment, float slope, float& v) {
+  const auto w1 = static_cast<int>(first.width);
+  const auto h1 = static_cast<int>(first.height);
+  if (fu < 3 || fv < 3 || fu + 3 >= w1 || fv + 3 >= h1) {
+    return false;
+  }
+  std::array<float, 25> templ{};
+  std::array<float, 25> grad{};
+  const float* y = first.luma.data();
+  float sgg = 0.0F;
+  float sg = 0.0F;
+  float st = 0.0F;
+  int k = 0;
+  for (int dv = -kHalfWindow; dv <= kHalfWindow; ++dv) {
+    for (int du = -kHalfWindow; du <= kHalfWindow; ++du) {
+      const int i = (fv + dv) * w1 + fu + du;
+      const float g = slope * 0.5F * (y[i + 1] - y[i - 1]) + 0.5F * (y[i + w1] - y[i - w1]);
+      templ[static_cast<std::size_t>(k)] = y[i];
+      grad[static_cast<std::size_t>(k)] = g;
+      sgg += g * g;
+      sg += g;
+      st += y[i];
+      ++k;
+    }
+  }
+  const float det = 25.0F * sgg - sg * sg;
+  if (!(det > 1e-3F * 25.0F * sgg) || !(sgg > 1.0F)) {
+    return false;
+  }
+  const float x_limit =
+      static_cast<float>(second.width) - 1.0F - static_cast<float>(kHalfWindow) - 1e-3F;
+  const float y_limit =
+      static_cast<float>(second.height) - 1.0F - static_cast<float>(kHalfWindow) - 1e-3F;
+  const float start = v;
+  float current = v;
+  float offset = 0.0F;
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    const float cu = segment.far_u_px + slope * (current - segment.far_v_px);
+    if (cu < static_cast<float>(kHalfWindow) || current < static_cast<float>(kHalfWindow) ||
+        cu > x_limit || current > y_limit) {
+      return false;
+    }
+    float seg = 0.0F;
+    float se = 0.0F;
+    float si = 0.0F;
+    k = 0;
+    for (int dv = -kHalfWindow; dv <= kHalfWindow; ++dv) {
+      for (int du = -kHalfWindow; du <= kHalfWindow; ++du) {
+        const float sample =
+            bilinear(second, cu + static_cast<float>(du), current + static_cast<float>(dv));
+        if (iteration == 0) {
+          si += sample;
+        }
+        const float e = sample - templ[static_cast<std::size_t>(k)] - offset;
+        seg += grad[static_cast<std::size_t>(k)] * e;
+        se += e;
+        ++k;
+      }
+    }
+    if (iteration == 0) {
+      // Start from the mean brightness difference and redo the sums with it.
+      offset = (si - st) / 25.0F;
+      se -= 25.0F * offset;
+      seg -= offset * sg;
+    }
+    // [Σg² Σg; Σg 25]·[Δs; Δb] = −[Σg·e; Σe]
+    const float step = -(25.0F * seg - sg * se) / det;
+    const float offset_step = -(sgg * se - sg * seg) / det;
+    current += step;
+    offset += offset_step;
+    if (std::fabs(current - start) > 1.0F) {
+      return false;
+    }
+    if (std::fabs(step) < 0.005F) {
+      break;
+    }
+  }
+  v = current;
+  return true;
+}
+
 }  // namespace
 
 float match_error(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
@@ -148,7 +247,10 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
   }
   // The column follows the epipolar line at the refined row (a separate horizontal
   // parabola would be biased by oblique texture at the integer row).
-  const float v_sub = static_cast<float>(bv) + dv;
+  float v_sub = static_cast<float>(bv) + dv;
+  if (params.refine_along_line) {
+    (void)refine_along_line(first, fu, fv, second, segment, slope, v_sub);
+  }
   track.found = true;
   track.u_px = segment.far_u_px + slope * (v_sub - segment.far_v_px);
   track.v_px = v_sub;

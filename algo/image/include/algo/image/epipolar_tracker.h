@@ -29,6 +29,9 @@ struct TrackParams {
   // A match must beat the best one elsewhere on the line (more than 2 rows away) by this
   // factor; 1 disables it. Rejects repeated texture, the main source of outliers (§3.6).
   float distinctiveness = 0.8F;
+  // After the parabola, a few Gauss-Newton steps along the line on bilinearly sampled
+  // luma (a one-dimensional Lucas-Kanade): beats the parabola's bias towards whole pixels.
+  bool refine_along_line = true;
 };
 
 struct Track {
