@@ -2,6 +2,7 @@
 #include "algo/mapping/polygon_ops.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "segment_geometry.h"
@@ -17,24 +18,34 @@ Vec2d unit(const StarPolygon& p, std::size_t k) {
   return {std::cos(a), std::sin(a)};
 }
 
-Vec2d vertex_d(const StarPolygon& p, std::size_t k) {
-  return static_cast<double>(p.rho_m(k)) * unit(p, k);
-}
+// The polygon's vertices in double precision, computed once per operation.
+class Vertices {
+ public:
+  explicit Vertices(const StarPolygon& p) : n_(static_cast<std::ptrdiff_t>(p.vertex_count())) {
+    for (std::size_t k = 0; k < p.vertex_count(); ++k) {
+      unit_[k] = unit(p, k);
+      v_[k] = static_cast<double>(p.rho_m(k)) * unit_[k];
+    }
+  }
+  [[nodiscard]] Vec2d unit_at(std::size_t k) const { return unit_[k]; }
+  // Edge j joins vertex j and vertex j+1 (mod n); j may be any integer.
+  [[nodiscard]] Vec2d edge_start(std::ptrdiff_t j) const { return v_[wrap(j)]; }
+  [[nodiscard]] Vec2d edge_end(std::ptrdiff_t j) const { return v_[wrap(j + 1)]; }
 
-// Edge j joins vertex j and vertex j+1 (mod n).
-Vec2d edge_start(const StarPolygon& p, std::ptrdiff_t j) {
-  const auto n = static_cast<std::ptrdiff_t>(p.vertex_count());
-  return vertex_d(p, static_cast<std::size_t>(((j % n) + n) % n));
-}
-Vec2d edge_end(const StarPolygon& p, std::ptrdiff_t j) {
-  return edge_start(p, j + 1);
-}
+ private:
+  [[nodiscard]] std::size_t wrap(std::ptrdiff_t j) const {
+    return static_cast<std::size_t>(((j % n_) + n_) % n_);
+  }
+  std::ptrdiff_t n_;
+  std::array<Vec2d, kMaxPolygonVertices> unit_{};
+  std::array<Vec2d, kMaxPolygonVertices> v_{};
+};
 
-double min_edge_distance_to_centre(const StarPolygon& p) {
+double min_edge_distance_to_centre(const Vertices& v, std::size_t n) {
   double d = detail::kNoHit;
-  for (std::size_t j = 0; j < p.vertex_count(); ++j) {
+  for (std::size_t j = 0; j < n; ++j) {
     const auto jj = static_cast<std::ptrdiff_t>(j);
-    d = std::min(d, detail::point_segment_distance({0.0, 0.0}, edge_start(p, jj), edge_end(p, jj)));
+    d = std::min(d, detail::point_segment_distance({0.0, 0.0}, v.edge_start(jj), v.edge_end(jj)));
   }
   return d;
 }
@@ -50,10 +61,10 @@ std::ptrdiff_t edge_window(const StarPolygon& p, double radius, double d_min) {
 }
 
 // Clearance of the triangle (0, a, b) from the edges j ∈ [first, last] is at least R.
-bool triangle_clear(const StarPolygon& p, Vec2d a, Vec2d b, std::ptrdiff_t first,
-                    std::ptrdiff_t last, double radius) {
+bool triangle_clear(const Vertices& p, Vec2d a, Vec2d b, std::ptrdiff_t first, std::ptrdiff_t last,
+                    double radius) {
   for (std::ptrdiff_t j = first; j <= last; ++j) {
-    if (detail::triangle_segment_distance({0.0, 0.0}, a, b, edge_start(p, j), edge_end(p, j)) <
+    if (detail::triangle_segment_distance({0.0, 0.0}, a, b, p.edge_start(j), p.edge_end(j)) <
         radius) {
       return false;
     }
@@ -87,7 +98,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   out.set_vertex_count(n);
   // A tiny slack keeps the float-stored result on the safe side of the double computation.
   const double radius = static_cast<double>(radius_m) * (1.0 + 1e-9) + 1e-9;
-  const double d_min = min_edge_distance_to_centre(free_region);
+  // About 23 KB of stack for the largest polygon; nothing on the heap.
+  const Vertices verts(free_region);
+  const double d_min = min_edge_distance_to_centre(verts, n);
   if (!(d_min > radius)) {
     return false;  // out is all zero: the disc at the centre already touches the boundary
   }
@@ -97,12 +110,11 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   //    union of the edges' stadiums). The robot's centre can go that far along the ray and
   //    no farther.
   for (std::size_t k = 0; k < n; ++k) {
-    const Vec2d u = unit(free_region, k);
+    const Vec2d u = verts.unit_at(k);
     const auto kk = static_cast<std::ptrdiff_t>(k);
     double t = static_cast<double>(free_region.rho_m(k));
     for (std::ptrdiff_t j = kk - w - 1; j <= kk + w; ++j) {
-      t = std::min(t, detail::ray_stadium_hit(u, edge_start(free_region, j),
-                                              edge_end(free_region, j), radius));
+      t = std::min(t, detail::ray_stadium_hit(u, verts.edge_start(j), verts.edge_end(j), radius));
     }
     out.set_rho_m(k, round_down(t));
   }
@@ -116,11 +128,11 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     const auto kk = static_cast<std::ptrdiff_t>(k);
     const std::ptrdiff_t first = kk - w - 1;
     const std::ptrdiff_t last = kk + w + 1;
-    const Vec2d uk = unit(free_region, k);
-    const Vec2d uk1 = unit(free_region, k1);
+    const Vec2d uk = verts.unit_at(k);
+    const Vec2d uk1 = verts.unit_at(k1);
     double rk = static_cast<double>(out.rho_m(k));
     double rk1 = static_cast<double>(out.rho_m(k1));
-    if (triangle_clear(free_region, rk * uk, rk1 * uk1, first, last, radius)) {
+    if (triangle_clear(verts, rk * uk, rk1 * uk1, first, last, radius)) {
       continue;
     }
     // Largest clear length of one vertex with the other fixed (bisection; length 0 is
@@ -130,9 +142,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       double hi = move_k ? rk : rk1;
       for (int it = 0; it < 40; ++it) {
         const double mid = 0.5 * (lo + hi);
-        const bool clear =
-            move_k ? triangle_clear(free_region, mid * uk, other * uk1, first, last, radius)
-                   : triangle_clear(free_region, other * uk, mid * uk1, first, last, radius);
+        const bool clear = move_k
+                               ? triangle_clear(verts, mid * uk, other * uk1, first, last, radius)
+                               : triangle_clear(verts, other * uk, mid * uk1, first, last, radius);
         (clear ? lo : hi) = mid;
       }
       return lo;
@@ -153,11 +165,12 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
 
 float sweep_clearance_m(const StarPolygon& region, core::Point2 p) {
   const Vec2d q{static_cast<double>(p.x_m), static_cast<double>(p.y_m)};
+  const Vertices verts(region);
   double d = detail::kNoHit;
   for (std::size_t j = 0; j < region.vertex_count(); ++j) {
     const auto jj = static_cast<std::ptrdiff_t>(j);
-    d = std::min(d, detail::segment_segment_distance({0.0, 0.0}, q, edge_start(region, jj),
-                                                     edge_end(region, jj)));
+    d = std::min(d, detail::segment_segment_distance({0.0, 0.0}, q, verts.edge_start(jj),
+                                                     verts.edge_end(jj)));
   }
   return static_cast<float>(d);
 }

@@ -28,7 +28,7 @@ inline double cross(Vec2d a, Vec2d b) {
   return a.x * b.y - a.y * b.x;
 }
 inline double norm(Vec2d a) {
-  return std::hypot(a.x, a.y);
+  return std::sqrt(dot(a, a));
 }
 
 inline constexpr double kNoHit = std::numeric_limits<double>::infinity();

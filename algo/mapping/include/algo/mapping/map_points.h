@@ -20,7 +20,7 @@ struct MapPointParams {
   float obstacle_merge_radius_m = 0.1F;
   float exploration_merge_radius_m = 0.35F;  // likewise for exploration points [m]
   // An exploration point this far inside a later free polygon has been explored [m].
-  float explored_margin_m = 0.3F;
+  float explored_margin_m = 0.1F;
 };
 
 // §5.4.4: splits the free polygon's boundary (robot frame) into sectors on the bounding
