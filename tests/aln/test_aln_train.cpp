@@ -163,7 +163,7 @@ TEST(AlnTrain, FitsTheCylindricalRoomToEpsilonWithEveryPieceInsideItsBounds) {
 }
 
 TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
-  const std::size_t n = fill_room(4000, 0.03, 8);
+  const std::size_t n = fill_room(2500, 0.03, 8);
   set_room_ranges(g_model3);
   set_room_ranges(g_model3b);
   aln::TrainerConfig cfg;
@@ -201,7 +201,7 @@ TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
 }
 
 TEST(AlnTrain, RobustWeightsStopOutliersForcingExtraPieces) {
-  const std::size_t n = fill_room(6000, 0.05, 31);
+  const std::size_t n = fill_room(4000, 0.05, 31);
   set_room_ranges(g_model3);
   set_room_ranges(g_model3b);
   aln::TrainerConfig cfg;

@@ -110,7 +110,9 @@ void bench_model(std::size_t cap) {
   g_trainer.configure(cfg);
   g_trainer.train(aln::SampleSet<float, 3>(g_samples, kSamples), g_model);
   const std::size_t pieces = g_model.piece_count();
+  const std::int64_t c0 = boticelli::bench::now_ns();
   const bool dtree_ok = g_dtree.compile(g_model);
+  const double compile_ms = static_cast<double>(boticelli::bench::now_ns() - c0) * 1e-6;
   const bool fixed_ok = g_fixed.compile(g_model);
   std::size_t t_plain = 0;
   std::size_t t_ab = 0;
@@ -158,6 +160,7 @@ void bench_model(std::size_t cap) {
       .num("touched_dtree", per(t_dt))
       .num("touched_fixed", per(t_fx))
       .integer("dtree_blocks", static_cast<std::int64_t>(g_dtree.block_count()))
+      .num("dtree_compile_ms", compile_ms)
       .flag("dtree_ok", dtree_ok)
       .flag("fixed_ok", fixed_ok)
       .emit();
