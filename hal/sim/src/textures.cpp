@@ -5,46 +5,59 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace boticelli::hal::sim {
 namespace {
 
-// Periodic value noise in [0, 1]: lattice of `cells_x` x `cells_y` cells over the texture.
-float value_noise(std::uint32_t seed, float x, float y, std::uint32_t cells_x,
-                  std::uint32_t cells_y) {
-  const float fx = x * static_cast<float>(cells_x) / static_cast<float>(kTextureSize);
-  const float fy = y * static_cast<float>(cells_y) / static_cast<float>(kTextureSize);
-  const float x0f = std::floor(fx);
-  const float y0f = std::floor(fy);
-  const std::uint32_t x0 = static_cast<std::uint32_t>(x0f) % cells_x;
-  const std::uint32_t y0 = static_cast<std::uint32_t>(y0f) % cells_y;
-  const std::uint32_t x1 = (x0 + 1U) % cells_x;
-  const std::uint32_t y1 = (y0 + 1U) % cells_y;
-  auto lattice = [&](std::uint32_t cx, std::uint32_t cy) {
-    return static_cast<float>(hash32(seed ^ hash32(cx * 0x9E3779B1U + hash32(cy + 0x1234567U))) >>
-                              8U) /
-           16777216.0F;
-  };
-  float tx = fx - x0f;
-  float ty = fy - y0f;
-  tx = tx * tx * (3.0F - 2.0F * tx);  // smoothstep
-  ty = ty * ty * (3.0F - 2.0F * ty);
-  const float a = lattice(x0, y0) + (lattice(x1, y0) - lattice(x0, y0)) * tx;
-  const float b = lattice(x0, y1) + (lattice(x1, y1) - lattice(x0, y1)) * tx;
-  return a + (b - a) * ty;
-}
+// Periodic value noise in [0, 1] on a lattice of cells_x x cells_y cells over the texture:
+// the lattice values are hashed once, then every texel interpolates (smoothstep) between them.
+class ValueNoise {
+ public:
+  ValueNoise(std::uint32_t seed, std::uint32_t cells_x, std::uint32_t cells_y)
+      : cells_x_(cells_x), cells_y_(cells_y), lattice_(cells_x * cells_y) {
+    for (std::uint32_t cy = 0; cy < cells_y; ++cy) {
+      for (std::uint32_t cx = 0; cx < cells_x; ++cx) {
+        const std::uint32_t h = hash32(seed ^ hash32(cx * 0x9E3779B1U + hash32(cy + 0x1234567U)));
+        lattice_[cy * cells_x + cx] = static_cast<float>(h >> 8U) / 16777216.0F;
+      }
+    }
+  }
+  // At texel (x, y) of the texture.
+  float at(std::uint32_t x, std::uint32_t y) const {
+    const std::uint32_t span_x = kTextureSize / cells_x_;  // texels per cell
+    const std::uint32_t span_y = kTextureSize / cells_y_;
+    const std::uint32_t x0 = x / span_x;
+    const std::uint32_t y0 = y / span_y;
+    const std::uint32_t x1 = (x0 + 1U) % cells_x_;
+    const std::uint32_t y1 = (y0 + 1U) % cells_y_;
+    float tx = static_cast<float>(x % span_x) / static_cast<float>(span_x);
+    float ty = static_cast<float>(y % span_y) / static_cast<float>(span_y);
+    tx = tx * tx * (3.0F - 2.0F * tx);  // smoothstep
+    ty = ty * ty * (3.0F - 2.0F * ty);
+    const float* row0 = &lattice_[y0 * cells_x_];
+    const float* row1 = &lattice_[y1 * cells_x_];
+    const float a = row0[x0] + (row0[x1] - row0[x0]) * tx;
+    const float b = row1[x0] + (row1[x1] - row1[x0]) * tx;
+    return a + (b - a) * ty;
+  }
+
+ private:
+  std::uint32_t cells_x_;
+  std::uint32_t cells_y_;
+  std::vector<float> lattice_;  // built at init only
+};
 
 void make_camouflage(std::uint32_t seed, std::uint8_t* out) {
   constexpr std::uint32_t kBlotchCells = kTextureSize / static_cast<std::uint32_t>(kTexelsPerScale);
   // Four cloth tones (intensity factors x128): dark, mid, light, pale.
   constexpr std::uint8_t kTones[4] = {38, 96, 150, 210};
+  const ValueNoise coarse(seed, kBlotchCells, kBlotchCells);
+  const ValueNoise medium(seed + 101U, 2 * kBlotchCells, 2 * kBlotchCells);
+  const ValueNoise fine(seed + 202U, 4 * kBlotchCells, 4 * kBlotchCells);
   for (std::uint32_t y = 0; y < kTextureSize; ++y) {
     for (std::uint32_t x = 0; x < kTextureSize; ++x) {
-      const float fx = static_cast<float>(x);
-      const float fy = static_cast<float>(y);
-      const float n = 0.62F * value_noise(seed, fx, fy, kBlotchCells, kBlotchCells) +
-                      0.28F * value_noise(seed + 101U, fx, fy, 2 * kBlotchCells, 2 * kBlotchCells) +
-                      0.10F * value_noise(seed + 202U, fx, fy, 4 * kBlotchCells, 4 * kBlotchCells);
+      const float n = 0.62F * coarse.at(x, y) + 0.28F * medium.at(x, y) + 0.10F * fine.at(x, y);
       const int tone = n < 0.40F ? 0 : (n < 0.50F ? 1 : (n < 0.60F ? 2 : 3));
       out[y * kTextureSize + x] = kTones[tone];
     }
@@ -56,12 +69,11 @@ void make_leaves(std::uint32_t seed, std::uint8_t* out) {
   // vertical.
   constexpr std::uint32_t kAcross = kTextureSize / 2U;
   constexpr std::uint32_t kAlong = kTextureSize / 32U;
+  const ValueNoise streaks(seed, kAcross, kAlong);
+  const ValueNoise broad(seed + 77U, kAcross / 2U, kAlong / 2U);
   for (std::uint32_t y = 0; y < kTextureSize; ++y) {
     for (std::uint32_t x = 0; x < kTextureSize; ++x) {
-      const float fx = static_cast<float>(x);
-      const float fy = static_cast<float>(y);
-      const float n = 0.7F * value_noise(seed, fx, fy, kAcross, kAlong) +
-                      0.3F * value_noise(seed + 77U, fx, fy, kAcross / 2U, kAlong / 2U);
+      const float n = 0.7F * streaks.at(x, y) + 0.3F * broad.at(x, y);
       out[y * kTextureSize + x] = static_cast<std::uint8_t>(std::lround(70.0F + 120.0F * n));
     }
   }
