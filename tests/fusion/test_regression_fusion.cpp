@@ -1,5 +1,4 @@
-// §4.4.2: the independent opinion pool reinforces a repeated poor reading; regression fusion does
-// not.
+// §4.4.2: independent opinion reinforces a repeated poor reading; regression does not.
 #include <cmath>
 #include <cstddef>
 

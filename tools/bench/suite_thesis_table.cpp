@@ -1,5 +1,4 @@
-// Benchmark suite "thesis-table": the regression-fusion table of thesis §4.8.2, with a grid
-// baseline.
+// Bench suite "thesis-table": the regression-fusion table of thesis §4.8.2 beside a grid.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,4 @@
-// Ray samples of the visual sensor model (Fig 3.8b, 4.2b): a Reading becomes a few regression
-// samples.
+// Ray samples of the visual sensor model (Fig 3.8b, 4.2b): a Reading becomes a few samples.
 #pragma once
 
 #include <cstddef>

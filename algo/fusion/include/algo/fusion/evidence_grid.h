@@ -1,5 +1,4 @@
-// A 3-D log-odds evidence grid over a bounded box (the grid baseline the thesis argues against,
-// §4.5.1, §5.2).
+// 3-D log-odds evidence grid over a bounded box: the baseline the thesis argues against.
 #pragma once
 
 #include <array>
