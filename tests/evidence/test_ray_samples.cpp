@@ -12,7 +12,7 @@ using namespace boticelli;
 using namespace boticelli::evidence;
 
 TEST_GROUP(RaySamples) {
-  core::FixedVector<RaySample, 256> samples;
+  core::FixedVector<RaySample, 512> samples;
   RaySampleParams params;
   const Reading reading{1.0F, 0.6F, 3.0F, 0.9F};  // α = 1 rad, h = 0.6 m, r = 3 m, m = 0.9
 };
@@ -103,10 +103,11 @@ TEST(RaySamples, ManyReadingsExpandWithoutAllocating) {
     (void)readings.push_back({0.2F * static_cast<float>(i), 0.1F, 2.0F, 0.8F});
   }
   std::size_t fitted = 0;
-  CHECK_NO_ALLOCATION(
-      fitted = append_ray_samples(readings.span(), params, OccupancyBound::kPlausibility, samples));
+  CHECK_NO_ALLOCATION(fitted = append_ray_samples(readings.span(), params, samples));
   LONGS_EQUAL(32, fitted);
   LONGS_EQUAL(160, samples.size());
+  LONGS_EQUAL(32, append_ray_samples(readings.span(), params, samples, OccupancyBound::kBelief));
+  LONGS_EQUAL(160 + 32 * 8, samples.size());
 }
 
 TEST(RaySamples, SeamCopiesMirrorSamplesNearZeroAndTwoPi) {

@@ -252,8 +252,7 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
                                      std::size_t* pad_count) {
   g_ray_samples.clear();
   const evidence::RaySampleParams params;
-  (void)evidence::append_ray_samples(readings, params, evidence::OccupancyBound::kPlausibility,
-                                     g_ray_samples);
+  (void)evidence::append_ray_samples(readings, params, g_ray_samples);
   *pad_count = 0;
   if (pads) {
     evidence::PadRegion region;

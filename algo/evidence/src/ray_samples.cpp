@@ -76,7 +76,7 @@ std::size_t append_belief_samples(const Reading& reading, const RaySampleParams&
 }
 
 std::size_t append_ray_samples(std::span<const Reading> readings, const RaySampleParams& params,
-                               OccupancyBound bound, RaySampleBuffer& out) {
+                               RaySampleBuffer& out, OccupancyBound bound) {
   std::size_t fitted = 0;
   for (const Reading& reading : readings) {
     const std::size_t added = bound == OccupancyBound::kPlausibility

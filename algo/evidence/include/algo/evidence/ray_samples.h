@@ -62,8 +62,10 @@ std::size_t append_belief_samples(const Reading& reading, const RaySampleParams&
 enum class OccupancyBound : std::uint8_t { kPlausibility, kBelief };
 
 // All readings, all or nothing per reading; returns the number of readings that fitted.
+// Plausibility (monotone in r) is the thesis's model and the default.
 std::size_t append_ray_samples(std::span<const Reading> readings, const RaySampleParams& params,
-                               OccupancyBound bound, RaySampleBuffer& out);
+                               RaySampleBuffer& out,
+                               OccupancyBound bound = OccupancyBound::kPlausibility);
 
 // §4.9.1 discontinuity at α = 0/2π: every sample among the first `count` of `samples`
 // with α < margin gets a copy at α + 2π, every one with α > 2π − margin a copy at α − 2π.
