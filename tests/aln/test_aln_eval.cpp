@@ -97,6 +97,26 @@ TEST(AlnEval, DtreeKeepsAboutNPlusOnePiecesPerBlock) {
   CHECK(g_dtree.mean_block_pieces() <= 4.5);
 }
 
+TEST(AlnEval, DtreeWithSmallCapacityCompilesShallowerAndStaysExact) {
+  aln_test::Rng rng(13);
+  aln_test::random_model(g_model, 48, rng);
+  static aln::Dtree<float, 3, 128, 100, 8192, 64> small;
+  CHECK(small.compile(g_model, 10));
+  CHECK(small.depth_used() < 10);
+  for (int k = 0; k < 5000; ++k) {
+    const auto x = aln_test::random_point<Model3::Vec>(rng);
+    const auto plain = g_model.evaluate(x);
+    const auto dt = small.evaluate(x);
+    CHECK(plain.value == dt.value);
+    LONGS_EQUAL(plain.piece, dt.piece);
+  }
+  // Too few block nodes for even one block per cell: refused, and evaluation says so.
+  static aln::Dtree<float, 3, 128, 100, 64, 64> tiny;
+  CHECK_FALSE(tiny.compile(g_model));
+  CHECK_FALSE(tiny.valid());
+  CHECK(std::isnan(tiny.evaluate(Model3::Vec(0.5F, 0.5F, 0.5F)).value));
+}
+
 TEST(AlnEval, DtreeAndAlphaBetaWorkInDoubleAndOneDimension) {
   aln_test::Rng rng(3);
   static aln::Aln<double, 1, 16> f;

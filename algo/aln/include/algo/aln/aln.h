@@ -118,6 +118,7 @@ class Aln {
     node_count_ = 1;
     piece_node_[0] = 0;
     post_order_[0] = 0;
+    ops_[0] = Op{NodeKind::kPiece, 0};
     depth_ = 1;
   }
   // Replaces the leaf holding piece `p` by kind(first, second): `first` keeps index p,
@@ -210,20 +211,18 @@ class Aln {
     std::array<std::uint16_t, MaxPieces> who;
     std::size_t top = 0;
     for (std::size_t k = 0; k < node_count_; ++k) {
-      const Node& n = nodes_[post_order_[k]];
-      if (n.kind == NodeKind::kPiece) {
-        value[top] = pieces_[n.a].value(x);
-        who[top] = n.a;
+      const Op op = ops_[k];
+      if (op.kind == NodeKind::kPiece) {
+        value[top] = pieces_[op.piece].value(x);
+        who[top] = op.piece;
         ++top;
       } else {
         --top;
         const Scalar second = value[top];
         const Scalar first = value[top - 1];
-        const bool take_second = n.kind == NodeKind::kMax ? second > first : second < first;
-        if (take_second) {
-          value[top - 1] = second;
-          who[top - 1] = who[top];
-        }
+        const bool take_second = op.kind == NodeKind::kMax ? second > first : second < first;
+        value[top - 1] = take_second ? second : first;
+        who[top - 1] = take_second ? who[top] : who[top - 1];
       }
     }
     return {value[0], who[0], static_cast<std::uint16_t>(piece_count_)};
@@ -235,8 +234,8 @@ class Aln {
   [[nodiscard]] EvalResult<Scalar> evaluate_alpha_beta(const Vec& x) const {
     EvalResult<Scalar> r{};
     std::uint16_t touched = 0;
-    ab(0, x, -std::numeric_limits<Scalar>::infinity(), std::numeric_limits<Scalar>::infinity(), r,
-       touched);
+    r.value = ab(0, x, -std::numeric_limits<Scalar>::infinity(),
+                 std::numeric_limits<Scalar>::infinity(), r.piece, touched);
     r.pieces_evaluated = touched;
     return r;
   }
@@ -246,26 +245,52 @@ class Aln {
  private:
   static std::size_t idx(int i) { return static_cast<std::size_t>(i); }
 
-  void ab(std::size_t n, const Vec& x, Scalar lo, Scalar hi, EvalResult<Scalar>& out,
-          std::uint16_t& touched) const {
+  // Value of the subtree at node n, exact if it lies in (lo, hi), else some value on the
+  // same side of the window (which the ancestors then ignore). Leaf children are
+  // evaluated in place rather than by a call.
+  Scalar child(std::uint16_t n, const Vec& x, Scalar lo, Scalar hi, std::uint16_t& piece,
+               std::uint16_t& touched) const {
     const Node& node = nodes_[n];
     if (node.kind == NodeKind::kPiece) {
-      out.value = pieces_[node.a].value(x);
-      out.piece = node.a;
+      piece = node.a;
       ++touched;
-      return;
+      return pieces_[node.a].value(x);
     }
-    ab(node.a, x, lo, hi, out, touched);
-    EvalResult<Scalar> second{};
+    return ab(n, x, lo, hi, piece, touched);
+  }
+
+  Scalar ab(std::size_t n, const Vec& x, Scalar lo, Scalar hi, std::uint16_t& piece,
+            std::uint16_t& touched) const {
+    const Node& node = nodes_[n];
+    if (node.kind == NodeKind::kPiece) {
+      piece = node.a;
+      ++touched;
+      return pieces_[node.a].value(x);
+    }
+    std::uint16_t p1 = 0;
+    const Scalar v1 = child(node.a, x, lo, hi, p1, touched);
+    std::uint16_t p2 = 0;
     if (node.kind == NodeKind::kMax) {
-      if (out.value >= hi) return;  // a MIN ancestor will not take anything this large
-      ab(node.b, x, out.value > lo ? out.value : lo, hi, second, touched);
-      if (second.value > out.value) out = second;
+      // A MIN ancestor will not take anything >= hi.
+      if (v1 < hi) {
+        const Scalar v2 = child(node.b, x, v1 > lo ? v1 : lo, hi, p2, touched);
+        if (v2 > v1) {
+          piece = p2;
+          return v2;
+        }
+      }
     } else {
-      if (out.value <= lo) return;  // a MAX ancestor will not take anything this small
-      ab(node.b, x, lo, out.value < hi ? out.value : hi, second, touched);
-      if (second.value < out.value) out = second;
+      // A MAX ancestor will not take anything <= lo.
+      if (v1 > lo) {
+        const Scalar v2 = child(node.b, x, lo, v1 < hi ? v1 : hi, p2, touched);
+        if (v2 < v1) {
+          piece = p2;
+          return v2;
+        }
+      }
     }
+    piece = p1;
+    return v1;
   }
 
   // Recomputes the post order and the depth (iteratively).
@@ -285,6 +310,7 @@ class Aln {
       const Node& n = nodes_[f.node];
       if (f.depth > depth_) depth_ = f.depth;
       if (n.kind == NodeKind::kPiece || f.expanded) {
+        ops_[k] = Op{n.kind, n.kind == NodeKind::kPiece ? n.a : std::uint16_t{0}};
         post_order_[k++] = f.node;
         --top;
         continue;
@@ -301,6 +327,11 @@ class Aln {
   std::array<Node, kMaxNodes> nodes_{};
   std::array<std::size_t, MaxPieces> piece_node_{};
   std::array<std::uint16_t, kMaxNodes> post_order_{};
+  struct Op {
+    NodeKind kind = NodeKind::kPiece;
+    std::uint16_t piece = 0;
+  };
+  std::array<Op, kMaxNodes> ops_{};  // post order, for evaluate()
   std::array<Range<Scalar>, static_cast<std::size_t>(N)> input_range_{};
   Range<Scalar> output_range_{};
   std::array<Scalar, static_cast<std::size_t>(N)> weight_lo_{};

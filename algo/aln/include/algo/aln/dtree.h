@@ -48,11 +48,31 @@ class Dtree {
   }();
   static_assert(MaxBlocks >= 1 && MaxBlocks < (1U << 30), "block capacity");
   static_assert(MaxBlockNodes < (1U << 31), "block node capacity");
+  static_assert(kGridCells <= MaxBlocks, "every grid cell needs a block");
 
-  // Compiles `model`; max_depth bounds the number of thresholds on a query's path (and the
-  // compiler's recursion). False if the capacities were too small (the DTREE is then empty).
-  bool compile(const Model& model, std::size_t max_depth = 10) {
+  // Compiles `model`; max_depth bounds the number of thresholds below a grid cell on a
+  // query's path (and the compiler's recursion). If the capacities are too small for that
+  // depth, compiles again with less depth. False if even depth 0 does not fit: then
+  // evaluate() returns NaN until a compile succeeds.
+  // block_pieces: a block with at most this many pieces is not split further (N + 1 by
+  // default, thesis §4.7.2; more gives fewer thresholds per query).
+  bool compile(const Model& model, std::size_t max_depth = 10,
+               std::size_t block_pieces = static_cast<std::size_t>(N) + 1) {
+    target_ = block_pieces > 0 ? block_pieces : 1;
+    for (std::size_t depth = max_depth;; --depth) {
+      if (compile_at(model, depth)) return true;
+      if (depth == 0) return false;
+    }
+  }
+
+  [[nodiscard]] bool valid() const { return ok_; }
+  // The depth the last successful compile used.
+  [[nodiscard]] std::size_t depth_used() const { return depth_used_; }
+
+ private:
+  bool compile_at(const Model& model, std::size_t max_depth) {
     model_ = &model;
+    depth_used_ = max_depth;
     splits_used_ = 0;
     blocks_used_ = 0;
     pool_used_ = 0;
@@ -96,7 +116,9 @@ class Dtree {
     return ok_;
   }
 
+ public:
   [[nodiscard]] EvalResult<Scalar> evaluate(const Vec& x) const {
+    if (!ok_) return {std::numeric_limits<Scalar>::quiet_NaN(), 0, 0};
     std::size_t cell = 0;
     std::size_t stride = 1;
     for (int i = 0; i < N; ++i) {
@@ -275,9 +297,13 @@ class Dtree {
                      std::size_t stale = 0) {
     if (!ok_) return -1;
     const std::size_t here = analyse(lo, hi);
-    const std::size_t target = static_cast<std::size_t>(N) + 1;
-    if (here <= target || depth >= max_depth || splits_used_ >= kMaxSplits ||
-        kGridCells + splits_used_ + 1 > MaxBlocks) {
+    const std::size_t target = target_;
+    if (here > target && depth < max_depth &&
+        (splits_used_ >= kMaxSplits || kGridCells + splits_used_ + 1 > MaxBlocks)) {
+      ok_ = false;  // out of blocks: compile() tries again with less depth
+      return -1;
+    }
+    if (here <= target || depth >= max_depth) {
       std::int32_t code = -1;
       if (!emit_block(code)) ok_ = false;
       return code;
@@ -326,6 +352,8 @@ class Dtree {
 
   const Model* model_ = nullptr;
   bool ok_ = false;
+  std::size_t depth_used_ = 0;
+  std::size_t target_ = static_cast<std::size_t>(N) + 1;
   std::array<std::int32_t, kGridCells> cell_root_{};
   Vec cell_origin_ = Vec::Zero();
   Vec cell_scale_ = Vec::Zero();
