@@ -311,3 +311,35 @@ TEST(ConstrainedLsq, TheSolutionMeetsTheOptimalityConditionsAndBeatsClipping) {
   }
   CHECK(constrained > 500);
 }
+
+TEST(AlnTrain, TrainsInOneAndFourDimensions) {
+  static aln::Sample<double, 1> s1[400];
+  static aln::Aln<double, 1, 8> m1;
+  static aln::Trainer<double, 1, 8> t1;
+  aln_test::Rng rng(71);
+  for (auto& s : s1) {
+    s.x(0) = rng.uniform(-1.0, 1.0);
+    s.y = std::fabs(s.x(0) - 0.2);
+  }
+  m1.set_input_range(0, -1.0, 1.0);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 1e-6;
+  t1.configure(cfg);
+  CHECK(t1.train(aln::SampleSet<double, 1>(s1), m1));
+  LONGS_EQUAL(2, m1.piece_count());
+  DOUBLES_EQUAL(0.5, m1.evaluate(Eigen::Matrix<double, 1, 1>(0.7)).value, 1e-6);
+
+  static aln::Sample<float, 4> s4[3000];
+  static aln::Aln<float, 4, 16> m4;
+  static aln::Trainer<float, 4, 16> t4;
+  for (auto& s : s4) {
+    for (int i = 0; i < 4; ++i) s.x(i) = static_cast<float>(rng.uniform(0.0, 1.0));
+    s.y = std::fmax(s.x(0) + 0.5F * s.x(3), 1.2F - s.x(1) + 0.25F * s.x(2));
+  }
+  for (int i = 0; i < 4; ++i) m4.set_input_range(i, 0.0F, 1.0F);
+  cfg.epsilon = 1e-3;
+  t4.configure(cfg);
+  CHECK(t4.train(aln::SampleSet<float, 4>(s4), m4));
+  CHECK(m4.piece_count() <= 2);
+  CHECK(t4.stats().rms < 1e-3);
+}

@@ -24,7 +24,8 @@ namespace boticelli::aln {
 // depth limit allows. evaluate() walks the thresholds and evaluates the block's small tree:
 // about N + 1 pieces per query (thesis §4.7.2). Exact (same value and piece as
 // Aln::evaluate) for inputs inside the model's input box; callers clamp inputs to it.
-// Storage: MaxSplits threshold nodes, MaxBlocks blocks, MaxBlockNodes nodes over all blocks.
+// Storage: MaxBlocks blocks (and as many thresholds), MaxBlockNodes nodes over all blocks,
+// MaxGridCells grid cells: about 0.5 MB with the defaults for <float, 3, 256>: make it static.
 template <typename Scalar, int N, std::size_t MaxPieces, std::size_t MaxBlocks = 8192,
           std::size_t MaxBlockNodes = 65536, std::size_t MaxGridCells = 512>
 class Dtree {
