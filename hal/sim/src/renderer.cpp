@@ -22,6 +22,11 @@ struct Renderer::Candidate {
   float min_x, min_y, max_x, max_y;   // bounds in normalised image coordinates
   float min_z;                        // nearest z-depth of the bounds [m]
   bool visible;
+  // Boxes seen from outside: the faces a ray can enter through are those whose plane has the
+  // optical centre on its outer side (at most three; for a wall usually one).
+  int entry_count;                    // −1: the camera is inside the box
+  int entry_axis[3];
+  float entry_plane[3];               // ±half size on that axis [m]
 };
 
 struct Renderer::FrameSetup {
@@ -71,6 +76,27 @@ inline bool hit_box(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const Ei
   hit.t = t;
   hit.face = t_near > kNear_m ? face_near : face_far;
   return true;
+}
+
+// The same box for a ray from outside it: only the faces facing the origin can be entered,
+// and a ray enters a convex body through at most one face.
+inline bool hit_box_from_outside(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                                 const Eigen::Vector3f& h, int count, const int* axes,
+                                 const float* planes, float best, Hit& hit) {
+  for (int k = 0; k < count; ++k) {
+    const int a = axes[k];
+    const float gap = planes[k] - o[a];  // from the origin to the face's plane
+    if (gap * d[a] <= 0.0F) continue;    // moving away from (or along) that face
+    const float t = gap / d[a];
+    if (t <= kNear_m || t >= best) continue;
+    const int b = a == 0 ? 1 : 0;
+    const int c = a == 2 ? 1 : 2;
+    if (std::fabs(o[b] + t * d[b]) <= h[b] && std::fabs(o[c] + t * d[c]) <= h[c]) {
+      hit = {t, 2 * a + (planes[k] < 0.0F ? 1 : 0)};
+      return true;
+    }
+  }
+  return false;
 }
 
 // Cylinder along z, radius h.x, half length h.z. Faces: 0 side, 4 top, 5 bottom.
@@ -281,6 +307,19 @@ void Renderer::setup_frame(const RigidTransform& world_from_camera, FrameSetup& 
       }
     }
     c.visible = c.min_x <= c.max_x;
+    c.entry_count = 0;
+    if (s.shape == Shape::kBox) {
+      for (int a = 0; a < 3; ++a) {
+        if (c.origin_local[a] > h[a]) {
+          c.entry_axis[c.entry_count] = a;
+          c.entry_plane[c.entry_count++] = h[a];
+        } else if (c.origin_local[a] < -h[a]) {
+          c.entry_axis[c.entry_count] = a;
+          c.entry_plane[c.entry_count++] = -h[a];
+        }
+      }
+      if (c.entry_count == 0) c.entry_count = -1;
+    }
   }
 }
 
@@ -341,7 +380,13 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
                                         c.local_from_camera.col(1) * d_cam.y() +
                                         c.local_from_camera.col(2);
               Hit hit;
-              if (hit_surface(world.surfaces[list[n]], c.origin_local, d, best.t, hit)) {
+              const Surface& s = world.surfaces[list[n]];
+              const bool found = (s.shape == Shape::kBox && c.entry_count > 0)
+                                     ? hit_box_from_outside(c.origin_local, d, s.half_size_m,
+                                                            c.entry_count, c.entry_axis,
+                                                            c.entry_plane, best.t, hit)
+                                     : hit_surface(s, c.origin_local, d, best.t, hit);
+              if (found) {
                 best = hit;
                 best_surface = list[n];
                 best_d = d;
