@@ -15,7 +15,7 @@ namespace boticelli::aln {
 // is the former output; the output of `out` is the former input k. So for the occupancy
 // model m = F(alpha, h, r) (inputs 0, 1, 2) and k = 2, out is r = F^-1(alpha, h, m).
 // Each piece y = c_y + sum_i w_i (x_i - c_i) is solved for x_k (its weights divided by -w_k,
-// so the new output weight is -1 in the Eq 5.5 form); its centroid stays the same point.
+// so the output weight is -1 again in the Eq 5.5 form); its centroid stays the same point.
 // Node kinds: MIN and MAX swap when F increases in x_k, and stay when it decreases.
 // Exact for the unfilleted function: F(x with x_k = F^-1(x with x_k = m)) = m.
 // Ranges move with their variables. Weight bounds of `out`: unbounded, except input k,

@@ -464,7 +464,7 @@ class Trainer {
       }
     }
     if (dead == 0 || alive[0] == 0) return;
-    // Copy the live tree top-down into new arrays (explicit stack, no recursion).
+    // Copy the live tree top-down into scratch arrays (explicit stack, no recursion).
     struct Job {
       std::uint16_t from;
       std::uint16_t to;
