@@ -2,6 +2,7 @@
 #include "firmware/firmware_main.h"
 
 #include <csignal>
+#include <optional>
 #include <cstdio>
 #include <ctime>
 
@@ -36,6 +37,36 @@ double wall_seconds() {
 MissionState g_state;
 StateStore g_store;
 ParameterTable g_parameters;
+
+// Everything that is bound to the board's devices, rebuilt in place for each run (static
+// storage, no heap; firmware_main may be called again, e.g. by tests).
+struct Runtime {
+  Runtime(hal::Hal& hal, const BoardConfig& config, StateStore* store)
+      : executive(hal.clock),
+        safety(hal.estop, hal.bumper, hal.base),
+        mission(hal.base, hal.pan_tilt, hal.clock, g_state, store,
+                config.checkpoint_period_ms * 1000U),
+        console(hal.console, executive, safety, mission, g_parameters),
+        estop_task(safety),
+        base_task(hal.base, safety),
+        ptu_task(hal.pan_tilt),
+        camera_task(hal.camera),
+        console_task(console),
+        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {}
+
+  ServiceNotifier notifier;
+  Executive executive;
+  Safety safety;
+  IdleMission mission;
+  Console console;
+  EstopTask estop_task;
+  BaseTask base_task;
+  PanTiltTask ptu_task;
+  CameraTask camera_task;
+  ConsoleTask console_task;
+  WatchdogTask watchdog_task;
+};
+std::optional<Runtime> g_runtime;
 
 int fail(const char* what, const char* why) {
   std::fprintf(stderr, "boticelli: %s%s%s\n", what, why[0] != '\0' ? ": " : "", why);
@@ -102,23 +133,19 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
       std::fprintf(stderr, "boticelli: watchdog not armed (%s)\n", hal.watchdog.error());
     }
   }
-  static ServiceNotifier notifier;
+  g_parameters = ParameterTable{};
+  g_runtime.emplace(hal, config, store);
+  Runtime& rt = *g_runtime;
+  ServiceNotifier& notifier = rt.notifier;
   if (!notifier.open()) std::fprintf(stderr, "boticelli: %s\n", notifier.error());
+  Executive& executive = rt.executive;
+  Safety& safety = rt.safety;
+  IdleMission& mission = rt.mission;
+  Console& console = rt.console;
 
   // The executive and its tasks.
-  static Executive executive(hal.clock);
-  static Safety safety(hal.estop, hal.bumper, hal.base);
-  static IdleMission mission(hal.base, hal.pan_tilt, hal.clock, g_state, store,
-                             config.checkpoint_period_ms * 1000U);
-  static Console console(hal.console, executive, safety, mission, g_parameters);
-  static EstopTask estop_task(safety);
-  static BaseTask base_task(hal.base, safety);
-  static PanTiltTask ptu_task(hal.pan_tilt);
-  static CameraTask camera_task(hal.camera);
-  static ConsoleTask console_task(console);
-  static WatchdogTask watchdog_task(executive, hal.watchdog, notifier, hal.status_led);
-  Task* const tasks[kTaskCount] = {&estop_task,  &base_task,    &ptu_task,
-                                   &camera_task, &console_task, &watchdog_task};
+  Task* const tasks[kTaskCount] = {&rt.estop_task,  &rt.base_task,    &rt.ptu_task,
+                                   &rt.camera_task, &rt.console_task, &rt.watchdog_task};
   const char* why = "";
   for (std::size_t i = 0; i < kTaskCount; ++i) {
     if (!executive.add_task(kTaskTable[i], *tasks[i], &why)) return fail("executive", why);
@@ -134,9 +161,9 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   }
 
   if (config.realtime) {
-    RealtimeConfig rt;
-    rt.fifo_priority = config.fifo_priority;
-    const RealtimeReport report = prepare_realtime(rt);
+    RealtimeConfig realtime;
+    realtime.fifo_priority = config.fifo_priority;
+    const RealtimeReport report = prepare_realtime(realtime);
     std::fprintf(stderr, "boticelli: %s\n", report.message);
   }
 
@@ -196,6 +223,8 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
       static_cast<unsigned long long>(safety.collisions()), sim_time_s,
       wall_seconds() - wall_start_s);
   std::fflush(stdout);
+  g_runtime.reset();
+  g_signal = 0;
   return kExitNotFound;
 }
 

@@ -332,13 +332,36 @@ bool StateStore::save(const MissionState& state, char* error, std::size_t error_
     std::snprintf(error, error_size, "state does not fit the file buffer");
     return false;
   }
+  auto crashed = [&](SaveStep step) {
+    if (crash_hook_ == nullptr || !crash_hook_(step, crash_context_)) return false;
+    std::snprintf(error, error_size, "save interrupted (test crash hook)");
+    return true;
+  };
   const int fd = ::open(tmp_path_.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
   if (fd < 0) {
     set_error(error, error_size, "cannot create", tmp_path_.data());
     return false;
   }
-  if (!write_all(fd, buffer_.data(), size) || ::fsync(fd) != 0) {
-    set_error(error, error_size, "cannot write", tmp_path_.data());
+  if (crashed(SaveStep::kTempCreated)) {
+    ::close(fd);
+    return false;
+  }
+  for (std::size_t done = 0; done < size;) {
+    const std::size_t n = size - done < kWriteChunkBytes ? size - done : kWriteChunkBytes;
+    if (!write_all(fd, buffer_.data() + done, n)) {
+      set_error(error, error_size, "cannot write", tmp_path_.data());
+      ::close(fd);
+      ::unlink(tmp_path_.data());
+      return false;
+    }
+    done += n;
+    if (crashed(SaveStep::kChunkWritten)) {
+      ::close(fd);
+      return false;
+    }
+  }
+  if (::fsync(fd) != 0) {
+    set_error(error, error_size, "cannot sync", tmp_path_.data());
     ::close(fd);
     ::unlink(tmp_path_.data());
     return false;
@@ -348,11 +371,13 @@ bool StateStore::save(const MissionState& state, char* error, std::size_t error_
     ::unlink(tmp_path_.data());
     return false;
   }
+  if (crashed(SaveStep::kTempSynced)) return false;
   if (::rename(tmp_path_.data(), path_.data()) != 0) {
     set_error(error, error_size, "cannot rename onto", path_.data());
     ::unlink(tmp_path_.data());
     return false;
   }
+  if (crashed(SaveStep::kRenamed)) return false;
   // Make the rename itself durable.
   const int dfd = ::open(dir_.data(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd < 0 || ::fsync(dfd) != 0) {

@@ -1,10 +1,11 @@
-// Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console shutdown, --state/--resume.
+// Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console quit, --state/--resume.
 #include <fcntl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,7 @@ class FakeBoard final : public Board {
   boticelli::hal::Hal& hal() override { return hal_; }
 
   bool refuse = false;
+  std::function<void(FakeBoard&)> after_run;  // looks at the devices after the run
   BoardConfig config_{};
   boticelli::fakes::FakeClock clock{1000};
   boticelli::fakes::FakeSerialPort console;
@@ -74,7 +76,8 @@ std::string slurp(int fd) {
   return s;
 }
 
-// Runs firmware_main in a child process (its objects are static, one run per process).
+// Runs firmware_main in this process on a fresh fake board, with stdout and stderr sent to
+// temporary files. (firmware_main rebuilds its static objects on every call.)
 template <typename Prepare>
 Run run_firmware(std::vector<const char*> args, Prepare prepare) {
   args.insert(args.begin(), "boticelli");
@@ -86,21 +89,23 @@ Run run_firmware(std::vector<const char*> args, Prepare prepare) {
   unlink(err_name);
   std::fflush(stdout);
   std::fflush(stderr);
-  const pid_t child = fork();
-  if (child == 0) {
-    dup2(out_fd, STDOUT_FILENO);
-    dup2(err_fd, STDERR_FILENO);
-    static FakeBoard board;
-    prepare(board);
-    const int code = firmware_main(static_cast<int>(args.size()), args.data(), board);
-    std::fflush(stdout);
-    std::fflush(stderr);
-    _exit(code);
-  }
+  const int saved_out = dup(STDOUT_FILENO);
+  const int saved_err = dup(STDERR_FILENO);
+  dup2(out_fd, STDOUT_FILENO);
+  dup2(err_fd, STDERR_FILENO);
   Run r;
-  int status = 0;
-  waitpid(child, &status, 0);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  {
+    auto board = std::make_unique<FakeBoard>();
+    prepare(*board);
+    r.exit_code = firmware_main(static_cast<int>(args.size()), args.data(), *board);
+    if (board->after_run) board->after_run(*board);
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  dup2(saved_out, STDOUT_FILENO);
+  dup2(saved_err, STDERR_FILENO);
+  close(saved_out);
+  close(saved_err);
   r.out = slurp(out_fd);
   r.err = slurp(err_fd);
   close(out_fd);
@@ -157,16 +162,33 @@ TEST(FirmwareMain, PrintsTheBoardsReasonWhenItsInitFails) {
   STRCMP_CONTAINS("boticelli: camera: no such device", cam.err.c_str());
 }
 
-TEST(FirmwareMain, StopsOnTheConsolesQuitCommand) {
-  const Run r = run_firmware({}, [](FakeBoard& b) { b.console.feed("status\rquit\r"); });
+TEST(FirmwareMain, StopsOnTheConsolesQuitCommandAfterAnsweringOnTheConsole) {
+  std::string console_output;
+  const Run r = run_firmware({}, [&](FakeBoard& b) {
+    b.console.feed("status\restop\rquit\r");
+    b.after_run = [&](FakeBoard& done) {
+      console_output = done.console.written();
+      CHECK(done.base.health() == boticelli::hal::BaseHealth::kStopped);
+    };
+  });
   CHECK_EQUAL(kExitNotFound, r.exit_code);
   STRCMP_CONTAINS("MISSION result=aborted cycles=0", last_line(r.out).c_str());
+  STRCMP_CONTAINS("status state=idle estop=none", console_output.c_str());
+  STRCMP_CONTAINS("OK shutting down", console_output.c_str());
+  STRCMP_CONTAINS("LOG info stopping: console shutdown", console_output.c_str());
+}
+
+TEST(FirmwareMain, RunsAgainInTheSameProcess) {
+  CHECK_EQUAL(kExitNotFound, run_firmware({"--max-cycles", "2"}).exit_code);
+  const Run r = run_firmware({"--max-cycles", "1"});
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("MISSION result=aborted cycles=1 ", last_line(r.out).c_str());
 }
 
 TEST(FirmwareMain, SavesEachCycleAndResumesFromTheStateDirectory) {
   Run r = run_firmware({"--max-cycles", "4", "--state", dir.c_str(), "--seed", "9"});
   CHECK_EQUAL(kExitNotFound, r.exit_code);
-  static MissionState state;
+  static MissionState state;  // large: static storage
   static StateStore store;
   char error[256] = "";
   CHECK(store.open(dir.c_str(), error, sizeof error));

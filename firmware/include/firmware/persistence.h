@@ -29,6 +29,17 @@ bool decode_state(std::string_view file, MissionState& out, const char** error);
 
 enum class LoadResult : std::uint8_t { kLoaded, kMissing, kCorrupt, kIoError };
 
+// The steps of StateStore::save(), for the crash hook.
+enum class SaveStep : std::uint8_t {
+  kTempCreated,   // the temporary file exists, empty
+  kChunkWritten,  // another chunk of the file is written (not yet synced)
+  kTempSynced,    // the temporary file is complete and fsynced
+  kRenamed,       // it has replaced the state file (directory not yet synced)
+};
+// Test seam: called after each step; returning true makes save() stop there as if the
+// process had been killed (its descriptors closed, nothing cleaned up).
+using SaveCrashHook = bool (*)(SaveStep step, void* context);
+
 // The state directory. save() is atomic: it writes `mission.state.tmp`, fsyncs it, renames
 // it over `mission.state` and fsyncs the directory, so after a crash at any point the file
 // is either the previous state or the new one, never a mix.
@@ -48,6 +59,11 @@ class StateStore {
   LoadResult load(MissionState& out, char* error, std::size_t error_size);
   const char* path() const { return path_.data(); }
   std::uint64_t saves() const { return saves_; }
+  void set_crash_hook(SaveCrashHook hook, void* context) {
+    crash_hook_ = hook;
+    crash_context_ = context;
+  }
+  static constexpr std::size_t kWriteChunkBytes = 16 * 1024;
 
  private:
   std::array<char, 512> dir_{};
@@ -55,6 +71,8 @@ class StateStore {
   std::array<char, 512> tmp_path_{};
   std::array<char, kMaxStateFileBytes> buffer_{};
   std::uint64_t saves_ = 0;
+  SaveCrashHook crash_hook_ = nullptr;
+  void* crash_context_ = nullptr;
 };
 
 }  // namespace boticelli::firmware
