@@ -68,7 +68,8 @@ TEST(Extraction, CylindricalRoomSeenFromItsCentreGivesTheCircleMinusTheRobotRadi
   CHECK_TRUE(free_range.set_model(model, 0.6F));
   static mapping::LocalMap map;
   static mapping::StarPolygon scratch;
-  const mapping::ExtractionParams p = params();
+  mapping::ExtractionParams p = params();
+  p.clearance_margin_m = 0.0F;  // the geometry alone: no margin for obstacles between rays
   mapping::extract_local_map(free_range, p, map, scratch);
   CHECK_TRUE(map.can_move);
   LONGS_EQUAL(360, map.navigable.vertex_count());
@@ -76,6 +77,11 @@ TEST(Extraction, CylindricalRoomSeenFromItsCentreGivesTheCircleMinusTheRobotRadi
     DOUBLES_EQUAL(2.5, map.free.rho_m(k), 0.02);
     DOUBLES_EQUAL(2.5 - 0.2, map.navigable.rho_m(k), 0.02);
   }
+  // With the default margin the circle is that much smaller.
+  p.clearance_margin_m = params().clearance_margin_m;
+  mapping::extract_local_map(free_range, p, map, scratch);
+  DOUBLES_EQUAL(2.5 - 0.2 - static_cast<double>(p.clearance_margin_m), map.navigable.rho_m(100),
+                0.02);
 }
 
 TEST(Extraction, AModelThatIsNotMonotoneInRangeIsRefused) {

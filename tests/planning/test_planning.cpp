@@ -2,8 +2,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 
 #include "algo/core/fixed_vector.h"
+#include "algo/mapping/extraction.h"
 #include "algo/mapping/map_points.h"
 #include "algo/mapping/polygon_ops.h"
 #include "algo/mapping/star_polygon.h"
@@ -26,7 +28,11 @@ namespace {
 
 constexpr float kBoundM = 3.0F;
 constexpr float kRobotRadiusM = 0.2F;
-constexpr std::size_t kMaxWalls = 8;
+constexpr std::size_t kMaxWalls = 12;
+constexpr std::size_t kTestStates = 120;
+constexpr std::size_t kTestSweeps = 16;
+constexpr std::size_t kTestFitRounds = 8;
+constexpr std::size_t kTestFitPasses = 4;
 
 // A robot in a world of wall segments: it sees the walls as the free polygon would show
 // them (ray cast at the polygon's vertex angles, bounded), keeps global lists, plans and
@@ -45,6 +51,7 @@ struct TestWorld {
   planning::ValueIterationParams vi_params;
   planning::RewardParams reward_params;
   planning::StepParams step_params;
+  planning::Trail trail;
   bool has_goal = false;
   Point2 goal{};
   float worst_path_clearance_m = 1e9F;  // brute force: robot disc to the walls, along steps
@@ -54,13 +61,29 @@ struct TestWorld {
     wall_count = 0;
     pose = start;
     global.clear();
+    trail.clear();
     has_goal = false;
     worst_path_clearance_m = 1e9F;
     stepped_outside_polygon = false;
+    // A lighter plan than the robot's defaults keeps the test fast under sanitizers and
+    // emulation: fewer states, sweeps and fitting passes.
     vi_params = planning::ValueIterationParams{};
+    vi_params.state_count = kTestStates;
+    vi_params.sweeps = kTestSweeps;
+    vi_params.fit_rounds = kTestFitRounds;
+    vi_params.fit_passes = kTestFitPasses;
     reward_params = planning::RewardParams{};
   }
   void add_wall(Point2 a, Point2 b) { walls[wall_count++] = {a, b}; }
+  // A wall 5 cm thick along x = x_m from y0 to y1 (a segment alone would vanish for rays
+  // running along its own line).
+  void add_thick_wall(float x_m, float y0_m, float y1_m) {
+    constexpr float kHalf = 0.025F;
+    add_wall({x_m - kHalf, y0_m}, {x_m + kHalf, y0_m});
+    add_wall({x_m + kHalf, y0_m}, {x_m + kHalf, y1_m});
+    add_wall({x_m + kHalf, y1_m}, {x_m - kHalf, y1_m});
+    add_wall({x_m - kHalf, y1_m}, {x_m - kHalf, y0_m});
+  }
 
   void observe() {
     for (std::size_t k = 0; k < free.vertex_count(); ++k) {
@@ -68,7 +91,9 @@ struct TestWorld {
                                                   free.angle_rad(k) + pose.yaw_rad);
       free.set_rho_m(k, std::fmin(r, kBoundM));
     }
-    (void)mapping::shrink_by_radius(free, kRobotRadiusM, navigable);
+    // As extract_local_map does: the robot radius plus the margin for wall ends between rays.
+    (void)mapping::shrink_for_robot(free, kRobotRadiusM,
+                                    mapping::ExtractionParams{}.clearance_margin_m, navigable);
     obstacles.clear();
     exploration.clear();
     (void)mapping::extract_map_points(free, kBoundM, point_params, obstacles, exploration);
@@ -76,7 +101,7 @@ struct TestWorld {
   }
 
   planning::RewardSources sources() const {
-    return {global.obstacles().span(), global.exploration().span(), has_goal, goal};
+    return {global.obstacles().span(), global.exploration().span(), trail.points(), has_goal, goal};
   }
 
   planning::StepDecision plan() {
@@ -89,6 +114,7 @@ struct TestWorld {
   // One Look-Think-Drive cycle; returns the decision taken.
   planning::StepKind cycle() {
     observe();
+    trail.add({pose.x_m, pose.y_m});
     const planning::StepDecision d = plan();
     if (d.kind != planning::StepKind::kMove) {
       return d.kind;
@@ -162,7 +188,7 @@ TEST(Rewards, ConesFollowEquationsFiveNineToFiveEleven) {
   const planning::RewardParams p = cone_params();
   const std::array<Point2, 1> obstacle{{{1.0F, 0.0F}}};
   const std::array<Point2, 1> exploration{{{0.0F, 3.0F}}};
-  planning::RewardSources s{obstacle, exploration, true, {-2.0F, 0.0F}};
+  planning::RewardSources s{obstacle, exploration, {}, true, {-2.0F, 0.0F}};
   // At (1.2, 0): obstacle −1 + 2.5·0.2 = −0.5; exploration 0.3 − 0.3·√(1.44+9) < 0 → 0;
   // goal 3 − 0.3·3.2 = 2.04.
   DOUBLES_EQUAL(-0.5 + 2.04, planning::reward_at(p, s, {1.2F, 0.0F}), 1e-5);
@@ -174,7 +200,7 @@ TEST(Rewards, ObstaclePointsAtTheGoalDoNotRepel) {
   // §6.4: the goal on a wall. Its wall's points within the clear radius give no penalty.
   planning::RewardParams p = cone_params();
   const std::array<Point2, 3> wall{{{2.0F, -0.15F}, {2.0F, 0.0F}, {2.0F, 0.15F}}};
-  planning::RewardSources s{wall, {}, true, {2.0F, 0.0F}};
+  planning::RewardSources s{wall, {}, {}, true, {2.0F, 0.0F}};
   DOUBLES_EQUAL(3.0 - 0.3 * 0.2, planning::reward_at(p, s, {1.8F, 0.0F}), 1e-5);
   p.goal_clear_radius_m = 0.0F;  // the thesis's behaviour: the goal's wall repels
   CHECK_TRUE(planning::reward_at(p, s, {1.8F, 0.0F}) < 3.0F - 0.3F * 0.2F - 1.0F);
@@ -201,7 +227,7 @@ TEST(Planner, GoesAroundAWallToAGoalBehindIt) {
   TestWorld& w = world();
   w.reset({0.0F, 0.0F, 0.0F});
   w.add_room(4.0F);
-  w.add_wall({1.2F, -1.2F}, {1.2F, 1.2F});
+  w.add_thick_wall(1.2F, -1.2F, 1.2F);
   w.has_goal = true;
   w.goal = {2.6F, 0.0F};
   const int cycles = w.run(60);
@@ -217,7 +243,7 @@ TEST(Planner, ApproachesAGoalOnAWallUpToTheStandOff) {
   TestWorld& w = world();
   w.reset({0.0F, 0.0F, 0.0F});
   w.add_room(4.0F);
-  w.add_wall({2.2F, -1.0F}, {2.2F, 1.0F});
+  w.add_thick_wall(2.2F, -1.0F, 1.0F);
   w.has_goal = true;
   w.goal = {2.2F, 0.3F};
   const int cycles = w.run(30);
@@ -255,7 +281,7 @@ TEST(Planner, SlicedValueIterationEqualsOneShot) {
   const std::array<Point2, 4> obstacles{
       {{1.0F, 0.0F}, {1.0F, 0.15F}, {1.0F, 0.3F}, {1.0F, -0.15F}}};
   const std::array<Point2, 2> exploration{{{-2.0F, 1.0F}, {0.0F, 3.0F}}};
-  const planning::RewardSources s{obstacles, exploration, true, {2.0F, 0.5F}};
+  const planning::RewardSources s{obstacles, exploration, {}, true, {2.0F, 0.5F}};
   planning::ValueIterationParams p;
   p.state_count = 120;
   p.sweeps = 6;
@@ -281,7 +307,7 @@ TEST(Planner, ValueIterationAndStepSelectionDoNotAllocate) {
   TestWorld& w = world();
   w.reset({0.0F, 0.0F, 0.0F});
   w.add_room(4.0F);
-  w.add_wall({1.2F, -1.2F}, {1.2F, 1.2F});
+  w.add_thick_wall(1.2F, -1.2F, 1.2F);
   w.has_goal = true;
   w.goal = {2.6F, 0.0F};
   planning::StepDecision d;

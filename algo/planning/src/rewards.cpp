@@ -20,6 +20,10 @@ float reward_at(const RewardParams& params, const RewardSources& sources, core::
     reward += std::max(0.0F, params.exploration_apex -
                                  params.exploration_slope_per_m * core::distance_m(arrival, q));
   }
+  for (const core::Point2& v : sources.visited) {
+    reward += std::min(
+        0.0F, params.visited_apex + params.visited_slope_per_m * core::distance_m(arrival, v));
+  }
   if (sources.has_goal) {
     // Eq 5.11: max{0, V_goal − S_goal ‖s' − g‖}
     reward += std::max(

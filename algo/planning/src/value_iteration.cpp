@@ -198,7 +198,8 @@ void ValueIteration::begin_fit() {
   aln::TrainerConfig config;
   config.epsilon = std::max(1e-4, static_cast<double>(params_.fit_tolerance * (hi - lo)));
   config.max_pieces = params_.max_pieces;
-  config.max_iterations = 12;
+  config.max_iterations = params_.fit_rounds;
+  config.max_refit_passes = params_.fit_passes;
   config.seed = params_.seed + static_cast<std::uint32_t>(sweep_ * 7919U + fit_attempt_ * 104729U);
   trainer_.configure(config);
   training_.set_output_range(lo, hi);

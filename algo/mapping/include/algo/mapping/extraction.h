@@ -19,11 +19,15 @@ struct ExtractionParams {
   float safe_occupancy = 0.6F;     // m_safe: at most this occupancy is free (§5.4)
   float bounding_radius_m = 3.0F;  // beyond this the model is not trusted (§5.4.4)
   float robot_radius_m = 0.2F;     // the cylindrical robot's radius
-  float ptu_height_m = 0.35F;      // PTU centre above the floor
-  float lowest_height_m = 0.03F;   // lowest slice above the floor (ground clearance)
-  float robot_height_m = 0.45F;    // top of the robot above the floor
-  std::size_t height_count = 5;    // slices from lowest_height_m to robot_height_m
-  float seam_margin_rad = 0.2F;    // near α = 0 also read the model at α ± 2π (the α seam)
+  // Added to the robot radius for the shrink: the polygon knows the free range only along
+  // its vertex rays, so an obstacle edge (a wall's end) between two rays can reach into a
+  // sector by up to about ρ·Δθ (5 cm at 3 m with 360 rays).
+  float clearance_margin_m = 0.05F;
+  float ptu_height_m = 0.35F;     // PTU centre above the floor
+  float lowest_height_m = 0.03F;  // lowest slice above the floor (ground clearance)
+  float robot_height_m = 0.45F;   // top of the robot above the floor
+  std::size_t height_count = 5;   // slices from lowest_height_m to robot_height_m
+  float seam_margin_rad = 0.2F;   // near α = 0 also read the model at α ± 2π (the α seam)
 };
 
 inline constexpr std::size_t kMaxHeights = 16;
@@ -72,6 +76,15 @@ void extract_slice(const FreeRange& free_range, float h_m, const ExtractionParam
   }
 }
 
+// Shrinks by the robot radius plus the margin; if the robot already stands closer than
+// that to the boundary (a step taken on an earlier, coarser view can end there), by the
+// radius alone, so that it can still move away. False if even the bare disc touches.
+inline bool shrink_for_robot(const StarPolygon& free, float robot_radius_m, float margin_m,
+                             StarPolygon& out) {
+  return shrink_by_radius(free, robot_radius_m + margin_m, out) ||
+         shrink_by_radius(free, robot_radius_m, out);
+}
+
 // The local map of one cycle, in the robot frame.
 struct LocalMap {
   StarPolygon free;       // intersection of the slices' polygons, within the bounding circle
@@ -91,7 +104,7 @@ void extract_local_map(const FreeRange& free_range, const ExtractionParams& p, L
     extract_slice(free_range, slice_height_m(p, i), p, scratch);
     (void)intersect_into(out.free, scratch);
   }
-  out.can_move = shrink_by_radius(out.free, p.robot_radius_m, out.navigable);
+  out.can_move = shrink_by_radius(out.free, p.robot_radius_m + p.clearance_margin_m, out.navigable);
 }
 
 }  // namespace boticelli::mapping

@@ -19,7 +19,7 @@ struct StepParams {
   // Bellman backups unrolled at the policy (≥ 1; 1 is Eq 5.12 as written): V(s') is
   // replaced by max_a' (r(s', a') + γ V(s'')) over clear moves, depth − 1 times. The ALN
   // smooths V across walls; a few exact backups at the robot see around a corner.
-  std::size_t lookahead_depth = 3;
+  std::size_t lookahead_depth = 4;
 };
 
 enum class StepKind { kMove, kAtGoal, kNoSafeAction };

@@ -29,6 +29,8 @@ struct ValueIterationParams {
   float robot_radius_m = 0.2F;      // a state must keep the robot's disc off obstacle points
   float fit_tolerance = 0.005F;     // ALN fit RMS, as a fraction of the targets' spread
   std::size_t max_pieces = 48;      // ALN piece cap (≤ kMaxValuePieces)
+  std::size_t fit_rounds = 12;      // ALN split rounds per fit (trainer max_iterations)
+  std::size_t fit_passes = 8;       // assign/refit passes per round (trainer max_refit_passes)
   std::uint32_t seed = 1;           // state sampling: same seed, same plan
 };
 
