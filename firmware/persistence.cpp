@@ -128,9 +128,10 @@ bool parse_float(std::string_view text, float& out) {
   std::memcpy(copy, text.data(), text.size());
   copy[text.size()] = '\0';
   char* end = nullptr;
-  errno = 0;
   const float v = std::strtof(copy, &end);
-  if (end != copy + text.size() || !std::isfinite(v) || errno == ERANGE) return false;
+  // Overflow gives ±inf (refused). Underflow (ERANGE with a subnormal result) is accepted:
+  // the writer prints every float, subnormals included, so that it reads back exactly.
+  if (end != copy + text.size() || !std::isfinite(v)) return false;
   out = v;
   return true;
 }

@@ -113,7 +113,7 @@ TEST(Persistence, HoldsAStateFilledToEveryCapacity) {
   g_a.clear();
   g_a.cycle = UINT64_MAX;
   g_a.pose = {-1e30F, 1e-30F, -3.14159274F};
-  while (g_a.obstacles.push_back({-123456.789F, 1.17549435e-38F})) {
+  while (g_a.obstacles.push_back({-123456.789F, 1e-40F})) {  // a subnormal y
   }
   while (g_a.exploration.push_back({3.40282347e38F, -0.0F})) {
   }
