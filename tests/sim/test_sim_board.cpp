@@ -1,0 +1,107 @@
+// Tests of the sim board's wiring: config, world loading, the HAL bag driving one SimWorld.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "sim_board.h"
+#include "sim_test_worlds.h"
+
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+using boticelli::hal::sim::test::world_path;
+namespace hal = boticelli::hal;
+
+namespace {
+char g_error[256];
+}  // namespace
+
+TEST_GROUP(SimBoard) {
+  // The board holds the world and its textures (a few MB): static in main.cpp, on the heap
+  // here so each test gets a fresh one and its buffers are freed with it.
+  std::unique_ptr<boticelli::boards::sim::SimBoard> board;
+  void setup() override {
+    board = std::make_unique<boticelli::boards::sim::SimBoard>();
+    g_error[0] = '\0';
+  }
+  void teardown() override { board.reset(); }
+};
+
+TEST(SimBoard, DescribesItselfAsASimulatedBoardWithTheThesisRig) {
+  CHECK(board->info().simulated);
+  STRCMP_EQUAL("sim", board->info().name);
+  const auto& c = board->config();
+  UNSIGNED_LONGS_EQUAL(640, c.camera_width_px);
+  DOUBLES_EQUAL(150.0, c.focal_px / 4.0F, 1e-6);  // F = 150 px at 160x120 (thesis §3.4)
+  DOUBLES_EQUAL(0.21, c.lever_m, 1e-6);
+  DOUBLES_EQUAL(7.7 * 3.14159265358979 / 180.0, c.tilt_step_rad, 1e-7);
+  CHECK_FALSE(c.realtime);
+  CHECK(c.background_units_per_slice > 0);  // work per frame independent of the host
+}
+
+TEST(SimBoard, ABadWorldFailsInitWithTheFileAndLine) {
+  boticelli::firmware::Options options;
+  options.world_file = "/nonexistent/room.sdf";
+  CHECK_FALSE(board->init(options, g_error, sizeof g_error));
+  CHECK(std::strstr(g_error, "/nonexistent/room.sdf") != nullptr);
+}
+
+TEST(SimBoard, TheHalBagDrivesOneWorldInLockstep) {
+  const std::string path = world_path("thesis_room");
+  boticelli::firmware::Options options;
+  options.world_file = path.c_str();
+  options.seed = 5;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  hal::Hal& h = board->hal();
+  // The renderer uses exactly the config's camera.
+  UNSIGNED_LONGS_EQUAL(board->config().camera_width_px, board->renderer().width_px());
+  DOUBLES_EQUAL(board->config().radial_k1, board->rig().camera().radial_k1, 0.0);
+  CHECK(h.camera.init());
+  CHECK(h.pan_tilt.init());
+  CHECK(h.base.init());
+  CHECK(h.watchdog.start(board->config().watchdog_timeout_ms));
+  CHECK(h.pan_tilt.move_to(0.5F, 0.0F) == false);  // not initialised until update()
+  h.pan_tilt.update();
+  CHECK(h.pan_tilt.move_to(0.5F, 0.0F));
+  // A minor frame: services the devices, then sleeps to the next deadline. No allocation.
+  const std::uint32_t frame_us = board->config().minor_frame_us;
+  hal::Frame frame;
+  int frames = 0;
+  auto minor_frame = [&] {
+    h.pan_tilt.update();
+    h.base.update();
+    if (h.camera.poll(frame) == hal::CameraPoll::kFrame) {
+      ++frames;
+      h.camera.release();
+    }
+    h.watchdog.kick();
+    h.status_led.write((h.clock.now_us() / 500000U) % 2U == 0U);
+    h.clock.sleep_until_us(h.clock.now_us() + frame_us);
+  };
+  for (int i = 0; i < 10; ++i) minor_frame();  // the first frame (and any warm-up) here
+  CHECK_NO_ALLOCATION(for (int i = 0; i < 100; ++i) minor_frame());
+  // 1.1 s of simulated time: 33 frames at 30 fps, the pan move (0.75 s) done, base ready.
+  UNSIGNED_LONGS_EQUAL(1100000, h.clock.now_us());
+  CHECK(frames >= 33 && frames <= 34);
+  UNSIGNED_LONGS_EQUAL(640, frame.width_px);
+  UNSIGNED_LONGS_EQUAL(1280, frame.stride_bytes);
+  CHECK_FALSE(h.pan_tilt.state().moving);
+  DOUBLES_EQUAL(0.5, h.pan_tilt.state().pan_rad, 1e-3);
+  CHECK(h.base.health() == hal::BaseHealth::kReady);
+  UNSIGNED_LONGS_EQUAL(0, board->sim().watchdog_expirations());
+  CHECK(board->sim().led_changes() >= 2);
+  // Ground truth through the sim-only API.
+  auto& sim = board->sim();
+  DOUBLES_EQUAL(board->world().start.x_m, sim.true_pose().x_m, 1e-6);
+  DOUBLES_EQUAL(-1.6, sim.target_point_m().x(), 1e-3);
+  UNSIGNED_LONGS_EQUAL(0, sim.collisions());
+  // The scripted e-stop reaches the firmware's input.
+  sim.schedule_estop(h.clock.now_us() + 5000, 20000);
+  minor_frame();
+  CHECK(h.estop.read());
+  CHECK(h.estop.activated_since_last_poll());
+  for (int i = 0; i < 3; ++i) minor_frame();
+  CHECK_FALSE(h.estop.read());
+}
