@@ -185,7 +185,9 @@ void Console::execute(std::string_view line) {
 
 // Each handler either fills reply_ and ends it with OK, or calls reply_error() alone.
 namespace {
-bool no_args(const Words& w) { return w.count == 1; }
+bool no_args(const Words& w) {
+  return w.count == 1;
+}
 }  // namespace
 
 void Console::cmd_help(const Words& w) {
@@ -203,10 +205,9 @@ void Console::cmd_status(const Words& w) {
   reply_.appendf(
       "status state=%s estop=%s paused=%d healthy=%d cycles=%llu frames=%llu uptime_s=%.1f\r\n"
       "OK\r\n",
-      view_.state_name(), stop_cause_name(safety_.cause()),
-      executive_.background_paused() ? 1 : 0, executive_.all_healthy() ? 1 : 0,
-      static_cast<unsigned long long>(view_.cycles()), static_cast<unsigned long long>(f.frames),
-      static_cast<double>(now_us_ - start_us_) * 1e-6);
+      view_.state_name(), stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
+      executive_.all_healthy() ? 1 : 0, static_cast<unsigned long long>(view_.cycles()),
+      static_cast<unsigned long long>(f.frames), static_cast<double>(now_us_ - start_us_) * 1e-6);
   emit(reply_.view());
 }
 

@@ -78,7 +78,8 @@ void Executive::run_frame() {
     e.task->run(t0);
     now_us = clock_.now_us();
     const std::uint64_t took = now_us - t0;
-    const std::uint32_t took_us = took > 0xFFFFFFFFU ? 0xFFFFFFFFU : static_cast<std::uint32_t>(took);
+    const std::uint32_t took_us =
+        took > 0xFFFFFFFFU ? 0xFFFFFFFFU : static_cast<std::uint32_t>(took);
     TaskStats& st = e.stats;
     ++st.runs;
     st.total_us += took_us;

@@ -1,4 +1,5 @@
-// Firmware entry: options, board init, executive with the device tasks and the console, MISSION line.
+// Firmware entry: options, board init, executive with the device tasks and the console, MISSION
+// line.
 #include "firmware/firmware_main.h"
 
 #include <csignal>
@@ -24,7 +25,9 @@ namespace {
 
 volatile std::sig_atomic_t g_signal = 0;
 
-extern "C" void on_signal(int signal) { g_signal = signal; }
+extern "C" void on_signal(int signal) {
+  g_signal = signal;
+}
 
 double wall_seconds() {
   timespec ts{};

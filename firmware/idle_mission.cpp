@@ -26,8 +26,9 @@ StepResult IdleMission::step(SliceBudget& budget) {
   ++cycles_this_run_;
   state_.pose = pose();
   TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
-  line.appendf("idle checkpoint x_m=%.3f y_m=%.3f yaw_rad=%.3f", static_cast<double>(state_.pose.x_m),
-               static_cast<double>(state_.pose.y_m), static_cast<double>(state_.pose.yaw_rad));
+  line.appendf("idle checkpoint x_m=%.3f y_m=%.3f yaw_rad=%.3f",
+               static_cast<double>(state_.pose.x_m), static_cast<double>(state_.pose.y_m),
+               static_cast<double>(state_.pose.yaw_rad));
   state_.add_log(state_.cycle, line.view());
   if (store_ != nullptr && !store_->save(state_, error_, sizeof error_)) ++save_failures_;
   return StepResult::kDone;

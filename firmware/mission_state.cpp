@@ -19,8 +19,8 @@ void MissionState::add_log(std::uint64_t at_cycle, std::string_view text) {
   }
   MissionLogEntry e;
   e.cycle = at_cycle;
-  const std::size_t n = text.size() < MissionLogEntry::kMaxTextBytes ? text.size()
-                                                                      : MissionLogEntry::kMaxTextBytes;
+  const std::size_t n =
+      text.size() < MissionLogEntry::kMaxTextBytes ? text.size() : MissionLogEntry::kMaxTextBytes;
   for (std::size_t i = 0; i < n; ++i) {
     const char c = text[i];
     e.text[i] = (c >= 0x20 && c <= 0x7E) ? c : '?';

@@ -70,7 +70,8 @@ ParseResult parse_options(int argc, const char* const* argv, bool simulated, Opt
       if (!value(out.world_file)) return fail("option ", arg, " needs a FILE");
       if (!simulated) return fail("option ", arg, " is only for the sim board");
     } else if (std::strcmp(arg, "--seed") == 0) {
-      if (!value(v) || !parse_u64(v, out.seed)) return fail("option ", arg, " needs a whole number");
+      if (!value(v) || !parse_u64(v, out.seed))
+        return fail("option ", arg, " needs a whole number");
     } else if (std::strcmp(arg, "--max-cycles") == 0) {
       if (!value(v) || !parse_u64(v, out.max_cycles)) {
         return fail("option ", arg, " needs a whole number");

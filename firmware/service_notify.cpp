@@ -37,8 +37,8 @@ bool ServiceNotifier::open() {
   address_.sun_family = AF_UNIX;
   std::memcpy(address_.sun_path, path, len);
   if (path[0] == '@') address_.sun_path[0] = '\0';  // abstract namespace
-  address_size_ = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + len +
-                                         (path[0] == '@' ? 0U : 1U));
+  address_size_ =
+      static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + len + (path[0] == '@' ? 0U : 1U));
   fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   if (fd_ < 0) {
     std::snprintf(error_, sizeof error_, "notify socket: %s", std::strerror(errno));

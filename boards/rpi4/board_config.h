@@ -1,4 +1,5 @@
-// rpi4 board config: the reference robot's devices, lines, rates and capacities, as data (wiring in rpi4_board.cpp).
+// rpi4 board config: the reference robot's devices, lines, rates and capacities, as data (wiring in
+// rpi4_board.cpp).
 #pragma once
 
 #include <cstdint>
@@ -21,11 +22,11 @@ struct Rpi4Devices {
   float odrive_max_wheel_turns_s = 8.0F;
   // GPIO on the 40-pin header (gpiochip0 = the BCM2711's lines, numbered as BCM GPIOs).
   const char* gpio_chip = "gpiochip0";
-  unsigned estop_line = 17;   // pin 11: e-stop switch to GND, normally closed
+  unsigned estop_line = 17;       // pin 11: e-stop switch to GND, normally closed
   bool estop_active_low = false;  // NC switch to GND: the line goes high (pulled up) when pressed
-  unsigned bumper_line = 27;  // pin 13: bumper microswitches to GND, normally open
+  unsigned bumper_line = 27;      // pin 13: bumper microswitches to GND, normally open
   bool bumper_active_low = true;
-  unsigned led_line = 22;     // pin 15: status LED through 330 Ω to GND
+  unsigned led_line = 22;  // pin 15: status LED through 330 Ω to GND
   bool led_active_low = false;
   // Console UART on pins 8/10 (GPIO 14/15), 115200 8N1 (enable_uart=1, no serial getty).
   const char* console_device = "/dev/ttyAMA0";
@@ -52,12 +53,12 @@ inline firmware::BoardConfig make_config() {
   c.track_width_m = 0.40F;
   c.max_speed_m_s = 0.3F;
   c.max_turn_rate_rad_s = 0.8F;
-  c.minor_frame_us = 10000;       // 100 Hz executive
+  c.minor_frame_us = 10000;  // 100 Hz executive
   c.console_baud = 115200;
   c.telemetry_period_ms = 1000;
-  c.realtime = true;              // mlockall, prefaulted stack, SCHED_FIFO 50
+  c.realtime = true;  // mlockall, prefaulted stack, SCHED_FIFO 50
   c.fifo_priority = 50;
-  c.watchdog_timeout_ms = 5000;   // /dev/watchdog; systemd's WatchdogSec=3s acts first
+  c.watchdog_timeout_ms = 5000;  // /dev/watchdog; systemd's WatchdogSec=3s acts first
   c.background_units_per_slice = 0;
   c.checkpoint_period_ms = 1000;
   return c;

@@ -1,4 +1,5 @@
-// ConsolePort: console selection and pseudo-terminal set-up for the rpi4 board (see console_port.h).
+// ConsolePort: console selection and pseudo-terminal set-up for the rpi4 board (see
+// console_port.h).
 #include "console_port.h"
 
 #include <fcntl.h>
@@ -62,6 +63,8 @@ std::ptrdiff_t ConsolePort::write(const std::uint8_t* data, std::size_t size) {
   return active_->write(data, size);
 }
 
-const char* ConsolePort::error() const { return error_[0] != '\0' ? error_ : active_->error(); }
+const char* ConsolePort::error() const {
+  return error_[0] != '\0' ? error_ : active_->error();
+}
 
 }  // namespace boticelli::boards::rpi4

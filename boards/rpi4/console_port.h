@@ -1,4 +1,5 @@
-// ConsolePort: the rpi4 board's console — the UART, any tty, stdio or a fresh pseudo-terminal, chosen by --console.
+// ConsolePort: the rpi4 board's console — the UART, any tty, stdio or a fresh pseudo-terminal,
+// chosen by --console.
 #pragma once
 
 #include <cstddef>

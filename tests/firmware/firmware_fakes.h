@@ -1,4 +1,5 @@
-// Small device fakes for the firmware tests: inputs, output, base, PTU, camera, watchdog (state only, no I/O).
+// Small device fakes for the firmware tests: inputs, output, base, PTU, camera, watchdog (state
+// only, no I/O).
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,5 @@
-// Tests of the serial console: line assembly, parsing with hostile input, every command, telemetry, no allocation.
+// Tests of the serial console: line assembly, parsing with hostile input, every command, telemetry,
+// no allocation.
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -110,7 +111,7 @@ TEST(LineAssembler, SpoilsALineWithControlOrNonAsciiBytes) {
   STRCMP_EQUAL(" pose", lines.at(0).c_str());
 }
 
-TEST_GROUP(ConsoleParser) {};
+TEST_GROUP(ConsoleParser){};
 
 TEST(ConsoleParser, SplitsWordsOnSpacesAndRefusesTooMany) {
   Words w;
@@ -129,8 +130,8 @@ TEST(ConsoleParser, ReadsOnlyPlainDecimalNumbers) {
   DOUBLES_EQUAL(-1.5, v, 0.0);
   CHECK(parse_number("2e-3", v));
   DOUBLES_EQUAL(0.002, v, 1e-9);
-  for (const char* bad : {"", "-", ".", "e5", "0x10", "inf", "nan", "1.5x", "1 2", "1e99",
-                          "--1", "123456789012345678901234567890123"}) {
+  for (const char* bad : {"", "-", ".", "e5", "0x10", "inf", "nan", "1.5x", "1 2", "1e99", "--1",
+                          "123456789012345678901234567890123"}) {
     CHECK_FALSE_TEXT(parse_number(bad, v), bad);
   }
 }
@@ -193,7 +194,8 @@ TEST(Console, ReportsStatusPoseAndMap) {
   reply = command("pose");
   STRCMP_EQUAL("pose x_m=1.250 y_m=-0.500 yaw_rad=0.7500", reply.at(0).c_str());
   reply = command("map");
-  STRCMP_EQUAL("map polygon_vertices=12 obstacle_points=34 exploration_points=5", reply.at(0).c_str());
+  STRCMP_EQUAL("map polygon_vertices=12 obstacle_points=34 exploration_points=5",
+               reply.at(0).c_str());
   CHECK_EQUAL("OK", reply.back());
 }
 
@@ -261,9 +263,9 @@ TEST(Console, GetsAndSetsParametersWithinTheirRange) {
   DOUBLES_EQUAL(7.5, gain, 0.0);
   reply = command("get");
   CHECK_EQUAL(parameters.size() + 1, reply.size());
-  for (const char* bad : {"set gain 11", "set gain -0.1", "set gain abc", "set gain 0x3",
-                          "set gain nan", "set gain", "set nothing 1", "set gain 1 2",
-                          "set telemetry_ms 10.5", "set echo 2", "get nothing"}) {
+  for (const char* bad :
+       {"set gain 11", "set gain -0.1", "set gain abc", "set gain 0x3", "set gain nan", "set gain",
+        "set nothing 1", "set gain 1 2", "set telemetry_ms 10.5", "set echo 2", "get nothing"}) {
     reply = command(bad);
     CHECK_EQUAL_TEXT(1U, reply.size(), bad);
     CHECK_TEXT(reply[0].rfind("ERR ", 0) == 0, bad);
@@ -289,7 +291,9 @@ TEST(Console, AnswersBadInputWithOneErrorLineAndChangesNothing) {
   const std::string too_long(LineAssembler::kMaxLineBytes + 10, 'x');
   for (const std::string& bad :
        {std::string("fly"), std::string("pose extra"), std::string("a b c d e"), too_long,
-        std::string("st\x01" "atus"), std::string("estop now")}) {
+        std::string("st\x01"
+                    "atus"),
+        std::string("estop now")}) {
     const auto reply = command(bad);
     CHECK_EQUAL_TEXT(1U, reply.size(), bad.c_str());
     CHECK_TEXT(reply[0].rfind("ERR ", 0) == 0, bad.c_str());

@@ -1,4 +1,5 @@
-// Console over a real pseudo-terminal pair: the test types on the master side like picocom, the console owns the slave.
+// Console over a real pseudo-terminal pair: the test types on the master side like picocom, the
+// console owns the slave.
 #include <fcntl.h>
 #include <poll.h>
 #include <stdlib.h>
@@ -103,7 +104,9 @@ TEST(ConsoleOverPty, AnswersACommandTypedWithCarriageReturnLikePicocom) {
 TEST(ConsoleOverPty, TakesLineFeedEndsBackspacesAndEchoesForTerminals) {
   type("set echo 1\n");
   CHECK(read_until("OK\r\n").find("OK\r\n") != std::string::npos);
-  type("posx\x7f" "e\r");
+  type(
+      "posx\x7f"
+      "e\r");
   const std::string got = read_until("OK\r\n");
   STRCMP_CONTAINS("posx\b \be\r\npose x_m=0.500 y_m=0.250", got.c_str());
 }

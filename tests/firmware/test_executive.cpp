@@ -1,4 +1,5 @@
-// Tests of the cyclic executive on a fake clock: rates, budgets, overruns, re-anchoring, background slices, e-stop.
+// Tests of the cyclic executive on a fake clock: rates, budgets, overruns, re-anchoring, background
+// slices, e-stop.
 #include <cstdint>
 #include <vector>
 
@@ -21,7 +22,8 @@ namespace {
 // A task that takes `cost_us` of fake time per run (longer on chosen runs).
 class TimedTask final : public Task {
  public:
-  explicit TimedTask(FakeClock& clock, std::uint64_t cost_us = 0) : clock_(clock), cost_us_(cost_us) {}
+  explicit TimedTask(FakeClock& clock, std::uint64_t cost_us = 0)
+      : clock_(clock), cost_us_(cost_us) {}
   void run(std::uint64_t now_us) override {
     ++runs;
     last_start_us = now_us;
@@ -90,8 +92,12 @@ TEST_GROUP(Executive) {
   const char* error = "";
   ExecutiveConfig config;
 
-  void add(const TaskSpec& spec, Task& task) { CHECK_TRUE_TEXT(exec.add_task(spec, task, &error), error); }
-  void start() { CHECK_TRUE_TEXT(exec.start(config, &error), error); }
+  void add(const TaskSpec& spec, Task& task) {
+    CHECK_TRUE_TEXT(exec.add_task(spec, task, &error), error);
+  }
+  void start() {
+    CHECK_TRUE_TEXT(exec.start(config, &error), error);
+  }
   void frames(int n) {
     for (int i = 0; i < n; ++i) exec.run_frame();
   }
@@ -451,7 +457,10 @@ TEST_GROUP(CameraTask) {
 TEST(CameraTask, HandsEachFrameBackAndTurnsUnhealthyOnlyAfterAStall) {
   class Counter final : public FrameConsumer {
    public:
-    void on_frame(const boticelli::hal::Frame& f) override { last_sequence = f.sequence; ++frames; }
+    void on_frame(const boticelli::hal::Frame& f) override {
+      last_sequence = f.sequence;
+      ++frames;
+    }
     std::uint32_t last_sequence = 0;
     int frames = 0;
   } consumer;

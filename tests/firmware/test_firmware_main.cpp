@@ -1,4 +1,5 @@
-// Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console quit, --state/--resume.
+// Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console
+// quit, --state/--resume.
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -120,7 +121,8 @@ Run run_firmware(std::vector<const char*> args) {
 std::string last_line(const std::string& s) {
   const std::size_t end = s.find_last_not_of('\n');
   const std::size_t start = s.rfind('\n', end);
-  return s.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+  return s.substr(start == std::string::npos ? 0 : start + 1,
+                  end - (start == std::string::npos ? 0 : start + 1) + 1);
 }
 
 }  // namespace

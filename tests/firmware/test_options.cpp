@@ -6,11 +6,14 @@
 
 using namespace boticelli::firmware;
 
-TEST_GROUP(Options){Options options;};
+TEST_GROUP(Options) {
+  Options options;
+};
 
 TEST(Options, ReadsEveryDesignOption) {
-  const char* argv[] = {"boticelli", "--world", "w.sdf", "--seed", "42", "--max-cycles", "7",
-                        "--snapshots", "snap", "--trace", "t.csv", "--console", "pty"};
+  const char* argv[] = {"boticelli",    "--world",   "w.sdf",       "--seed", "42",
+                        "--max-cycles", "7",         "--snapshots", "snap",   "--trace",
+                        "t.csv",        "--console", "pty"};
   const ParseResult r = parse_options(13, argv, true, options);
   CHECK_TRUE_TEXT(r.ok, r.error);
   STRCMP_EQUAL("w.sdf", options.world_file);

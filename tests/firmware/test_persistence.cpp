@@ -1,4 +1,5 @@
-// Tests of the mission state file: round trip, strict rejection of corrupt files, atomic saves under SIGKILL, resume.
+// Tests of the mission state file: round trip, strict rejection of corrupt files, atomic saves
+// under SIGKILL, resume.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -89,8 +90,12 @@ void write_file(const std::string& path, const std::string& bytes) {
 TEST_GROUP(Persistence) {
   std::string dir;
   char error[256] = "";
-  void setup() override { dir = temp_dir(); }
-  void teardown() override { remove_dir(dir); }
+  void setup() override {
+    dir = temp_dir();
+  }
+  void teardown() override {
+    remove_dir(dir);
+  }
 };
 
 TEST(Persistence, ComputesTheStandardCrc32) {

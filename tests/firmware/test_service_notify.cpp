@@ -1,4 +1,5 @@
-// Tests of the systemd notify protocol: datagrams on a path socket and an abstract socket named by $NOTIFY_SOCKET.
+// Tests of the systemd notify protocol: datagrams on a path socket and an abstract socket named by
+// $NOTIFY_SOCKET.
 #include <stdlib.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -36,13 +37,12 @@ std::string receive(int fd) {
 
 }  // namespace
 
-TEST_GROUP(ServiceNotifier) {
-  void teardown() override {
-    unsetenv("NOTIFY_SOCKET");
-    unsetenv("WATCHDOG_USEC");
-    unsetenv("WATCHDOG_PID");
-  }
-};
+TEST_GROUP(ServiceNotifier){void teardown() override{unsetenv("NOTIFY_SOCKET");
+unsetenv("WATCHDOG_USEC");
+unsetenv("WATCHDOG_PID");
+}
+}
+;
 
 TEST(ServiceNotifier, SendsReadyAndWatchdogAsDatagramsToThePathInNotifySocket) {
   const std::string path = "/tmp/boticelli-notify-" + std::to_string(getpid());

@@ -23,24 +23,24 @@ struct BoardConfig {
   // Camera at full resolution (what the driver delivers).
   std::uint32_t camera_width_px = 640;
   std::uint32_t camera_height_px = 480;
-  float focal_px = 600.0F;          // focal length at full resolution [px]
-  float principal_x_px = 320.0F;    // principal point [px]
+  float focal_px = 600.0F;        // focal length at full resolution [px]
+  float principal_x_px = 320.0F;  // principal point [px]
   float principal_y_px = 240.0F;
-  float radial_k1 = 0.0F;           // radial distortion, normalised coordinates
+  float radial_k1 = 0.0F;  // radial distortion, normalised coordinates
   // Pan-tilt unit and the L-shaped camera support (App. A).
-  float ptu_height_m = 0.6F;        // PTU centre (pan and tilt axes) above the floor [m]
-  float lever_m = 0.21F;            // tilt axis to camera optical centre, L [m]
-  float support_angle_rad = 0.0F;   // angle Ω of the L-support between lever and optical axis [rad]
+  float ptu_height_m = 0.6F;       // PTU centre (pan and tilt axes) above the floor [m]
+  float lever_m = 0.21F;           // tilt axis to camera optical centre, L [m]
+  float support_angle_rad = 0.0F;  // angle Ω of the L-support between lever and optical axis [rad]
   float tilt_step_rad = 0.134390352F;  // tilt between the two stereo frames, Φ = 7.7° [rad]
   // Base.
-  float robot_radius_m = 0.25F;     // radius of the cylinder that contains the robot [m]
-  float robot_height_m = 0.8F;      // height of that cylinder [m]
-  float wheel_radius_m = 0.08F;     // [m]
-  float track_width_m = 0.40F;      // distance between the wheels [m]
-  float max_speed_m_s = 0.3F;       // forward speed limit [m/s]
-  float max_turn_rate_rad_s = 0.8F; // yaw rate limit [rad/s]
+  float robot_radius_m = 0.25F;      // radius of the cylinder that contains the robot [m]
+  float robot_height_m = 0.8F;       // height of that cylinder [m]
+  float wheel_radius_m = 0.08F;      // [m]
+  float track_width_m = 0.40F;       // distance between the wheels [m]
+  float max_speed_m_s = 0.3F;        // forward speed limit [m/s]
+  float max_turn_rate_rad_s = 0.8F;  // yaw rate limit [rad/s]
   // Executive and console.
-  std::uint32_t minor_frame_us = 10000;   // executive minor frame [µs]
+  std::uint32_t minor_frame_us = 10000;  // executive minor frame [µs]
   std::uint32_t console_baud = 115200;
   std::uint32_t telemetry_period_ms = 1000;
   // Linux process set-up for the executive (firmware/realtime.h): mlockall, prefaulted

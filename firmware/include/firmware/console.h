@@ -1,4 +1,5 @@
-// Console: the serial monitor — line commands, periodic telemetry and log lines over a hal::SerialPort.
+// Console: the serial monitor — line commands, periodic telemetry and log lines over a
+// hal::SerialPort.
 #pragma once
 
 #include <array>
@@ -26,9 +27,9 @@ bool parse_log_level(std::string_view text, LogLevel& out);
 // Unsolicited lines start with "TLM " (telemetry) or "LOG " (log). Output lines end in CRLF.
 class Console {
  public:
-  static constexpr std::size_t kTxBytes = 8192;        // output ring
-  static constexpr std::size_t kReplyBytes = 2048;     // one command's reply
-  static constexpr std::size_t kReadChunkBytes = 64;   // bytes read per service() call
+  static constexpr std::size_t kTxBytes = 8192;       // output ring
+  static constexpr std::size_t kReplyBytes = 2048;    // one command's reply
+  static constexpr std::size_t kReadChunkBytes = 64;  // bytes read per service() call
 
   Console(hal::SerialPort& port, Executive& executive, Safety& safety, MissionView& view,
           ParameterTable& parameters);

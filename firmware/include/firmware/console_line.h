@@ -1,4 +1,5 @@
-// Console line input: bounded line assembly from untrusted serial bytes (CR/LF, backspace, hostile bytes).
+// Console line input: bounded line assembly from untrusted serial bytes (CR/LF, backspace, hostile
+// bytes).
 #pragma once
 
 #include <array>
@@ -9,11 +10,11 @@
 namespace boticelli::firmware {
 
 enum class LineEvent : std::uint8_t {
-  kNone,      // byte absorbed, no complete line yet
-  kLine,      // line() holds a complete line (without its end)
-  kTooLong,   // a line longer than kMaxLineBytes ended; it was discarded
-  kBadByte,   // a line with a control or non-ASCII byte ended; it was discarded
-  kCancelled, // Ctrl-C / Ctrl-U dropped the line typed so far
+  kNone,       // byte absorbed, no complete line yet
+  kLine,       // line() holds a complete line (without its end)
+  kTooLong,    // a line longer than kMaxLineBytes ended; it was discarded
+  kBadByte,    // a line with a control or non-ASCII byte ended; it was discarded
+  kCancelled,  // Ctrl-C / Ctrl-U dropped the line typed so far
 };
 
 // Assembles lines the way a terminal user types them (picocom, screen): CR, LF or CRLF end a

@@ -1,4 +1,5 @@
-// Executive: the cyclic executive — fixed-rate tasks in minor frames plus a budgeted background slot.
+// Executive: the cyclic executive — fixed-rate tasks in minor frames plus a budgeted background
+// slot.
 #pragma once
 
 #include <array>
@@ -87,8 +88,8 @@ struct TaskStats {
 // Frame and background statistics.
 struct FrameStats {
   std::uint64_t frames = 0;
-  std::uint64_t overruns = 0;       // frames whose work ended after the next frame's start
-  std::uint64_t missed_frames = 0;  // frame starts skipped by re-anchoring after overruns
+  std::uint64_t overruns = 0;         // frames whose work ended after the next frame's start
+  std::uint64_t missed_frames = 0;    // frame starts skipped by re-anchoring after overruns
   std::uint64_t jitter_total_us = 0;  // sum of |actual − scheduled| frame start
   std::uint32_t jitter_worst_us = 0;
   std::uint64_t background_slices = 0;
@@ -105,12 +106,13 @@ struct FrameStats {
 };
 
 struct ExecutiveConfig {
-  std::uint32_t frame_us = 10000;              // minor frame
-  std::uint32_t background_margin_us = 1000;   // left free before the next frame starts
-  std::uint32_t background_min_slice_us = 200; // a slice shorter than this is not started
-  std::uint32_t background_max_slice_us = 0;   // 0 = up to the margin
+  std::uint32_t frame_us = 10000;                // minor frame
+  std::uint32_t background_margin_us = 1000;     // left free before the next frame starts
+  std::uint32_t background_min_slice_us = 200;   // a slice shorter than this is not started
+  std::uint32_t background_max_slice_us = 0;     // 0 = up to the margin
   std::uint32_t background_units_per_slice = 0;  // 0 = limited by time only
-  std::uint32_t unhealthy_after_overruns = 3;  // consecutive budget overruns that make a task unhealthy
+  std::uint32_t unhealthy_after_overruns =
+      3;  // consecutive budget overruns that make a task unhealthy
 };
 
 // Runs the tasks of a table in minor frames on a hal::Clock. Everything is set up by

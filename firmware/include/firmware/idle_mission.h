@@ -1,4 +1,5 @@
-// IdleMission: what runs in the mission's place until the Look-Think-Drive mission lands — a checkpoint cycle.
+// IdleMission: what runs in the mission's place until the Look-Think-Drive mission lands — a
+// checkpoint cycle.
 #pragma once
 
 #include <cstdint>
@@ -22,7 +23,11 @@ class IdleMission final : public MissionView, public BackgroundWork {
  public:
   IdleMission(hal::Base& base, hal::PanTilt& ptu, hal::Clock& clock, MissionState& state,
               StateStore* store, std::uint32_t cycle_period_us)
-      : base_(base), ptu_(ptu), clock_(clock), state_(state), store_(store),
+      : base_(base),
+        ptu_(ptu),
+        clock_(clock),
+        state_(state),
+        store_(store),
         period_us_(cycle_period_us) {}
 
   // Anchors the first cycle one period after now.

@@ -1,4 +1,5 @@
-// MissionState: everything a mission must keep across a restart, in fixed capacities (saved by StateStore).
+// MissionState: everything a mission must keep across a restart, in fixed capacities (saved by
+// StateStore).
 #pragma once
 
 #include <array>
@@ -29,9 +30,10 @@ struct MissionState {
   std::uint64_t seed = 1;   // --seed of the run that started the mission
   core::Pose2 pose;         // robot pose in the world frame [m, rad]
   bool has_goal = false;
-  core::Point2 goal;        // target position once seen [m]
-  core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles;      // global obstacle list [m]
-  core::FixedVector<core::Point2, kMaxExplorationPoints> exploration; // global exploration list [m]
+  core::Point2 goal;                                              // target position once seen [m]
+  core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles;  // global obstacle list [m]
+  core::FixedVector<core::Point2, kMaxExplorationPoints>
+      exploration;                           // global exploration list [m]
   std::array<char, kMaxModelBytes> model{};  // the last occupancy ALN, text format (opaque here)
   std::size_t model_bytes = 0;
   core::FixedVector<MissionLogEntry, kMaxLogEntries> log;  // oldest first

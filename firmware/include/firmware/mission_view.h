@@ -9,9 +9,9 @@
 namespace boticelli::firmware {
 
 struct MapCounts {
-  std::uint32_t polygon_vertices = 0;   // vertices of the current navigation polygon
-  std::uint32_t obstacle_points = 0;    // global obstacle list
-  std::uint32_t exploration_points = 0; // global exploration list
+  std::uint32_t polygon_vertices = 0;    // vertices of the current navigation polygon
+  std::uint32_t obstacle_points = 0;     // global obstacle list
+  std::uint32_t exploration_points = 0;  // global exploration list
 };
 
 // Read-only view the mission implements; the console calls it from its task, so every call
@@ -19,9 +19,9 @@ struct MapCounts {
 class MissionView {
  public:
   virtual ~MissionView() = default;
-  virtual const char* state_name() const = 0;  // e.g. "look", "think", "drive", "idle"
-  virtual core::Pose2 pose() const = 0;        // world frame [m, rad]
-  virtual float pan_rad() const = 0;           // current PTU pan [rad]
+  virtual const char* state_name() const = 0;           // e.g. "look", "think", "drive", "idle"
+  virtual core::Pose2 pose() const = 0;                 // world frame [m, rad]
+  virtual float pan_rad() const = 0;                    // current PTU pan [rad]
   virtual std::uint32_t features() const { return 0; }  // features tracked in the last view
   virtual std::uint32_t pieces() const { return 0; }    // linear pieces of the occupancy ALN
   virtual std::uint64_t cycles() const { return 0; }    // completed Look-Think-Drive cycles

@@ -1,4 +1,5 @@
-// Options: the firmware's command line (DESIGN.md "Contracts"), parsed without allocation or exceptions.
+// Options: the firmware's command line (DESIGN.md "Contracts"), parsed without allocation or
+// exceptions.
 #pragma once
 
 #include <cstdint>
@@ -8,11 +9,11 @@ namespace boticelli::firmware {
 enum class ConsoleKind : std::uint8_t { kStdio, kPty, kPath };
 
 struct Options {
-  const char* world_file = nullptr;  // --world FILE (sim board only)
-  std::uint64_t seed = 1;            // --seed N
-  std::uint64_t max_cycles = 0;      // --max-cycles N; 0 = no limit
-  const char* snapshots_dir = nullptr;  // --snapshots DIR
-  const char* trace_file = nullptr;     // --trace FILE
+  const char* world_file = nullptr;           // --world FILE (sim board only)
+  std::uint64_t seed = 1;                     // --seed N
+  std::uint64_t max_cycles = 0;               // --max-cycles N; 0 = no limit
+  const char* snapshots_dir = nullptr;        // --snapshots DIR
+  const char* trace_file = nullptr;           // --trace FILE
   ConsoleKind console = ConsoleKind::kStdio;  // --console stdio|pty|PATH
   const char* console_path = nullptr;         // the PATH of --console PATH
   const char* state_dir = nullptr;            // --state DIR

@@ -12,8 +12,8 @@ struct Parameter {
   float* value = nullptr;  // owned by the module that registered it
   float min = 0.0F;        // accepted range, inclusive
   float max = 0.0F;
-  bool whole = false;      // only whole numbers
-  const char* help = "";   // one line incl. the unit
+  bool whole = false;     // only whole numbers
+  const char* help = "";  // one line incl. the unit
 };
 
 // A fixed table filled at init; the console looks parameters up by name.

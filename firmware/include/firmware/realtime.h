@@ -1,4 +1,5 @@
-// Realtime: process set-up for the cyclic executive on Linux (mlockall, prefaulted stack, SCHED_FIFO).
+// Realtime: process set-up for the cyclic executive on Linux (mlockall, prefaulted stack,
+// SCHED_FIFO).
 #pragma once
 
 #include <cstddef>
@@ -6,10 +7,10 @@
 namespace boticelli::firmware {
 
 struct RealtimeConfig {
-  bool lock_memory = true;                      // mlockall(MCL_CURRENT | MCL_FUTURE)
+  bool lock_memory = true;                        // mlockall(MCL_CURRENT | MCL_FUTURE)
   std::size_t prefault_stack_bytes = 256 * 1024;  // stack touched once so no page fault later
-  bool fifo = true;                             // SCHED_FIFO when permitted
-  int fifo_priority = 50;                       // 1..99
+  bool fifo = true;                               // SCHED_FIFO when permitted
+  int fifo_priority = 50;                         // 1..99
 };
 
 struct RealtimeReport {

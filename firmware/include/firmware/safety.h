@@ -1,4 +1,5 @@
-// Safety: the e-stop latch — button, bumper or console stop the base at once and keep it stopped until cleared.
+// Safety: the e-stop latch — button, bumper or console stop the base at once and keep it stopped
+// until cleared.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,5 @@
-// ServiceNotifier: systemd's notify protocol (READY=1, WATCHDOG=1, STOPPING=1) as a datagram on $NOTIFY_SOCKET.
+// ServiceNotifier: systemd's notify protocol (READY=1, WATCHDOG=1, STOPPING=1) as a datagram on
+// $NOTIFY_SOCKET.
 #pragma once
 
 #include <sys/socket.h>

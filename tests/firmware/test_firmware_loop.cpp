@@ -1,0 +1,88 @@
+// The firmware's whole cyclic path (device tasks, console, idle mission with state saves) runs
+// without heap allocation.
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "fake_clock.h"
+#include "fake_serial_port.h"
+#include "firmware/console.h"
+#include "firmware/device_tasks.h"
+#include "firmware/executive.h"
+#include "firmware/idle_mission.h"
+#include "firmware/persistence.h"
+#include "firmware/service_notify.h"
+#include "firmware/task_table.h"
+#include "firmware_fakes.h"
+
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+using namespace boticelli::firmware;
+using namespace boticelli::test;
+
+namespace {
+MissionState g_loop_state;
+StateStore g_loop_store;
+}  // namespace
+
+TEST_GROUP(FirmwareLoop) {
+  std::string dir;
+  void setup() override {
+    char templ[] = "/tmp/boticelli-loop-XXXXXX";
+    dir = mkdtemp(templ);
+  }
+  void teardown() override {
+    unlink((dir + "/mission.state").c_str());
+    rmdir(dir.c_str());
+  }
+};
+
+TEST(FirmwareLoop, RunsTasksConsoleTelemetryAndCheckpointsWithoutAllocating) {
+  boticelli::fakes::FakeClock clock{0};
+  boticelli::fakes::FakeSerialPort port;
+  FakeCamera camera;
+  FakePanTilt ptu;
+  FakeBase base{&clock};
+  FakeInput button, bumper;
+  FakeOutput led;
+  FakeWatchdog watchdog;
+  ServiceNotifier notifier;
+  char error[256] = "";
+  CHECK(g_loop_store.open(dir.c_str(), error, sizeof error));
+  g_loop_state.clear();
+
+  Executive exec{clock};
+  Safety safety{button, bumper, base};
+  IdleMission mission{base, ptu, clock, g_loop_state, &g_loop_store, 1000000};
+  ParameterTable parameters;
+  Console console{port, exec, safety, mission, parameters};
+  EstopTask estop_task{safety};
+  BaseTask base_task{base, safety};
+  PanTiltTask ptu_task{ptu};
+  CameraTask camera_task{camera};
+  ConsoleTask console_task{console};
+  WatchdogTask watchdog_task{exec, watchdog, notifier, led};
+  Task* tasks[kTaskCount] = {&estop_task,  &base_task,    &ptu_task,
+                             &camera_task, &console_task, &watchdog_task};
+  const char* why = "";
+  for (std::size_t i = 0; i < kTaskCount; ++i) CHECK(exec.add_task(kTaskTable[i], *tasks[i], &why));
+  exec.set_background(&mission);
+  CHECK(console.register_parameters());
+  console.set_telemetry_ms(250.0F);
+  CHECK(exec.start(ExecutiveConfig{}, &why));
+  mission.start(clock.now_us());
+  port.feed("status\rstats\rpose\rmap\rmodel\rget\rset telemetry_ms 500\rbogus\r");
+
+  CHECK_NO_ALLOCATION(for (int i = 0; i < 350; ++i) exec.run_frame());
+
+  CHECK_EQUAL(3U, mission.cycles_this_run());
+  CHECK_EQUAL(3U, g_loop_store.saves());
+  CHECK(watchdog.kicks > 0);
+  CHECK(camera.releases > 0);
+  CHECK(port.written().find("TLM ") != std::string::npos);
+  CHECK(port.written().find("ERR unknown command") != std::string::npos);
+  CHECK(g_loop_store.load(g_loop_state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(3U, g_loop_state.cycle);
+}
