@@ -63,10 +63,13 @@ float value_noise(float x, float y, std::uint32_t seed) {
   return (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
 }
 
-const Eigen::Vector3f kPaperWhite(0.9F, 0.9F, 0.88F);
-const Eigen::Vector3f kTargetGreen(0.12F, 0.6F, 0.22F);
+struct Rgb {
+  float r, g, b;
+};
+constexpr Rgb kPaperWhite{0.9F, 0.9F, 0.88F};
+constexpr Rgb kTargetGreen{0.12F, 0.6F, 0.22F};
 
-Eigen::Vector3f surface_colour(const Patch& p, float x_m, float y_m) {
+Rgb surface_colour(const Patch& p, float x_m, float y_m) {
   switch (p.surface) {
     case Surface::kTexture: {
       const float s = p.scale_m;
@@ -86,7 +89,7 @@ Eigen::Vector3f surface_colour(const Patch& p, float x_m, float y_m) {
       return {0.55F, 0.52F, 0.36F};                 // khaki
     }
     case Surface::kPlain:
-      return p.colour;
+      return {p.colour[0], p.colour[1], p.colour[2]};
     case Surface::kPaper:
       return kPaperWhite;
     case Surface::kTarget: {
@@ -106,7 +109,7 @@ Eigen::Vector3f surface_colour(const Patch& p, float x_m, float y_m) {
                  ? kTargetGreen
                  : kPaperWhite;
   }
-  return p.colour;
+  return {p.colour[0], p.colour[1], p.colour[2]};
 }
 
 std::uint8_t to_byte(float v) {
@@ -155,16 +158,21 @@ Eigen::Vector3f SceneRenderer::shade(const Eigen::Vector3f& origin_m,
   const Patch* hit = nullptr;
   if (!intersect(origin_m, dir, t, &hit)) return background;
   const Eigen::Vector3f q = origin_m + t * dir - hit->centre_m;
-  return surface_colour(*hit, q.dot(hit->right), q.dot(hit->up));
+  const Rgb c = surface_colour(*hit, q.dot(hit->right), q.dot(hit->up));
+  return {c.r, c.g, c.b};
 }
 
 void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::CameraPose& pose,
                                 std::uint8_t* yuyv, std::uint32_t noise_seed, float noise_sigma,
                                 std::uint32_t sample_step) const {
-  // Per-patch constants for this eye, so a pixel costs a few multiplications per patch.
+  // Per-patch constants for this eye, so a sample costs a few multiplications per patch.
+  // Plain floats: Eigen's out-of-line helpers would come from unoptimised test objects in
+  // Debug builds (one definition per template), making the renderer crawl.
   struct Prepared {
     const Patch* patch;
-    Eigen::Vector3f normal;
+    float normal[3];
+    float right[3];
+    float up[3];
     float numerator;  // n·(c − o)
     float eye_x;      // (o − c)·right
     float eye_y;      // (o − c)·up
@@ -175,42 +183,69 @@ void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::Camer
     if (count == prepared.size()) break;
     const Eigen::Vector3f normal = p.right.cross(p.up);
     const Eigen::Vector3f offset = pose.centre_m - p.centre_m;
-    prepared[count++] = {&p, normal, -normal.dot(offset), offset.dot(p.right), offset.dot(p.up)};
+    prepared[count++] = {&p,
+                         {normal.x(), normal.y(), normal.z()},
+                         {p.right.x(), p.right.y(), p.right.z()},
+                         {p.up.x(), p.up.y(), p.up.z()},
+                         -normal.dot(offset),
+                         offset.dot(p.right),
+                         offset.dot(p.up)};
   }
   const stereo::CameraIntrinsics& cam = rig.camera();
-  const auto colour_at = [&](float pu, float pv) {
-    const Eigen::Vector3f dir =
-        cam.radial_k1 == 0.0F
-            ? Eigen::Vector3f(pose.rotation *
-                              Eigen::Vector3f((pu - cam.principal_x_px) / cam.focal_px,
-                                              (pv - cam.principal_y_px) / cam.focal_px, 1.0F))
-            : stereo::RigModel::ray_ptu(pose, cam, Eigen::Vector2f(pu, pv));
-    Eigen::Vector3f colour = background;
+  float rot[9];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) rot[r * 3 + c] = pose.rotation(r, c);
+  }
+  const float bg[3] = {background.x(), background.y(), background.z()};
+  const auto colour_at = [&](float pu, float pv, float rgb[3]) {
+    float d[3];
+    if (cam.radial_k1 == 0.0F) {
+      const float xn = (pu - cam.principal_x_px) / cam.focal_px;
+      const float yn = (pv - cam.principal_y_px) / cam.focal_px;
+      for (int r = 0; r < 3; ++r) d[r] = rot[r * 3] * xn + rot[r * 3 + 1] * yn + rot[r * 3 + 2];
+    } else {
+      const Eigen::Vector3f ray = stereo::RigModel::ray_ptu(pose, cam, Eigen::Vector2f(pu, pv));
+      d[0] = ray.x();
+      d[1] = ray.y();
+      d[2] = ray.z();
+    }
+    const Patch* hit = nullptr;
+    float hit_x = 0.0F;
+    float hit_y = 0.0F;
     float nearest = 0.0F;
     for (std::size_t i = 0; i < count; ++i) {
       const Prepared& q = prepared[i];
-      const float denom = q.normal.dot(dir);
+      const float denom = q.normal[0] * d[0] + q.normal[1] * d[1] + q.normal[2] * d[2];
       if (std::fabs(denom) < 1e-9F) continue;
       const float t = q.numerator / denom;
-      if (!(t > 1e-4F) || (nearest > 0.0F && t >= nearest)) continue;
-      const float x = q.eye_x + t * dir.dot(q.patch->right);
-      const float y = q.eye_y + t * dir.dot(q.patch->up);
+      if (!(t > 1e-4F) || (hit != nullptr && t >= nearest)) continue;
+      const float x = q.eye_x + t * (d[0] * q.right[0] + d[1] * q.right[1] + d[2] * q.right[2]);
+      const float y = q.eye_y + t * (d[0] * q.up[0] + d[1] * q.up[1] + d[2] * q.up[2]);
       if (std::fabs(x) > q.patch->half_width_m || std::fabs(y) > q.patch->half_height_m) continue;
       nearest = t;
-      colour = surface_colour(*q.patch, x, y);
+      hit = q.patch;
+      hit_x = x;
+      hit_y = y;
     }
-    return Eigen::Vector3f(255.0F * colour);
+    if (hit == nullptr) {
+      for (int c = 0; c < 3; ++c) rgb[c] = 255.0F * bg[c];
+      return;
+    }
+    const Rgb colour = surface_colour(*hit, hit_x, hit_y);
+    rgb[0] = 255.0F * colour.r;
+    rgb[1] = 255.0F * colour.g;
+    rgb[2] = 255.0F * colour.b;
   };
   const auto w = static_cast<std::int32_t>(cam.width_px);
   const auto h = static_cast<std::int32_t>(cam.height_px);
   const std::int32_t step = sample_step == 2 ? 2 : 1;
-  std::vector<Eigen::Vector3f> block_colours(static_cast<std::size_t>(w / 2));
+  std::vector<float> block_colours(static_cast<std::size_t>(w / 2) * 3);
   for (std::int32_t v = 0; v < h; ++v) {
     std::uint8_t* row = yuyv + static_cast<std::ptrdiff_t>(v) * w * 2;
     if (step == 2 && v % 2 == 0) {
       for (std::int32_t b = 0; b < w / 2; ++b) {
-        block_colours[static_cast<std::size_t>(b)] =
-            colour_at(static_cast<float>(2 * b) + 0.5F, static_cast<float>(v) + 0.5F);
+        colour_at(static_cast<float>(2 * b) + 0.5F, static_cast<float>(v) + 0.5F,
+                  &block_colours[static_cast<std::size_t>(b) * 3]);
       }
     }
     for (std::int32_t u = 0; u < w; u += 2) {
@@ -218,16 +253,20 @@ void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::Camer
       float cb = 0.0F;
       float cr = 0.0F;
       for (std::int32_t k = 0; k < 2; ++k) {
-        const Eigen::Vector3f rgb =
-            step == 2 ? block_colours[static_cast<std::size_t>(u / 2)]
-                      : colour_at(static_cast<float>(u + k), static_cast<float>(v));
+        float own[3];
+        const float* rgb = own;
+        if (step == 2) {
+          rgb = &block_colours[static_cast<std::size_t>(u / 2) * 3];
+        } else {
+          colour_at(static_cast<float>(u + k), static_cast<float>(v), own);
+        }
         // Noise per pixel: two uniforms from one hash (standard deviation 0.408), scaled.
         const std::uint32_t hash = hash3(u + k, v, noise_seed);
         const float n =
             static_cast<float>((hash & 0xFFFFU) + (hash >> 16)) * (1.0F / 65536.0F) - 1.0F;
-        ys[k] = 0.299F * rgb.x() + 0.587F * rgb.y() + 0.114F * rgb.z() + 2.449F * noise_sigma * n;
-        cb += 0.5F * (-0.168736F * rgb.x() - 0.331264F * rgb.y() + 0.5F * rgb.z());
-        cr += 0.5F * (0.5F * rgb.x() - 0.418688F * rgb.y() - 0.081312F * rgb.z());
+        ys[k] = 0.299F * rgb[0] + 0.587F * rgb[1] + 0.114F * rgb[2] + 2.449F * noise_sigma * n;
+        cb += 0.5F * (-0.168736F * rgb[0] - 0.331264F * rgb[1] + 0.5F * rgb[2]);
+        cr += 0.5F * (0.5F * rgb[0] - 0.418688F * rgb[1] - 0.081312F * rgb[2]);
       }
       std::uint8_t* p = row + static_cast<std::ptrdiff_t>(u) * 2;
       p[0] = to_byte(ys[0]);
