@@ -210,7 +210,7 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   if (watchdog_armed) hal.watchdog.stop();
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
   for (int i = 0; i < 50 && console.pending_output() > 0 && console.healthy(); ++i) {
-    console.service(hal.clock.now_us());
+    console.drain();
     hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);
   }
   if (mission.save_failures() > 0) {

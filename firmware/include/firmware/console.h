@@ -40,6 +40,8 @@ class Console {
   bool register_parameters();
   // The console task's body: flushes output, reads and executes input, sends telemetry.
   void service(std::uint64_t now_us);
+  // Sends queued output only (no input, telemetry or health lines): for the shutdown drain.
+  void drain() { flush(); }
   // A log line ("LOG <level> <text>") when `level` is within the console's log level.
   void log(LogLevel level, const char* format, ...) __attribute__((format(printf, 3, 4)));
 
