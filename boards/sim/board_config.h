@@ -16,13 +16,13 @@ inline firmware::BoardConfig make_config() {
   firmware::BoardConfig c;
   c.camera_width_px = 640;
   c.camera_height_px = 480;
-  c.focal_px = 600.0F;          // F = 150 px at 160x120, as in the thesis
-  c.principal_x_px = 319.5F;    // image centre in rig.h's pixel-centre convention
+  c.focal_px = 600.0F;        // F = 150 px at 160x120, as in the thesis
+  c.principal_x_px = 319.5F;  // image centre in rig.h's pixel-centre convention
   c.principal_y_px = 239.5F;
-  c.radial_k1 = -0.02F;         // a cheap webcam's mild barrel distortion
+  c.radial_k1 = -0.02F;  // a cheap webcam's mild barrel distortion
   c.ptu_height_m = 0.6F;
-  c.lever_m = 0.21F;            // L
-  c.support_angle_rad = 0.0F;   // Ω
+  c.lever_m = 0.21F;               // L
+  c.support_angle_rad = 0.0F;      // Ω
   c.tilt_step_rad = 0.134390352F;  // Φ = 7.7°
   c.robot_radius_m = 0.25F;
   c.robot_height_m = 0.8F;
@@ -30,11 +30,11 @@ inline firmware::BoardConfig make_config() {
   c.track_width_m = 0.40F;
   c.max_speed_m_s = 0.3F;
   c.max_turn_rate_rad_s = 0.8F;
-  c.minor_frame_us = 10000;     // 100 Hz executive; each frame steps the world 10 ms
+  c.minor_frame_us = 10000;  // 100 Hz executive; each frame steps the world 10 ms
   c.console_baud = 115200;
   c.telemetry_period_ms = 1000;
-  c.realtime = false;           // a host process: no mlockall, no SCHED_FIFO
-  c.watchdog_timeout_ms = 2000; // the stand-in counts expirations in simulated time
+  c.realtime = false;            // a host process: no mlockall, no SCHED_FIFO
+  c.watchdog_timeout_ms = 2000;  // the stand-in counts expirations in simulated time
   // Simulated time stands still while the host computes, so background work is bounded by
   // units, not by the clock: the work per frame (and so the mission) does not depend on
   // the host's speed.
@@ -45,9 +45,9 @@ inline firmware::BoardConfig make_config() {
 
 // Everything only the simulation needs.
 struct SimSettings {
-  float camera_fps = 30.0F;  // frame rate in simulated time
-  hal::sim::RenderSettings render{};   // gain, noise 2 grey levels, vignetting 0.25
-  hal::sim::SimParams physics{};       // PTU-D46 limits/speeds, base ramps, 1 ms steps
+  float camera_fps = 30.0F;           // frame rate in simulated time
+  hal::sim::RenderSettings render{};  // gain, noise 2 grey levels, vignetting 0.25
+  hal::sim::SimParams physics{};      // PTU-D46 limits/speeds, base ramps, 1 ms steps
 };
 
 inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t seed) {

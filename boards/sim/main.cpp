@@ -6,4 +6,6 @@ namespace {
 boticelli::boards::sim::SimBoard g_board;
 }  // namespace
 
-int main(int argc, char** argv) { return boticelli::firmware::firmware_main(argc, argv, g_board); }
+int main(int argc, char** argv) {
+  return boticelli::firmware::firmware_main(argc, argv, g_board);
+}

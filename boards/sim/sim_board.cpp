@@ -20,7 +20,8 @@ SimBoard::SimBoard()
       hal_{camera_, pan_tilt_, base_, estop_, bumper_, status_led_, console_, clock_, watchdog_} {}
 
 bool SimBoard::init(const firmware::Options& options, char* error, std::size_t error_size) {
-  const char* path = options.world_file != nullptr ? options.world_file : BOTICELLI_SIM_DEFAULT_WORLD;
+  const char* path =
+      options.world_file != nullptr ? options.world_file : BOTICELLI_SIM_DEFAULT_WORLD;
   if (!hal::sim::load_world(path, world_, error, error_size)) return false;
   char why[200] = "";
   if (!textures_.build(world_, why, sizeof why)) {

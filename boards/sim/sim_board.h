@@ -62,7 +62,6 @@ class SimBoard final : public firmware::Board {
   hal::sim::WatchdogSim watchdog_;
   SimConsole console_;
   hal::Hal hal_;
-
 };
 
 }  // namespace boticelli::boards::sim

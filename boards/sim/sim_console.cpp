@@ -54,6 +54,8 @@ std::ptrdiff_t SimConsole::write(const std::uint8_t* data, std::size_t size) {
   return active_->write(data, size);
 }
 
-const char* SimConsole::error() const { return error_[0] != '\0' ? error_ : active_->error(); }
+const char* SimConsole::error() const {
+  return error_[0] != '\0' ? error_ : active_->error();
+}
 
 }  // namespace boticelli::boards::sim

@@ -1,4 +1,5 @@
-// SimConsole: the sim board's console — stdio on the host, a fresh pty for --console pty, or a tty path.
+// SimConsole: the sim board's console — stdio on the host, a fresh pty for --console pty, or a tty
+// path.
 #pragma once
 
 #include <cstddef>

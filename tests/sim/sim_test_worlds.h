@@ -10,11 +10,16 @@ inline std::string world_path(const char* name) {
   return std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
 }
 
-inline constexpr const char* kShippedWorlds[] = {
-    "thesis_room",       "cylindrical_room",        "cylindrical_room_offcentre",
-    "rectangular_room",  "corridor",                "box_in_cylindrical_room",
-    "box_in_rectangular_room", "l_shaped_room",     "two_rooms_doorway",
-    "cluttered_room"};
+inline constexpr const char* kShippedWorlds[] = {"thesis_room",
+                                                 "cylindrical_room",
+                                                 "cylindrical_room_offcentre",
+                                                 "rectangular_room",
+                                                 "corridor",
+                                                 "box_in_cylindrical_room",
+                                                 "box_in_rectangular_room",
+                                                 "l_shaped_room",
+                                                 "two_rooms_doorway",
+                                                 "cluttered_room"};
 
 // A world with the robot at the origin facing +x, the target on a paper box, and `models`.
 inline std::string small_world(const std::string& models, const char* robot_pose = "0 0 0 0 0 0") {

@@ -61,9 +61,10 @@ void make_ready(BaseSim& base, ClockSim& clock) {
 
 }  // namespace
 
-TEST_GROUP(SimDevices) {
-  void setup() override { g_error[0] = '\0'; }
-};
+TEST_GROUP(SimDevices){void setup() override{g_error[0] = '\0';
+}
+}
+;
 
 TEST(SimDevices, ThePtuReachesAQuantisedTargetInTheTrapezoidalMoveTime) {
   start("rectangular_room");
@@ -75,7 +76,8 @@ TEST(SimDevices, ThePtuReachesAQuantisedTargetInTheTrapezoidalMoveTime) {
   CHECK(ptu.set_speed(1.0F, 0.5F));
   CHECK(ptu.move_to(1.0F, -0.2F));
   CHECK(ptu.state().moving);
-  const double t = run_until(clock, [&] { return !ptu.state().moving; }, 5.0, 1000);
+  const double t = run_until(
+      clock, [&] { return !ptu.state().moving; }, 5.0, 1000);
   const double res = ptu.limits().pan_resolution_rad;
   const double pan = std::round(1.0 / res) * res;
   const double tilt = std::round(-0.2 / res) * res;
@@ -116,7 +118,8 @@ TEST(SimDevices, HaltingThePtuBrakesToAStopShortOfTheTarget) {
   CHECK(ptu.move_to(2.0F, 0.0F));
   clock.sleep_until_us(500000);
   ptu.halt();
-  CHECK(run_until(clock, [&] { return !ptu.state().moving; }, 2.0) > 0.0);
+  CHECK(run_until(
+            clock, [&] { return !ptu.state().moving; }, 2.0) > 0.0);
   CHECK(ptu.state().pan_rad > 0.3F);
   CHECK(ptu.state().pan_rad < 1.0F);
 }
@@ -157,7 +160,8 @@ TEST(SimDevices, DrivingIntoThePartitionStopsTheBaseCountsOneCollisionAndClosesT
   CHECK_FALSE(bumper.read());
   CHECK_FALSE(bumper.activated_since_last_poll());
   base.set_velocity(0.3F, 0.0F);  // start faces +y, the partition's face is at y = 0.55
-  CHECK(run_until(clock, [&] { return g_sim.collisions() > 0; }, 12.0) > 0.0);
+  CHECK(run_until(
+            clock, [&] { return g_sim.collisions() > 0; }, 12.0) > 0.0);
   UNSIGNED_LONGS_EQUAL(1, g_sim.collisions());
   CHECK(base.health() == BaseHealth::kStopped);
   STRCMP_CONTAINS("partition", base.error());
@@ -175,7 +179,8 @@ TEST(SimDevices, DrivingIntoThePartitionStopsTheBaseCountsOneCollisionAndClosesT
   clock.sleep_until_us(clock.now_us() + 1000000);
   CHECK_FALSE(bumper.read());
   base.set_velocity(0.2F, 0.0F);
-  CHECK(run_until(clock, [&] { return g_sim.collisions() > 1; }, 5.0) > 0.0);
+  CHECK(run_until(
+            clock, [&] { return g_sim.collisions() > 1; }, 5.0) > 0.0);
   UNSIGNED_LONGS_EQUAL(2, g_sim.collisions());
 }
 
@@ -187,7 +192,8 @@ TEST(SimDevices, ARotatedBoxIsHitAtItsTrueOutline) {
   CHECK(g_sim.teleport({-1.4F, -0.6F, 0.0F}));
   make_ready(base, clock);
   base.set_velocity(0.2F, 0.0F);
-  CHECK(run_until(clock, [&] { return g_sim.collisions() > 0; }, 10.0) > 0.0);
+  CHECK(run_until(
+            clock, [&] { return g_sim.collisions() > 0; }, 10.0) > 0.0);
   STRCMP_EQUAL("box_b", g_sim.last_collision_model());
   // The −x face of the turned box crosses y = −0.6 at x = −0.2 − 0.2 / cos(0.2).
   const double face_x = -0.2 - 0.2 / std::cos(0.2);
@@ -205,10 +211,13 @@ TEST(SimDevices, CirclingInFreeSpaceNeverCollides) {
   make_ready(base, clock);
   base.set_velocity(0.25F, 0.4F);  // a 0.625 m circle about (0, 0.625) in the 5 x 5 m room
   bool touched = false;
-  run_until(clock, [&] {
-    touched = touched || bumper.read();
-    return false;
-  }, 60.0);
+  run_until(
+      clock,
+      [&] {
+        touched = touched || bumper.read();
+        return false;
+      },
+      60.0);
   UNSIGNED_LONGS_EQUAL(0, g_sim.collisions());
   CHECK_FALSE(touched);
   CHECK(base.health() == BaseHealth::kReady);
@@ -326,7 +335,8 @@ TEST(SimDevices, TheCameraDeliversFramesAtItsRateFromTheCurrentPose) {
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kFrame);
   UNSIGNED_LONGS_EQUAL(2, frame.sequence);  // frames in between were dropped
   std::size_t differing = 0;
-  for (std::size_t i = 0; i < first.size(); i += 2) differing += first[i] != frame.data[i] ? 1U : 0U;
+  for (std::size_t i = 0; i < first.size(); i += 2)
+    differing += first[i] != frame.data[i] ? 1U : 0U;
   CHECK(differing > first.size() / 4);
   std::size_t surface = 0;
   float d = 0.0F;

@@ -18,10 +18,10 @@
 #include "CppUTest/TestHarness.h"
 
 using namespace boticelli::hal::sim;
-using boticelli::stereo::CameraIntrinsics;
 using boticelli::hal::sim::test::box_model;
 using boticelli::hal::sim::test::small_world;
 using boticelli::hal::sim::test::world_path;
+using boticelli::stereo::CameraIntrinsics;
 
 namespace {
 
@@ -75,13 +75,16 @@ Yuv pixel(const std::vector<std::uint8_t>& img, std::uint32_t width, std::uint32
   const std::size_t pair = (static_cast<std::size_t>(v) * width + (u & ~1U)) * 2;
   return {img[pair + (u & 1U) * 2], img[pair + 1], img[pair + 3]};
 }
-bool is_green(const Yuv& p) { return p.u < 122 && p.v < 115; }
+bool is_green(const Yuv& p) {
+  return p.u < 122 && p.v < 115;
+}
 
 }  // namespace
 
-TEST_GROUP(Renderer) {
-  void setup() override { g_error[0] = '\0'; }
-};
+TEST_GROUP(Renderer){void setup() override{g_error[0] = '\0';
+}
+}
+;
 
 TEST(Renderer, DepthOfAFrontoParallelWallEqualsTheDistanceToIt) {
   // A wall whose near face is the plane x = 3.
@@ -111,8 +114,8 @@ TEST(Renderer, DepthOfATiltedFloorPlaneMatchesTheAnalyticRayIntersection) {
   int floor_pixels = 0;
   for (std::uint32_t v = 0; v < 120; ++v) {
     for (std::uint32_t u = 0; u < 160; ++u) {
-      const Eigen::Vector2f n =
-          camera.normalized_from_pixel(Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v)));
+      const Eigen::Vector2f n = camera.normalized_from_pixel(
+          Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v)));
       const Eigen::Vector3f ray = pose.rotation * Eigen::Vector3f(n.x(), n.y(), 1.0F);
       const float d = depth[v * 160 + u];
       if (ray.z() < -1e-3F) {
@@ -178,11 +181,11 @@ TEST(Renderer, TheTargetIsGreenWhereTheGeometryProjectsIt) {
   // Project the triangle's centroid and the paper beside it through the camera model.
   const Surface& s = g_world.surfaces[g_world.target_surface];
   const TargetFace face = target_face_frame(s);
-  const Eigen::Vector3f centroid = g_world.target_point_m - face.up * (s.target_size_m / std::sqrt(3.0F));
+  const Eigen::Vector3f centroid =
+      g_world.target_point_m - face.up * (s.target_size_m / std::sqrt(3.0F));
   const Eigen::Vector3f paper = face.centre_m - face.up * 0.13F;  // below the triangle's base
   auto project = [&](const Eigen::Vector3f& world_point) {
-    const Eigen::Vector3f c =
-        pose.rotation.transpose() * (world_point - pose.translation_m);
+    const Eigen::Vector3f c = pose.rotation.transpose() * (world_point - pose.translation_m);
     Eigen::Vector2f px;
     CHECK(camera.project(c, px));
     return px;
@@ -220,8 +223,8 @@ TEST(Renderer, TheThesisRoomTargetIsHiddenFromTheStartAndVisibleBehindThePartiti
   std::vector<std::uint8_t> img(160 * 120 * 2);
   auto green_pixels = [&](const boticelli::core::Pose2& robot) {
     // Look straight at the target: pan towards it in the robot frame.
-    const float bearing = std::atan2(g_world.target_point_m.y() - robot.y_m,
-                                     g_world.target_point_m.x() - robot.x_m);
+    const float bearing =
+        std::atan2(g_world.target_point_m.y() - robot.y_m, g_world.target_point_m.x() - robot.x_m);
     const float pan = std::remainder(bearing - robot.yaw_rad, 6.2831853F);
     renderer.render(g_sim.camera_pose(robot, pan, 0.2F), 0, img.data(), 320, nullptr);
     int n = 0;
@@ -284,7 +287,8 @@ TEST(Renderer, CamouflageHasStrongVerticalChangesAndLeavesWeakOnes) {
   int camouflage = -1;
   int leaves = -1;
   for (std::size_t i = 0; i < g_world.surface_count; ++i) {
-    if (g_world.surfaces[i].pattern == Pattern::kCamouflage) camouflage = g_world.surfaces[i].texture;
+    if (g_world.surfaces[i].pattern == Pattern::kCamouflage)
+      camouflage = g_world.surfaces[i].texture;
     if (g_world.surfaces[i].pattern == Pattern::kLeaves) leaves = g_world.surfaces[i].texture;
   }
   CHECK(camouflage >= 0 && leaves >= 0);

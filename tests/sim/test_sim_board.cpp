@@ -26,7 +26,9 @@ TEST_GROUP(SimBoard) {
     board = std::make_unique<boticelli::boards::sim::SimBoard>();
     g_error[0] = '\0';
   }
-  void teardown() override { board.reset(); }
+  void teardown() override {
+    board.reset();
+  }
 };
 
 TEST(SimBoard, DescribesItselfAsASimulatedBoardWithTheThesisRig) {

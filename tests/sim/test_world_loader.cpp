@@ -28,9 +28,10 @@ bool parse(const std::string& xml) {
 }
 }  // namespace
 
-TEST_GROUP(WorldLoader) {
-  void setup() override { g_error[0] = '\0'; }
-};
+TEST_GROUP(WorldLoader){void setup() override{g_error[0] = '\0';
+}
+}
+;
 
 TEST(WorldLoader, EveryShippedWorldLoadsWithAFreeStartAndOneTarget) {
   const boticelli::stereo::RigModel rig;
@@ -183,7 +184,8 @@ TEST(WorldLoader, MalformedFilesAreRejectedWithFileLineAndProblem) {
        "a second <boticelli:target>", 5},
       {"mesh", replace(good, "<box><size>1 1 1</size></box>", "<mesh><uri>a.dae</uri></mesh>"),
        "unsupported geometry <mesh>", 5},
-      {"sphere", replace(good, "<box><size>1 1 1</size></box>", "<sphere><radius>1</radius></sphere>"),
+      {"sphere",
+       replace(good, "<box><size>1 1 1</size></box>", "<sphere><radius>1</radius></sphere>"),
        "unsupported geometry <sphere>", 5},
       {"negative size", replace(good, "1 1 1</size>", "1 -1 1</size>"), "must be > 0", 5},
       {"not a number", replace(good, "1 1 0.5 0 0 0", "1 one 0.5 0 0 0"), "is not a number", 5},
@@ -199,9 +201,8 @@ TEST(WorldLoader, MalformedFilesAreRejectedWithFileLineAndProblem) {
        small_world("<model name=\"c\"><link name=\"l\"><visual name=\"v\"><geometry><cylinder>"
                    "<length>1</length></cylinder></geometry></visual></link></model>"),
        "<cylinder> has no <radius>", 5},
-      {"unknown pattern",
-       replace(good, "<boticelli:pattern>paper", "<boticelli:pattern>tartan"), "unknown pattern",
-       4},
+      {"unknown pattern", replace(good, "<boticelli:pattern>paper", "<boticelli:pattern>tartan"),
+       "unknown pattern", 4},
       {"bad target face", replace(good, "face=\"+x\"", "face=\"up\""), "is not one of", 4},
       {"target too big", replace(good, "size=\"0.2\"", "size=\"0.5\""), "fit the", 4},
       {"target on a cylinder",
@@ -222,7 +223,8 @@ TEST(WorldLoader, MalformedFilesAreRejectedWithFileLineAndProblem) {
   for (const BadWorld& c : cases) {
     g_error[0] = '\0';
     CHECK_FALSE_TEXT(parse(c.xml), c.what);
-    CHECK_TEXT(std::strstr(g_error, c.message) != nullptr, (std::string(c.what) + ": " + g_error).c_str());
+    CHECK_TEXT(std::strstr(g_error, c.message) != nullptr,
+               (std::string(c.what) + ": " + g_error).c_str());
     CHECK_TEXT(std::strncmp(g_error, "test.sdf:", 9) == 0, g_error);
     if (c.line != 0) {
       const std::string expected = "test.sdf:" + std::to_string(c.line) + ":";

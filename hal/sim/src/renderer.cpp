@@ -24,9 +24,9 @@ struct Renderer::Candidate {
   bool visible;
   // Boxes seen from outside: the faces a ray can enter through are those whose plane has the
   // optical centre on its outer side (at most three; for a wall usually one).
-  int entry_count;                    // −1: the camera is inside the box
+  int entry_count;  // −1: the camera is inside the box
   int entry_axis[3];
-  float entry_plane[3];               // ±half size on that axis [m]
+  float entry_plane[3];  // ±half size on that axis [m]
 };
 
 struct Renderer::FrameSetup {
@@ -139,8 +139,8 @@ inline bool hit_cylinder(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
 }
 
 // Rectangle in the local z = 0 plane, half extents h.x, h.y.
-inline bool hit_plane(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
-                      const Eigen::Vector3f& h, float best, Hit& hit) {
+inline bool hit_plane(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const Eigen::Vector3f& h,
+                      float best, Hit& hit) {
   if (std::fabs(d.z()) < 1e-12F) return false;
   const float t = -o.z() / d.z();
   if (t <= kNear_m || t >= best) return false;
@@ -181,8 +181,8 @@ bool Renderer::init(const World& world, const TextureBank& textures,
                     char* error, std::size_t error_size) {
   if (camera.width_px == 0 || camera.height_px == 0 || camera.width_px % 2 != 0 ||
       camera.width_px > 4096 || camera.height_px > 4096 || !(camera.focal_px > 0.0F)) {
-    std::snprintf(error, error_size, "camera %ux%u px, F %g px is not supported",
-                  camera.width_px, camera.height_px, static_cast<double>(camera.focal_px));
+    std::snprintf(error, error_size, "camera %ux%u px, F %g px is not supported", camera.width_px,
+                  camera.height_px, static_cast<double>(camera.focal_px));
     return false;
   }
   world_ = &world;
@@ -362,8 +362,8 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
       const std::uint32_t u_end = std::min(width_, (tx + 1) * kTile);
       const std::uint32_t v_end = std::min(height_, (ty + 1) * kTile);
       for (std::uint32_t v = ty * kTile; v < v_end; ++v) {
-        std::uint8_t* row = yuyv != nullptr ? yuyv + static_cast<std::size_t>(v) * stride_bytes
-                                            : nullptr;
+        std::uint8_t* row =
+            yuyv != nullptr ? yuyv + static_cast<std::size_t>(v) * stride_bytes : nullptr;
         for (std::uint32_t u = tx * kTile; u < u_end; u += 2) {
           float rgb[2][3];
           for (std::uint32_t k = 0; k < 2; ++k) {
@@ -381,11 +381,11 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
                                         c.local_from_camera.col(2);
               Hit hit;
               const Surface& s = world.surfaces[list[n]];
-              const bool found = (s.shape == Shape::kBox && c.entry_count > 0)
-                                     ? hit_box_from_outside(c.origin_local, d, s.half_size_m,
-                                                            c.entry_count, c.entry_axis,
-                                                            c.entry_plane, best.t, hit)
-                                     : hit_surface(s, c.origin_local, d, best.t, hit);
+              const bool found =
+                  (s.shape == Shape::kBox && c.entry_count > 0)
+                      ? hit_box_from_outside(c.origin_local, d, s.half_size_m, c.entry_count,
+                                             c.entry_axis, c.entry_plane, best.t, hit)
+                      : hit_surface(s, c.origin_local, d, best.t, hit);
               if (found) {
                 best = hit;
                 best_surface = list[n];
@@ -455,9 +455,9 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
                 const float lambert = std::max(0.0F, -n_world.dot(light_dir));
                 radiance = albedo.cwiseProduct(ambient + lambert * light);
               } else {
-                radiance = albedo.cwiseProduct(
-                    face_light_[6 * static_cast<std::size_t>(best_surface) +
-                                static_cast<std::size_t>(face)]);
+                radiance =
+                    albedo.cwiseProduct(face_light_[6 * static_cast<std::size_t>(best_surface) +
+                                                    static_cast<std::size_t>(face)]);
               }
             }
             radiance *= gain * vignette_[pix];
@@ -470,8 +470,8 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
           std::uint8_t* out = row + 2 * static_cast<std::size_t>(u);
           float y[2];
           for (std::uint32_t k = 0; k < 2; ++k) {
-            y[k] = 16.0F + (65.481F * rgb[k][0] + 128.553F * rgb[k][1] + 24.966F * rgb[k][2]) /
-                               255.0F;
+            y[k] =
+                16.0F + (65.481F * rgb[k][0] + 128.553F * rgb[k][1] + 24.966F * rgb[k][2]) / 255.0F;
             if (settings_.noise_sigma_grey > 0.0F) {
               const std::uint32_t pix = v * width_ + u + k;
               y[k] += settings_.noise_sigma_grey * noise_sd(noise_key ^ (pix * 0x85EBCA6BU));
@@ -490,8 +490,8 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
   }
 }
 
-bool cast_ray(const World& world, const Eigen::Vector3f& origin_m,
-              const Eigen::Vector3f& direction, std::size_t& surface, float& t) {
+bool cast_ray(const World& world, const Eigen::Vector3f& origin_m, const Eigen::Vector3f& direction,
+              std::size_t& surface, float& t) {
   Hit best;
   bool found = false;
   for (std::size_t i = 0; i < world.surface_count; ++i) {

@@ -23,8 +23,8 @@ float distance_to_hull(const Collider& c, float px, float py) {
     const float ex = b.x_m - a.x_m;
     const float ey = b.y_m - a.y_m;
     const float len2 = ex * ex + ey * ey;
-    const float t = len2 > 0.0F ? std::clamp(((px - a.x_m) * ex + (py - a.y_m) * ey) / len2, 0.0F, 1.0F)
-                                : 0.0F;
+    const float t =
+        len2 > 0.0F ? std::clamp(((px - a.x_m) * ex + (py - a.y_m) * ey) / len2, 0.0F, 1.0F) : 0.0F;
     best = std::min(best, std::hypot(px - a.x_m - t * ex, py - a.y_m - t * ey));
     if (ex * (py - a.y_m) - ey * (px - a.x_m) < 0.0F) inside = false;  // right of an edge
   }
@@ -110,8 +110,7 @@ RigidTransform SimWorld::camera_pose(const core::Pose2& robot, float pan_rad,
   const float c = std::cos(robot.yaw_rad);
   const float s = std::sin(robot.yaw_rad);
   world_from_ptu.rotation << c, -s, 0.0F, s, c, 0.0F, 0.0F, 0.0F, 1.0F;
-  world_from_ptu.translation_m =
-      Eigen::Vector3f(robot.x_m, robot.y_m, rig_->params().ptu_height_m);
+  world_from_ptu.translation_m = Eigen::Vector3f(robot.x_m, robot.y_m, rig_->params().ptu_height_m);
   return world_from_ptu.then(RigidTransform{cam.rotation, cam.centre_m});
 }
 
@@ -131,7 +130,8 @@ bool SimWorld::teleport(const core::Pose2& pose) {
 
 void SimWorld::advance_to(std::uint64_t deadline_us) {
   while (now_us_ < deadline_us) {
-    const std::uint64_t dt = std::min<std::uint64_t>(params_.physics_step_us, deadline_us - now_us_);
+    const std::uint64_t dt =
+        std::min<std::uint64_t>(params_.physics_step_us, deadline_us - now_us_);
     step(static_cast<std::uint32_t>(dt));
   }
 }
@@ -168,7 +168,8 @@ void SimWorld::step_axis(PtuAxis& axis, float dt_s) const {
   if (!axis.moving()) return;
   const float a = params_.ptu.accel_rad_s2;
   const float error = axis.target_rad - axis.position_rad;
-  const float remaining = std::max(0.0F, std::fabs(error) - 0.5F * std::fabs(axis.velocity_rad_s) * dt_s);
+  const float remaining =
+      std::max(0.0F, std::fabs(error) - 0.5F * std::fabs(axis.velocity_rad_s) * dt_s);
   const float brake_speed =
       std::max(0.0F, 0.5F * (-a * dt_s + std::sqrt(a * a * dt_s * dt_s + 8.0F * a * remaining)));
   const float desired = std::copysign(std::min(axis.speed_rad_s, brake_speed), error);

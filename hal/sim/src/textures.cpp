@@ -127,10 +127,12 @@ float TextureBank::sample(int texture, float u, float v) const {
   const float ty = v - fv;
   const float a = static_cast<float>(t[y0 * kTextureSize + x0]) +
                   (static_cast<float>(t[y0 * kTextureSize + x1]) -
-                   static_cast<float>(t[y0 * kTextureSize + x0])) * tx;
+                   static_cast<float>(t[y0 * kTextureSize + x0])) *
+                      tx;
   const float b = static_cast<float>(t[y1 * kTextureSize + x0]) +
                   (static_cast<float>(t[y1 * kTextureSize + x1]) -
-                   static_cast<float>(t[y1 * kTextureSize + x0])) * tx;
+                   static_cast<float>(t[y1 * kTextureSize + x0])) *
+                      tx;
   return (a + (b - a) * ty) * (1.0F / 128.0F);
 }
 

@@ -59,7 +59,8 @@ constexpr float kMaxSize_m = 1000.0F;
 // Collects the first error as "FILE:LINE: message".
 class Errors {
  public:
-  Errors(const char* file, char* buffer, std::size_t size) : file_(file), buffer_(buffer), size_(size) {}
+  Errors(const char* file, char* buffer, std::size_t size)
+      : file_(file), buffer_(buffer), size_(size) {}
   bool fail(int line, const char* fmt, ...) __attribute__((format(printf, 3, 4))) {
     if (failed_) return false;
     failed_ = true;
@@ -84,7 +85,9 @@ class Errors {
   bool failed_ = false;
 };
 
-bool is_name(const XMLElement* e, const char* name) { return std::strcmp(e->Name(), name) == 0; }
+bool is_name(const XMLElement* e, const char* name) {
+  return std::strcmp(e->Name(), name) == 0;
+}
 
 // Parses exactly `count` finite numbers (or between min_count and count) from an element's text.
 bool parse_numbers(const XMLElement* e, float* out, int min_count, int count, Errors& errors) {
@@ -106,8 +109,7 @@ bool parse_numbers(const XMLElement* e, float* out, int min_count, int count, Er
     const double v = std::strtod(p, &end);
     const bool separated = end != nullptr && (*end == '\0' || *end == ' ' || *end == '\t' ||
                                               *end == '\n' || *end == '\r');
-    if (end == p || !separated || errno == ERANGE || !std::isfinite(v) ||
-        std::fabs(v) > 1e6) {
+    if (end == p || !separated || errno == ERANGE || !std::isfinite(v) || std::fabs(v) > 1e6) {
       return errors.fail(e->GetLineNum(), "<%s>: '%.40s' is not a number", e->Name(), p);
     }
     out[n++] = static_cast<float>(v);
@@ -148,8 +150,8 @@ bool parse_colour(const XMLElement* e, Rgb& out, Errors& errors) {
   if (!parse_numbers(e, v, 3, 4, errors)) return false;
   for (int i = 0; i < 4; ++i) {
     if (v[i] < 0.0F || v[i] > 1.0F) {
-      return errors.fail(e->GetLineNum(), "<%s>: colour component %g is outside [0, 1]",
-                         e->Name(), static_cast<double>(v[i]));
+      return errors.fail(e->GetLineNum(), "<%s>: colour component %g is outside [0, 1]", e->Name(),
+                         static_cast<double>(v[i]));
     }
   }
   out = {v[0], v[1], v[2]};
@@ -176,7 +178,8 @@ bool parse_geometry(const XMLElement* owner, Shape& shape, Eigen::Vector3f& half
   if (g == nullptr) return errors.fail(geometry->GetLineNum(), "<geometry> has no shape");
   if (g->NextSiblingElement() != nullptr) {
     return errors.fail(g->NextSiblingElement()->GetLineNum(),
-                       "<geometry> has more than one shape (<%s>)", g->NextSiblingElement()->Name());
+                       "<geometry> has more than one shape (<%s>)",
+                       g->NextSiblingElement()->Name());
   }
   plane_frame = RigidTransform{};
   if (is_name(g, "box")) {
@@ -222,7 +225,8 @@ bool parse_geometry(const XMLElement* owner, Shape& shape, Eigen::Vector3f& half
     return true;
   }
   return errors.fail(g->GetLineNum(),
-                     "unsupported geometry <%s> (only box, cylinder and plane are drawn)", g->Name());
+                     "unsupported geometry <%s> (only box, cylinder and plane are drawn)",
+                     g->Name());
 }
 
 std::uint32_t parse_seed(const XMLElement* e, Errors& errors) {
@@ -425,7 +429,8 @@ struct Loader {
     const char* name = model->Attribute("name") != nullptr ? model->Attribute("name") : "";
     RigidTransform model_pose;
     if (!parse_pose(model, model_pose, errors)) return false;
-    for (const XMLElement* e = model->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+    for (const XMLElement* e = model->FirstChildElement(); e != nullptr;
+         e = e->NextSiblingElement()) {
       if (is_name(e, "model")) {
         return errors.fail(e->GetLineNum(), "nested <model> is not supported");
       }
@@ -527,7 +532,8 @@ struct Loader {
       }
     }
     if (!have_robot) {
-      return errors.fail(w->GetLineNum(), "no robot: <include><uri>model://boticelli</uri> is required");
+      return errors.fail(w->GetLineNum(),
+                         "no robot: <include><uri>model://boticelli</uri> is required");
     }
     if (targets == 0) {
       return errors.fail(w->GetLineNum(), "no <boticelli:target> (exactly one is required)");

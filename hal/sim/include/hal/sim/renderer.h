@@ -13,26 +13,25 @@ namespace boticelli::hal::sim {
 
 // Image formation after the scene radiance (all deterministic for a given seed).
 struct RenderSettings {
-  float gain = 1.0F;                  // radiance 1.0 → 255 grey levels before clipping
-  float noise_sigma_grey = 2.0F;      // sensor noise, standard deviation [grey levels of Y]
-  float vignetting = 0.25F;           // relative brightness loss at the image corners [0, 1)
-  bool shading = true;                // Lambert + ambient; false = albedo only
-  std::uint64_t seed = 1;             // noise seed
+  float gain = 1.0F;                    // radiance 1.0 → 255 grey levels before clipping
+  float noise_sigma_grey = 2.0F;        // sensor noise, standard deviation [grey levels of Y]
+  float vignetting = 0.25F;             // relative brightness loss at the image corners [0, 1)
+  bool shading = true;                  // Lambert + ambient; false = albedo only
+  std::uint64_t seed = 1;               // noise seed
   Rgb background{0.05F, 0.05F, 0.06F};  // rays that hit nothing
 };
 
 // First surface hit by the ray origin + t·direction, t > 0 (direction need not be unit; t is
 // in its units). False when nothing is hit. For ground truth (visibility of the target).
-bool cast_ray(const World& world, const Eigen::Vector3f& origin_m,
-              const Eigen::Vector3f& direction, std::size_t& surface, float& t);
+bool cast_ray(const World& world, const Eigen::Vector3f& origin_m, const Eigen::Vector3f& direction,
+              std::size_t& surface, float& t);
 
 class Renderer {
  public:
   // Precomputes the per-pixel rays (with the radial distortion) and the vignetting; allocates,
   // so call at init. `world` and `textures` must outlive the renderer.
-  bool init(const World& world, const TextureBank& textures,
-            const stereo::CameraIntrinsics& camera, const RenderSettings& settings, char* error,
-            std::size_t error_size);
+  bool init(const World& world, const TextureBank& textures, const stereo::CameraIntrinsics& camera,
+            const RenderSettings& settings, char* error, std::size_t error_size);
 
   // Draws the view from `world_from_camera` (camera frame: x right, y down, z forward) into
   // a YUYV image (`stride_bytes` per row) and, if `depth_m` is given, the z-depth [m] along

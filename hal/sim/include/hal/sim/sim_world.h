@@ -16,9 +16,9 @@ namespace boticelli::hal::sim {
 // PTU-D46-like axis behaviour (defaults: the D46's limits and its 185.1428" resolution).
 struct PtuParams {
   PanTiltLimits limits{-2.7751F, 2.7751F, -0.8203F, 0.5411F, 8.9759e-4F, 8.9759e-4F};
-  float speed_rad_s = 1.0F;        // default speed of both axes
-  float max_speed_rad_s = 2.6F;    // fastest set_speed() accepted
-  float accel_rad_s2 = 4.0F;       // acceleration and deceleration of both axes
+  float speed_rad_s = 1.0F;      // default speed of both axes
+  float max_speed_rad_s = 2.6F;  // fastest set_speed() accepted
+  float accel_rad_s2 = 4.0F;     // acceleration and deceleration of both axes
 };
 
 struct BaseParams {
@@ -27,11 +27,11 @@ struct BaseParams {
   float track_width_m = 0.40F;
   float max_speed_m_s = 0.3F;
   float max_turn_rate_rad_s = 0.8F;
-  float wheel_accel_m_s2 = 1.0F;        // velocity ramp at the wheel rim (ODrive vel_ramp)
-  float odometry_noise = 0.0F;          // relative sd of each wheel's step distance (0 = off)
-  std::uint32_t startup_us = 50000;     // start-up until closed-loop control [µs]
-  float contact_margin_m = 0.01F;       // the bumper closes within this gap [m]
-  float floor_clearance_m = 0.01F;      // obstacles lower than this are driven over [m]
+  float wheel_accel_m_s2 = 1.0F;     // velocity ramp at the wheel rim (ODrive vel_ramp)
+  float odometry_noise = 0.0F;       // relative sd of each wheel's step distance (0 = off)
+  std::uint32_t startup_us = 50000;  // start-up until closed-loop control [µs]
+  float contact_margin_m = 0.01F;    // the bumper closes within this gap [m]
+  float floor_clearance_m = 0.01F;   // obstacles lower than this are driven over [m]
 };
 
 struct SimParams {

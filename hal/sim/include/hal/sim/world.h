@@ -13,8 +13,8 @@ namespace boticelli::hal::sim {
 // Capacities: a world file with more elements than these is rejected, not truncated.
 inline constexpr std::size_t kMaxSurfaces = 256;
 inline constexpr std::size_t kMaxColliders = 256;
-inline constexpr std::size_t kMaxTextures = 12;         // distinct (pattern, seed) pairs
-inline constexpr std::size_t kMaxNameLength = 63;       // model names, longer ones are cut
+inline constexpr std::size_t kMaxTextures = 12;    // distinct (pattern, seed) pairs
+inline constexpr std::size_t kMaxNameLength = 63;  // model names, longer ones are cut
 inline constexpr std::size_t kMaxWorldFileBytes = 4U << 20U;
 inline constexpr std::size_t kMaxHullVertices = 8;
 
@@ -54,11 +54,11 @@ struct Surface {
   Pattern pattern = Pattern::kPlain;
   float pattern_scale_m = 0.1F;  // camouflage blotch size / leaf size [m]
   std::uint32_t pattern_seed = 1;
-  int texture = -1;              // index into the TextureBank for camouflage and leaves
-  int target_face = kNoFace;     // face with the green triangle, or kNoFace
-  float target_size_m = 0.0F;    // side of the triangle [m]
+  int texture = -1;            // index into the TextureBank for camouflage and leaves
+  int target_face = kNoFace;   // face with the green triangle, or kNoFace
+  float target_size_m = 0.0F;  // side of the triangle [m]
   char model[kMaxNameLength + 1] = {};
-  int line = 0;                  // line of the <visual> in the world file
+  int line = 0;  // line of the <visual> in the world file
 };
 
 // One obstacle the robot's cylinder can hit: a vertical prism (convex polygon on the floor
@@ -81,7 +81,7 @@ struct World {
   Rgb ambient{0.5F, 0.5F, 0.5F};
   Eigen::Vector3f light_direction = Eigen::Vector3f(0.0F, 0.0F, -1.0F);  // unit, travel direction
   Rgb light_diffuse{0.5F, 0.5F, 0.5F};
-  core::Pose2 start{};                     // the robot's start pose
+  core::Pose2 start{};  // the robot's start pose
   Surface surfaces[kMaxSurfaces];
   std::size_t surface_count = 0;
   Collider colliders[kMaxColliders];
