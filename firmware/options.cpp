@@ -43,7 +43,7 @@ const char* usage_text() {
          "  --trace FILE        write the robot's path as CSV to FILE\n"
          "  --console KIND      stdio (default), pty, or the PATH of a serial device\n"
          "  --state DIR         keep the mission state in DIR (written atomically)\n"
-         "  --resume            continue the mission saved in --state DIR\n"
+         "  --resume            continue the mission saved in --state DIR (new if none)\n"
          "  --version           print the version and board, then exit\n"
          "  --help              print this text, then exit\n";
 }
