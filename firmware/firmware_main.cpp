@@ -18,6 +18,7 @@
 #include "firmware/realtime.h"
 #include "firmware/safety.h"
 #include "firmware/service_notify.h"
+#include "firmware/state_saver.h"
 #include "firmware/task_table.h"
 
 namespace boticelli::firmware {
@@ -45,9 +46,10 @@ ParameterTable g_parameters;
 // storage, no heap; firmware_main may be called again, e.g. by tests).
 struct Runtime {
   Runtime(hal::Hal& hal, const BoardConfig& config, StateStore* store)
-      : executive(hal.clock),
+      : saver(g_store),
+        executive(hal.clock),
         safety(hal.estop, hal.bumper, hal.base),
-        mission(hal.base, hal.pan_tilt, hal.clock, g_state, store,
+        mission(hal.base, hal.pan_tilt, hal.clock, g_state, store != nullptr ? &saver : nullptr,
                 config.checkpoint_period_ms * 1000U),
         console(hal.console, executive, safety, mission, g_parameters),
         estop_task(safety),
@@ -58,6 +60,7 @@ struct Runtime {
         watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {}
 
   ServiceNotifier notifier;
+  StateSaver saver;
   Executive executive;
   Safety safety;
   IdleMission mission;
@@ -139,6 +142,7 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   g_parameters = ParameterTable{};
   g_runtime.emplace(hal, config, store);
   Runtime& rt = *g_runtime;
+  if (store != nullptr) rt.saver.start();
   ServiceNotifier& notifier = rt.notifier;
   if (!notifier.open()) std::fprintf(stderr, "boticelli: %s\n", notifier.error());
   Executive& executive = rt.executive;
@@ -213,9 +217,11 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
     console.drain();
     hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);
   }
-  if (mission.save_failures() > 0) {
+  mission.finish_saving();
+  if (rt.saver.failures() > 0) {
+    rt.saver.last_error(error, sizeof error);
     std::fprintf(stderr, "boticelli: %llu state saves failed, last: %s\n",
-                 static_cast<unsigned long long>(mission.save_failures()), mission.last_error());
+                 static_cast<unsigned long long>(rt.saver.failures()), error);
   }
   const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
   // No mission yet: the run ends aborted (never found), with no target estimate.

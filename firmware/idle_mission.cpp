@@ -20,6 +20,7 @@ MapCounts IdleMission::map_counts() const {
 }
 
 StepResult IdleMission::step(SliceBudget& budget) {
+  if (submit_pending_ && saver_->submit(state_)) submit_pending_ = false;
   if (clock_.now_us() < next_cycle_us_ || !budget.next_unit()) return StepResult::kMore;
   next_cycle_us_ += period_us_;
   ++state_.cycle;
@@ -30,8 +31,14 @@ StepResult IdleMission::step(SliceBudget& budget) {
                static_cast<double>(state_.pose.x_m), static_cast<double>(state_.pose.y_m),
                static_cast<double>(state_.pose.yaw_rad));
   state_.add_log(state_.cycle, line.view());
-  if (store_ != nullptr && !store_->save(state_, error_, sizeof error_)) ++save_failures_;
+  if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
   return StepResult::kDone;
+}
+
+void IdleMission::finish_saving() {
+  if (saver_ == nullptr) return;
+  while (submit_pending_) submit_pending_ = !saver_->submit(state_);
+  saver_->flush();
 }
 
 }  // namespace boticelli::firmware

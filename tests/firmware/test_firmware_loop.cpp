@@ -13,6 +13,7 @@
 #include "firmware/idle_mission.h"
 #include "firmware/persistence.h"
 #include "firmware/service_notify.h"
+#include "firmware/state_saver.h"
 #include "firmware/task_table.h"
 #include "firmware_fakes.h"
 
@@ -55,7 +56,9 @@ TEST(FirmwareLoop, RunsTasksConsoleTelemetryAndCheckpointsWithoutAllocating) {
 
   Executive exec{clock};
   Safety safety{button, bumper, base};
-  IdleMission mission{base, ptu, clock, g_loop_state, &g_loop_store, 1000000};
+  StateSaver saver{g_loop_store};
+  saver.start();
+  IdleMission mission{base, ptu, clock, g_loop_state, &saver, 1000000};
   ParameterTable parameters;
   Console console{port, exec, safety, mission, parameters};
   EstopTask estop_task{safety};
@@ -77,8 +80,10 @@ TEST(FirmwareLoop, RunsTasksConsoleTelemetryAndCheckpointsWithoutAllocating) {
 
   CHECK_NO_ALLOCATION(for (int i = 0; i < 350; ++i) exec.run_frame());
 
+  mission.finish_saving();
   CHECK_EQUAL(3U, mission.cycles_this_run());
-  CHECK_EQUAL(3U, g_loop_store.saves());
+  CHECK(saver.saved() >= 1U);  // the writer may have skipped to the newest state
+  CHECK_EQUAL(0U, saver.failures());
   CHECK(watchdog.kicks > 0);
   CHECK(camera.releases > 0);
   CHECK(port.written().find("TLM ") != std::string::npos);

@@ -11,10 +11,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <memory>
 #include <string>
 
 #include "firmware/mission_state.h"
 #include "firmware/persistence.h"
+#include "firmware/state_saver.h"
 
 #include "CppUTest/TestHarness.h"
 
@@ -318,4 +320,26 @@ TEST(Persistence, AKilledRunResumesWithNothingLostAndNothingCorrupt) {
     last_loaded = g_b.cycle;
   }
   CHECK(last_loaded >= 6U);
+}
+
+TEST(Persistence, TheWriterThreadEndsWithTheNewestSubmittedState) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  {
+    auto owner = std::make_unique<StateSaver>(g_store);  // two states: not on the stack
+    StateSaver& saver = *owner;
+    saver.start();
+    for (std::uint64_t c = 1; c <= 30; ++c) {
+      make_state(c, g_a);
+      while (!saver.submit(g_a)) {
+      }
+    }
+    saver.flush();
+    CHECK(saver.saved() >= 1U);
+    CHECK(saver.saved() <= 30U);
+    CHECK_EQUAL(0U, saver.failures());
+  }
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(30U, g_b.cycle);
+  make_state(30, g_a);
+  CHECK(g_a == g_b);
 }

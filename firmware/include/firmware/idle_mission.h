@@ -7,7 +7,7 @@
 #include "firmware/executive.h"
 #include "firmware/mission_state.h"
 #include "firmware/mission_view.h"
-#include "firmware/persistence.h"
+#include "firmware/state_saver.h"
 #include "hal/base.h"
 #include "hal/clock.h"
 #include "hal/pan_tilt.h"
@@ -16,18 +16,18 @@ namespace boticelli::firmware {
 
 // A "cycle" here is one checkpoint period of board time (simulated time on the sim board):
 // the background slot records the odometry pose and a mission-log line in the state and,
-// with --state, saves it atomically. It never moves the robot. The mission replaces this
-// class with the same two interfaces (MissionView for the console, BackgroundWork for the
-// executive).
+// with --state, hands it to the StateSaver (saved atomically by its writer thread). It never moves
+// the robot. The mission replaces this class with the same two interfaces (MissionView for the
+// console, BackgroundWork for the executive).
 class IdleMission final : public MissionView, public BackgroundWork {
  public:
   IdleMission(hal::Base& base, hal::PanTilt& ptu, hal::Clock& clock, MissionState& state,
-              StateStore* store, std::uint32_t cycle_period_us)
+              StateSaver* saver, std::uint32_t cycle_period_us)
       : base_(base),
         ptu_(ptu),
         clock_(clock),
         state_(state),
-        store_(store),
+        saver_(saver),
         period_us_(cycle_period_us) {}
 
   // Anchors the first cycle one period after now.
@@ -42,20 +42,19 @@ class IdleMission final : public MissionView, public BackgroundWork {
   MapCounts map_counts() const override;
 
   std::uint64_t cycles_this_run() const { return cycles_this_run_; }
-  std::uint64_t save_failures() const { return save_failures_; }
-  const char* last_error() const { return error_; }
+  // Shutdown: hands over a state still waiting for the writer and waits until it is saved.
+  void finish_saving();
 
  private:
   hal::Base& base_;
   hal::PanTilt& ptu_;
   hal::Clock& clock_;
   MissionState& state_;
-  StateStore* store_;
+  StateSaver* saver_;
   std::uint32_t period_us_;
   std::uint64_t next_cycle_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;
-  std::uint64_t save_failures_ = 0;
-  char error_[256] = "";
+  bool submit_pending_ = false;  // the last cycle's state still waits for the writer
 };
 
 }  // namespace boticelli::firmware
