@@ -163,7 +163,7 @@ TEST(AlnTrain, FitsTheCylindricalRoomToEpsilonWithEveryPieceInsideItsBounds) {
 }
 
 TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
-  const std::size_t n = fill_room(2500, 0.03, 8);
+  const std::size_t n = fill_room(2000, 0.03, 8);
   set_room_ranges(g_model3);
   set_room_ranges(g_model3b);
   aln::TrainerConfig cfg;
@@ -188,7 +188,7 @@ TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
 }
 
 TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
-  const std::size_t n = fill_room(3000, 0.0, 12);
+  const std::size_t n = fill_room(2000, 0.0, 12);
   set_room_ranges(g_model3);
   set_room_ranges(g_model3b);
   aln::TrainerConfig cfg;
@@ -201,7 +201,7 @@ TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
 }
 
 TEST(AlnTrain, RobustWeightsStopOutliersForcingExtraPieces) {
-  const std::size_t n = fill_room(4000, 0.05, 31);
+  const std::size_t n = fill_room(3000, 0.05, 31);
   set_room_ranges(g_model3);
   set_room_ranges(g_model3b);
   aln::TrainerConfig cfg;
@@ -230,7 +230,7 @@ TEST(AlnTrain, RobustWeightsStopOutliersForcingExtraPieces) {
 }
 
 TEST(AlnTrain, PieceCapAndIterationCapAreHonoured) {
-  const std::size_t n = fill_room(3000, 0.0, 2);
+  const std::size_t n = fill_room(2000, 0.0, 2);
   set_room_ranges(g_model3);
   aln::TrainerConfig cfg;
   cfg.epsilon = 0.001;
