@@ -240,11 +240,13 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
   }
   const int bu = row_best_u[static_cast<std::size_t>(best_row)];
   const int bv = row_far + best_row * step;
-  float dv = 0.0F;
-  if (window_fits(second, bu, bv - 1) && window_fits(second, bu, bv + 1)) {
-    dv = parabola_offset(error_against(feature, second, bu, bv - 1), best_e,
-                         error_against(feature, second, bu, bv + 1));
+  // A best match against the image border is where the search was cut off, not a minimum:
+  // the true match has most likely left the frame.
+  if (!window_fits(second, bu, bv - 1) || !window_fits(second, bu, bv + 1)) {
+    return track;
   }
+  const float dv = parabola_offset(error_against(feature, second, bu, bv - 1), best_e,
+                                   error_against(feature, second, bu, bv + 1));
   // The column follows the epipolar line at the refined row (a separate horizontal
   // parabola would be biased by oblique texture at the integer row).
   float v_sub = static_cast<float>(bv) + dv;
