@@ -42,6 +42,22 @@ const std::array<float, kLattice * kLattice>& lattice() {
   return table;
 }
 
+// Luma noise with unit standard deviation (sum of two uniforms), built once.
+constexpr std::size_t kNoiseTable = 1U << 18;
+const std::array<float, kNoiseTable>& noise_table() {
+  static std::array<float, kNoiseTable> table{};
+  static const bool filled = [] {
+    for (std::size_t i = 0; i < kNoiseTable; ++i) {
+      const std::uint32_t hash = hash3(static_cast<std::int32_t>(i), 17, 0xA5A5U);
+      table[i] =
+          2.449F * (static_cast<float>((hash & 0xFFFFU) + (hash >> 16)) * (1.0F / 65536.0F) - 1.0F);
+    }
+    return true;
+  }();
+  (void)filled;
+  return table;
+}
+
 // Smooth value noise in [0, 1] with lattice spacing 1.
 float value_noise(float x, float y, std::uint32_t seed) {
   const float fx = std::floor(x);
@@ -197,7 +213,7 @@ void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::Camer
     for (int c = 0; c < 3; ++c) rot[r * 3 + c] = pose.rotation(r, c);
   }
   const float bg[3] = {background.x(), background.y(), background.z()};
-  const auto colour_at = [&](float pu, float pv, float rgb[3]) {
+  const auto colour_at = [&](float pu, float pv, float ycc[3]) {
     float d[3];
     if (cam.radial_k1 == 0.0F) {
       const float xn = (pu - cam.principal_x_px) / cam.focal_px;
@@ -227,52 +243,37 @@ void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::Camer
       hit_x = x;
       hit_y = y;
     }
-    if (hit == nullptr) {
-      for (int c = 0; c < 3; ++c) rgb[c] = 255.0F * bg[c];
-      return;
-    }
-    const Rgb colour = surface_colour(*hit, hit_x, hit_y);
-    rgb[0] = 255.0F * colour.r;
-    rgb[1] = 255.0F * colour.g;
-    rgb[2] = 255.0F * colour.b;
+    const Rgb c = hit == nullptr ? Rgb{bg[0], bg[1], bg[2]} : surface_colour(*hit, hit_x, hit_y);
+    // BT.601 full range, chroma centred on 128.
+    ycc[0] = 255.0F * (0.299F * c.r + 0.587F * c.g + 0.114F * c.b);
+    ycc[1] = 128.0F + 255.0F * (-0.168736F * c.r - 0.331264F * c.g + 0.5F * c.b);
+    ycc[2] = 128.0F + 255.0F * (0.5F * c.r - 0.418688F * c.g - 0.081312F * c.b);
   };
   const auto w = static_cast<std::int32_t>(cam.width_px);
   const auto h = static_cast<std::int32_t>(cam.height_px);
   const std::int32_t step = sample_step == 2 ? 2 : 1;
-  std::vector<float> block_colours(static_cast<std::size_t>(w / 2) * 3);
+  const auto& noise = noise_table();
+  const std::size_t noise_offset = std::size_t{noise_seed} * 7919U;
+  std::vector<float> samples(static_cast<std::size_t>(w) * 3);  // Y Cb Cr per sample of a row
   for (std::int32_t v = 0; v < h; ++v) {
     std::uint8_t* row = yuyv + static_cast<std::ptrdiff_t>(v) * w * 2;
-    if (step == 2 && v % 2 == 0) {
-      for (std::int32_t b = 0; b < w / 2; ++b) {
-        colour_at(static_cast<float>(2 * b) + 0.5F, static_cast<float>(v) + 0.5F,
-                  &block_colours[static_cast<std::size_t>(b) * 3]);
+    if (step == 1 || v % 2 == 0) {
+      for (std::int32_t u = 0; u < w; u += step) {
+        const float offset = step == 2 ? 0.5F : 0.0F;
+        colour_at(static_cast<float>(u) + offset, static_cast<float>(v) + offset,
+                  &samples[static_cast<std::size_t>(u / step) * 3]);
       }
     }
     for (std::int32_t u = 0; u < w; u += 2) {
-      float ys[2];
-      float cb = 0.0F;
-      float cr = 0.0F;
-      for (std::int32_t k = 0; k < 2; ++k) {
-        float own[3];
-        const float* rgb = own;
-        if (step == 2) {
-          rgb = &block_colours[static_cast<std::size_t>(u / 2) * 3];
-        } else {
-          colour_at(static_cast<float>(u + k), static_cast<float>(v), own);
-        }
-        // Noise per pixel: two uniforms from one hash (standard deviation 0.408), scaled.
-        const std::uint32_t hash = hash3(u + k, v, noise_seed);
-        const float n =
-            static_cast<float>((hash & 0xFFFFU) + (hash >> 16)) * (1.0F / 65536.0F) - 1.0F;
-        ys[k] = 0.299F * rgb[0] + 0.587F * rgb[1] + 0.114F * rgb[2] + 2.449F * noise_sigma * n;
-        cb += 0.5F * (-0.168736F * rgb[0] - 0.331264F * rgb[1] + 0.5F * rgb[2]);
-        cr += 0.5F * (0.5F * rgb[0] - 0.418688F * rgb[1] - 0.081312F * rgb[2]);
-      }
+      const float* a = &samples[static_cast<std::size_t>(u / step) * 3];
+      const float* b = &samples[static_cast<std::size_t>((u + 1) / step) * 3];
+      const std::size_t i =
+          static_cast<std::size_t>(v) * static_cast<std::size_t>(w) + static_cast<std::size_t>(u);
       std::uint8_t* p = row + static_cast<std::ptrdiff_t>(u) * 2;
-      p[0] = to_byte(ys[0]);
-      p[1] = to_byte(cb + 128.0F);
-      p[2] = to_byte(ys[1]);
-      p[3] = to_byte(cr + 128.0F);
+      p[0] = to_byte(a[0] + noise_sigma * noise[(i + noise_offset) & (kNoiseTable - 1)]);
+      p[1] = to_byte(0.5F * (a[1] + b[1]));
+      p[2] = to_byte(b[0] + noise_sigma * noise[(i + 1 + noise_offset) & (kNoiseTable - 1)]);
+      p[3] = to_byte(0.5F * (a[2] + b[2]));
     }
   }
 }
