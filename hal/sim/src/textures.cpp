@@ -11,41 +11,58 @@ namespace boticelli::hal::sim {
 namespace {
 
 // Periodic value noise in [0, 1] on a lattice of cells_x x cells_y cells over the texture:
-// the lattice values are hashed once, then every texel interpolates (smoothstep) between them.
+// the lattice values are hashed once, then each row of texels interpolates between them with
+// smoothstep weights (cells are whole powers of two of texels, so the weights repeat).
 class ValueNoise {
  public:
   ValueNoise(std::uint32_t seed, std::uint32_t cells_x, std::uint32_t cells_y)
-      : cells_x_(cells_x), cells_y_(cells_y), lattice_(cells_x * cells_y) {
+      : cells_x_(cells_x),
+        cells_y_(cells_y),
+        span_x_(kTextureSize / cells_x),
+        span_y_(kTextureSize / cells_y),
+        lattice_(cells_x * cells_y),
+        weight_x_(span_x_),
+        weight_y_(span_y_) {
     for (std::uint32_t cy = 0; cy < cells_y; ++cy) {
       for (std::uint32_t cx = 0; cx < cells_x; ++cx) {
         const std::uint32_t h = hash32(seed ^ hash32(cx * 0x9E3779B1U + hash32(cy + 0x1234567U)));
         lattice_[cy * cells_x + cx] = static_cast<float>(h >> 8U) / 16777216.0F;
       }
     }
+    auto smoothstep = [](std::uint32_t k, std::uint32_t span) {
+      const float t = static_cast<float>(k) / static_cast<float>(span);
+      return t * t * (3.0F - 2.0F * t);
+    };
+    for (std::uint32_t k = 0; k < span_x_; ++k) weight_x_[k] = smoothstep(k, span_x_);
+    for (std::uint32_t k = 0; k < span_y_; ++k) weight_y_[k] = smoothstep(k, span_y_);
   }
-  // At texel (x, y) of the texture.
-  float at(std::uint32_t x, std::uint32_t y) const {
-    const std::uint32_t span_x = kTextureSize / cells_x_;  // texels per cell
-    const std::uint32_t span_y = kTextureSize / cells_y_;
-    const std::uint32_t x0 = x / span_x;
-    const std::uint32_t y0 = y / span_y;
-    const std::uint32_t x1 = (x0 + 1U) % cells_x_;
+
+  // Adds weight x the noise of texel row y to `row` (kTextureSize values).
+  void add_row(std::uint32_t y, float weight, float* row) const {
+    const std::uint32_t y0 = y / span_y_;
     const std::uint32_t y1 = (y0 + 1U) % cells_y_;
-    float tx = static_cast<float>(x % span_x) / static_cast<float>(span_x);
-    float ty = static_cast<float>(y % span_y) / static_cast<float>(span_y);
-    tx = tx * tx * (3.0F - 2.0F * tx);  // smoothstep
-    ty = ty * ty * (3.0F - 2.0F * ty);
-    const float* row0 = &lattice_[y0 * cells_x_];
-    const float* row1 = &lattice_[y1 * cells_x_];
-    const float a = row0[x0] + (row0[x1] - row0[x0]) * tx;
-    const float b = row1[x0] + (row1[x1] - row1[x0]) * tx;
-    return a + (b - a) * ty;
+    const float ty = weight_y_[y % span_y_];
+    const float* l0 = &lattice_[y0 * cells_x_];
+    const float* l1 = &lattice_[y1 * cells_x_];
+    std::uint32_t x = 0;
+    for (std::uint32_t cx = 0; cx < cells_x_; ++cx) {
+      const std::uint32_t cx1 = (cx + 1U) % cells_x_;
+      const float left = l0[cx] + (l1[cx] - l0[cx]) * ty;
+      const float right = l0[cx1] + (l1[cx1] - l0[cx1]) * ty;
+      for (std::uint32_t k = 0; k < span_x_; ++k, ++x) {
+        row[x] += weight * (left + (right - left) * weight_x_[k]);
+      }
+    }
   }
 
  private:
   std::uint32_t cells_x_;
   std::uint32_t cells_y_;
+  std::uint32_t span_x_;  // texels per cell
+  std::uint32_t span_y_;
   std::vector<float> lattice_;  // built at init only
+  std::vector<float> weight_x_;
+  std::vector<float> weight_y_;
 };
 
 void make_camouflage(std::uint32_t seed, std::uint8_t* out) {
@@ -55,9 +72,14 @@ void make_camouflage(std::uint32_t seed, std::uint8_t* out) {
   const ValueNoise coarse(seed, kBlotchCells, kBlotchCells);
   const ValueNoise medium(seed + 101U, 2 * kBlotchCells, 2 * kBlotchCells);
   const ValueNoise fine(seed + 202U, 4 * kBlotchCells, 4 * kBlotchCells);
+  std::vector<float> row(kTextureSize);
   for (std::uint32_t y = 0; y < kTextureSize; ++y) {
+    std::fill(row.begin(), row.end(), 0.0F);
+    coarse.add_row(y, 0.62F, row.data());
+    medium.add_row(y, 0.28F, row.data());
+    fine.add_row(y, 0.10F, row.data());
     for (std::uint32_t x = 0; x < kTextureSize; ++x) {
-      const float n = 0.62F * coarse.at(x, y) + 0.28F * medium.at(x, y) + 0.10F * fine.at(x, y);
+      const float n = row[x];
       const int tone = n < 0.40F ? 0 : (n < 0.50F ? 1 : (n < 0.60F ? 2 : 3));
       out[y * kTextureSize + x] = kTones[tone];
     }
@@ -71,10 +93,13 @@ void make_leaves(std::uint32_t seed, std::uint8_t* out) {
   constexpr std::uint32_t kAlong = kTextureSize / 32U;
   const ValueNoise streaks(seed, kAcross, kAlong);
   const ValueNoise broad(seed + 77U, kAcross / 2U, kAlong / 2U);
+  std::vector<float> row(kTextureSize);
   for (std::uint32_t y = 0; y < kTextureSize; ++y) {
+    std::fill(row.begin(), row.end(), 0.0F);
+    streaks.add_row(y, 0.7F, row.data());
+    broad.add_row(y, 0.3F, row.data());
     for (std::uint32_t x = 0; x < kTextureSize; ++x) {
-      const float n = 0.7F * streaks.at(x, y) + 0.3F * broad.at(x, y);
-      out[y * kTextureSize + x] = static_cast<std::uint8_t>(std::lround(70.0F + 120.0F * n));
+      out[y * kTextureSize + x] = static_cast<std::uint8_t>(70.0F + 120.0F * row[x] + 0.5F);
     }
   }
 }
