@@ -33,7 +33,10 @@ Window window_of(const LowResFrame& frame, int u, int v) {
   return out;
 }
 
-float error_against(const Window& feature, const LowResFrame& frame, int u, int v) {
+// Eq 3.1 against the window at (u, v); stops early, returning a partial sum above `bound`,
+// once the sum exceeds it (the search only needs exact values below the bound).
+float error_against(const Window& feature, const LowResFrame& frame, int u, int v,
+                    float bound = std::numeric_limits<float>::max()) {
   const float* y = frame.luma.data();
   const auto w = static_cast<int>(frame.width);
   const float centre = y[v * w + u];
@@ -44,6 +47,9 @@ float error_against(const Window& feature, const LowResFrame& frame, int u, int 
     for (int du = 0; du < 5; ++du) {
       const float d = feature.values[static_cast<std::size_t>(k++)] - (row[du] - centre);
       e += d * d;
+    }
+    if (e > bound) {
+      return e;
     }
   }
   return e;
@@ -197,6 +203,11 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
   std::array<int, kMaxRows> row_best_u{};
   constexpr float kNone = std::numeric_limits<float>::max();
   int best_row = -1;
+  // Values above this bound cannot be the best nor a runner-up that rejects it.
+  const float runner_up_scale = params.distinctiveness > 0.0F && params.distinctiveness < 1.0F
+                                    ? 1.0F / params.distinctiveness
+                                    : 1.0F;
+  float bound = kNone;
   for (int k = 0; k < rows; ++k) {
     const int v = row_far + k * step;
     const float line_u = segment.far_u_px + slope * (static_cast<float>(v) - segment.far_v_px);
@@ -207,7 +218,7 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
       if (!window_fits(second, u, v)) {
         continue;
       }
-      const float e = error_against(feature, second, u, v);
+      const float e = error_against(feature, second, u, v, std::fmin(bound, best));
       if (e < best) {
         best = e;
         best_u = u;
@@ -217,6 +228,7 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
     row_best_u[static_cast<std::size_t>(k)] = best_u;
     if (best < kNone && (best_row < 0 || best < row_best[static_cast<std::size_t>(best_row)])) {
       best_row = k;
+      bound = best * runner_up_scale;
     }
   }
   if (best_row < 0) {
