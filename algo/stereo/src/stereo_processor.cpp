@@ -117,4 +117,28 @@ std::size_t StereoProcessor::process(const image::LowResFrame& first,
   return appended;
 }
 
+TargetFix StereoProcessor::locate_target(const image::LowResFrame& first,
+                                         const image::LowResFrame& second, const PairPose& pose) {
+  TargetFix fix;
+  fix.first = target_detector_.detect(first);
+  if (!fix.first.found) {
+    return fix;
+  }
+  fix.second = target_detector_.detect(second);
+  if (!fix.second.found) {
+    return fix;
+  }
+  const CameraPose pose1 = rig_.camera_pose(pose.pan_rad, pose.first_tilt_rad);
+  const CameraPose pose2 = rig_.camera_pose(pose.pan_rad, pose.second_tilt_rad);
+  if (!triangulate(pose1, pose2, Eigen::Vector2f(fix.first.u_px, fix.first.v_px),
+                   Eigen::Vector2f(fix.second.u_px, fix.second.v_px), fix.point_ptu_m)) {
+    return fix;
+  }
+  fix.confidence =
+      fix.first.confidence < fix.second.confidence ? fix.first.confidence : fix.second.confidence;
+  fix.reading = reading_from_point(fix.point_ptu_m, fix.confidence);
+  fix.found = true;
+  return fix;
+}
+
 }  // namespace boticelli::stereo

@@ -12,6 +12,7 @@
 #include "algo/image/epipolar_tracker.h"
 #include "algo/image/features.h"
 #include "algo/image/low_res_frame.h"
+#include "algo/image/target_detector.h"
 #include "algo/stereo/rig.h"
 
 namespace boticelli::stereo {
@@ -41,6 +42,16 @@ struct StereoPoint {
   float range_camera_m = 0.0F;                            // from the first optical centre [m]
   float range_error_m = 0.0F;                             // δr of Eq 3.7 at that range [m]
   evidence::Reading reading;                              // {α, h, r, m}
+};
+
+// The target (§3.4.2) found in both frames of a pair and triangulated like a feature.
+struct TargetFix {
+  bool found = false;                                     // seen in both frames and triangulated
+  float confidence = 0.0F;                                // the lower of the two detections'
+  Eigen::Vector3f point_ptu_m = Eigen::Vector3f::Zero();  // the corner, PTU frame [m]
+  evidence::Reading reading;     // {α, h, r} of the corner; m = confidence
+  image::TargetDetection first;  // per-frame detections (low-res px)
+  image::TargetDetection second;
 };
 
 class StereoProcessor {
@@ -74,6 +85,11 @@ class StereoProcessor {
   bool epipolar_segment(const CameraPose& first, const CameraPose& second,
                         const Eigen::Vector2f& first_px, image::EpipolarSegment& segment) const;
 
+  // Looks for the target in both frames (low resolution, as for process()) and
+  // triangulates its corner with the same routine as the features (§3.4.2).
+  TargetFix locate_target(const image::LowResFrame& first, const image::LowResFrame& second,
+                          const PairPose& pose);
+
   [[nodiscard]] const image::LowResFrame& first_frame() const { return first_; }
   [[nodiscard]] const image::LowResFrame& second_frame() const { return second_; }
   [[nodiscard]] const core::FixedVector<image::Feature, kMaxPoints>& features() const {
@@ -85,6 +101,7 @@ class StereoProcessor {
   RigModel rig_;
   StereoParams params_;
   image::FeatureSelector selector_;
+  image::TargetDetector target_detector_;
   image::LowResFrame first_;
   image::LowResFrame second_;
   core::FixedVector<image::Feature, kMaxPoints> features_;
