@@ -89,6 +89,32 @@ TEST(AlnEval, AlphaBetaAndDtreeEqualPlainEvaluationOnManyRandomInputs) {
   CHECK(total_dt < total_ab);
 }
 
+TEST(AlnEval, AlphaBetaWithAHintGivesTheSameValueAndCutsMoreOnARay) {
+  aln_test::Rng rng(31);
+  aln_test::random_model(g_model, 48, rng);
+  std::size_t with_hint = 0;
+  std::size_t without = 0;
+  std::size_t same_piece = 0;
+  constexpr int kRays = 200;
+  constexpr int kSteps = 50;
+  for (int ray = 0; ray < kRays; ++ray) {
+    Model3::Vec x = aln_test::random_point<Model3::Vec>(rng);
+    std::uint16_t hint = 0xFFFF;  // no hint for the first point
+    for (int k = 0; k < kSteps; ++k) {
+      x(2) = static_cast<float>(k) / kSteps;
+      const auto plain = g_model.evaluate(x);
+      const auto hinted = g_model.evaluate_alpha_beta(x, hint);
+      CHECK(plain.value == hinted.value);
+      if (plain.piece == hinted.piece) ++same_piece;
+      with_hint += hinted.pieces_evaluated;
+      without += g_model.evaluate_alpha_beta(x).pieces_evaluated;
+      hint = hinted.piece;
+    }
+  }
+  LONGS_EQUAL(kRays * kSteps, same_piece);  // no exact ties on random inputs
+  CHECK(with_hint < without);
+}
+
 TEST(AlnEval, DtreeKeepsAboutNPlusOnePiecesPerBlock) {
   aln_test::Rng rng(11);
   aln_test::random_model(g_model, 32, rng);

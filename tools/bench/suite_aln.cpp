@@ -32,6 +32,7 @@ Trainer g_trainer;
 Dtree g_dtree;
 Fixed g_fixed;
 Eigen::Vector3f g_queries[kQueries];
+Eigen::Vector3f g_rays[kQueries];  // 64 rays of 64 points, r rising along each
 Fixed::Input g_queries_q[kQueries];
 
 std::uint64_t g_state = 0x12345678ULL;
@@ -79,6 +80,13 @@ void make_samples() {
                           static_cast<float>(uniform(0.0, 60.0)));
     s.y = static_cast<float>(room(static_cast<double>(s.x(0)), static_cast<double>(s.x(1)),
                                   static_cast<double>(s.x(2))));
+  }
+  for (std::size_t ray = 0; ray < kQueries / 64; ++ray) {
+    const auto alpha = static_cast<float>(uniform(-kPi, kPi));
+    const auto h = static_cast<float>(uniform(0.0, 20.0));
+    for (std::size_t k = 0; k < 64; ++k) {
+      g_rays[ray * 64 + k] = Eigen::Vector3f(alpha, h, static_cast<float>(k) * (60.0F / 64.0F));
+    }
   }
   for (std::size_t k = 0; k < kQueries; ++k) {
     g_queries[k] = Eigen::Vector3f(static_cast<float>(uniform(-kPi, kPi)),
@@ -159,6 +167,25 @@ void bench_model(std::size_t cap) {
         return static_cast<std::size_t>(e.pieces_evaluated);
       },
       t_fx);
+  // Coherent queries along rays: plain alpha-beta, and with the previous piece as a hint.
+  std::size_t t_ray = 0;
+  std::size_t t_hint = 0;
+  const double ray_ab = ns_per_call(
+      [](std::size_t k, double& sink) {
+        const auto e = g_model.evaluate_alpha_beta(g_rays[k]);
+        sink += static_cast<double>(e.value);
+        return static_cast<std::size_t>(e.pieces_evaluated);
+      },
+      t_ray);
+  static std::uint16_t hint = 0xFFFF;
+  const double ray_hint = ns_per_call(
+      [](std::size_t k, double& sink) {
+        const auto e = g_model.evaluate_alpha_beta(g_rays[k], k % 64 == 0 ? 0xFFFF : hint);
+        hint = e.piece;
+        sink += static_cast<double>(e.value);
+        return static_cast<std::size_t>(e.pieces_evaluated);
+      },
+      t_hint);
   const auto blocks = static_cast<std::int64_t>(g_dtree.block_count());
   const auto dtree_depth = static_cast<std::int64_t>(g_dtree.depth_used());
   // DTREE with up to 8 pieces per block: fewer thresholds per query.
@@ -182,11 +209,15 @@ void bench_model(std::size_t cap) {
       .num("ns_dtree", dt)
       .num("ns_dtree8", dt8)
       .num("ns_fixed", fx)
+      .num("ns_alphabeta_rays", ray_ab)
+      .num("ns_alphabeta_hint_rays", ray_hint)
       .num("touched_plain", per(t_plain))
       .num("touched_alphabeta", per(t_ab))
       .num("touched_dtree", per(t_dt))
       .num("touched_dtree8", per(t_dt8))
       .num("touched_fixed", per(t_fx))
+      .num("touched_alphabeta_rays", per(t_ray))
+      .num("touched_alphabeta_hint_rays", per(t_hint))
       .integer("dtree_blocks", blocks)
       .integer("dtree_depth", dtree_depth)
       .integer("dtree8_blocks", static_cast<std::int64_t>(g_dtree.block_count()))

@@ -240,6 +240,29 @@ class Aln {
     return r;
   }
 
+  // Alpha-beta with a hint: the piece responsible for a nearby earlier query (e.g. the
+  // previous point on a ray). The hint's branch is evaluated first at every node on its
+  // path, so when the hint is still responsible most other branches are cut off (ALN.md).
+  // Same value as evaluate(); at an exact tie between two pieces it may name the other one.
+  // An out-of-range hint means no hint.
+  [[nodiscard]] EvalResult<Scalar> evaluate_alpha_beta(const Vec& x, std::uint16_t hint) const {
+    if (hint >= piece_count_) return evaluate_alpha_beta(x);
+    std::array<std::uint16_t, MaxPieces> path;  // path[0] the hint's leaf ... root
+    std::size_t len = 0;
+    std::size_t n = piece_node_[hint];
+    while (len < MaxPieces) {
+      path[len++] = static_cast<std::uint16_t>(n);
+      if (n == 0) break;
+      n = parent_[n];
+    }
+    EvalResult<Scalar> r{};
+    std::uint16_t touched = 0;
+    r.value = ab_hint(len - 1, path.data(), x, -std::numeric_limits<Scalar>::infinity(),
+                      std::numeric_limits<Scalar>::infinity(), r.piece, touched);
+    r.pieces_evaluated = touched;
+    return r;
+  }
+
   [[nodiscard]] Scalar operator()(const Vec& x) const { return evaluate_alpha_beta(x).value; }
 
  private:
@@ -293,6 +316,37 @@ class Aln {
     return v1;
   }
 
+  // Like ab() for node path[i], whose child path[i - 1] is evaluated first.
+  Scalar ab_hint(std::size_t i, const std::uint16_t* path, const Vec& x, Scalar lo, Scalar hi,
+                 std::uint16_t& piece, std::uint16_t& touched) const {
+    const Node& node = nodes_[path[i]];
+    if (node.kind == NodeKind::kPiece || i == 0) return ab(path[i], x, lo, hi, piece, touched);
+    const bool first_is_a = path[i - 1] == node.a;
+    const std::uint16_t other = first_is_a ? node.b : node.a;
+    std::uint16_t p1 = 0;
+    const Scalar v1 = ab_hint(i - 1, path, x, lo, hi, p1, touched);
+    std::uint16_t p2 = 0;
+    if (node.kind == NodeKind::kMax) {
+      if (v1 < hi) {
+        const Scalar v2 = child(other, x, v1 > lo ? v1 : lo, hi, p2, touched);
+        if (v2 > v1) {
+          piece = p2;
+          return v2;
+        }
+      }
+    } else {
+      if (v1 > lo) {
+        const Scalar v2 = child(other, x, lo, v1 < hi ? v1 : hi, p2, touched);
+        if (v2 < v1) {
+          piece = p2;
+          return v2;
+        }
+      }
+    }
+    piece = p1;
+    return v1;
+  }
+
   // Recomputes the post order and the depth (iteratively).
   bool finish_structure() {
     struct Frame {
@@ -317,6 +371,8 @@ class Aln {
       }
       f.expanded = true;
       const auto d = static_cast<std::uint16_t>(f.depth + 1);
+      parent_[n.a] = f.node;
+      parent_[n.b] = f.node;
       stack[top++] = Frame{n.b, d, false};
       stack[top++] = Frame{n.a, d, false};
     }
@@ -327,6 +383,7 @@ class Aln {
   std::array<Node, kMaxNodes> nodes_{};
   std::array<std::size_t, MaxPieces> piece_node_{};
   std::array<std::uint16_t, kMaxNodes> post_order_{};
+  std::array<std::uint16_t, kMaxNodes> parent_{};  // parent_[0] = 0
   struct Op {
     NodeKind kind = NodeKind::kPiece;
     std::uint16_t piece = 0;
