@@ -174,3 +174,22 @@ TEST(Image, RepeatedTextureAlongTheLineIsRejectedAsAmbiguous) {
   params.match_error_thresh = 0.0F;  // nothing is below a zero threshold
   CHECK_FALSE(track_feature(a, 20, 10, a, segment, params).found);
 }
+
+TEST(Image, AMatchThatLeftTheImageIsNotReportedAtTheBorder) {
+  LowResFrame& a = frame_a();
+  LowResFrame& b = frame_b();
+  fill_pattern(a, 0.0F);
+  fill_pattern(b, -8.0F);  // the scene moved up by 8 rows
+  TrackParams params;
+  params.match_error_thresh = 1e7F;
+  params.distinctiveness = 1.0F;
+  // The feature at row 9 moved to row 1, where its window no longer fits: the search is
+  // cut at row 2, whose error is then the lowest, and must not report it as the match.
+  const EpipolarSegment off_image{60.0F, 9.0F, 60.0F, -10.0F};
+  CHECK_FALSE(track_feature(a, 60, 9, b, off_image, params).found);
+  // The same motion lower down is found.
+  const EpipolarSegment inside{60.0F, 40.0F, 60.0F, 23.0F};
+  const Track t = track_feature(a, 60, 40, b, inside, params);
+  CHECK(t.found);
+  DOUBLES_EQUAL(32.0, t.v_px, 0.05);
+}
