@@ -29,10 +29,10 @@ namespace {
 constexpr float kBoundM = 3.0F;
 constexpr float kRobotRadiusM = 0.2F;
 constexpr std::size_t kMaxWalls = 12;
-constexpr std::size_t kTestStates = 120;
-constexpr std::size_t kTestSweeps = 16;
-constexpr std::size_t kTestFitRounds = 8;
-constexpr std::size_t kTestFitPasses = 4;
+constexpr std::size_t kTestStates = 100;
+constexpr std::size_t kTestSweeps = 12;
+constexpr std::size_t kTestFitRounds = 6;
+constexpr std::size_t kTestFitPasses = 3;
 
 // A robot in a world of wall segments: it sees the walls as the free polygon would show
 // them (ray cast at the polygon's vertex angles, bounded), keeps global lists, plans and

@@ -60,12 +60,22 @@ std::ptrdiff_t edge_window(const StarPolygon& p, double radius, double d_min) {
   return std::min(w, static_cast<std::ptrdiff_t>(p.vertex_count() / 2 + 1));
 }
 
-// Clearance of the triangle (0, a, b) from the edges j ∈ [first, last] is at least R.
+// Clearance of the triangle (0, a, b) from the edges j ∈ [first, last] is at least R. An
+// edge whose bounding box is more than R away from the triangle's is skipped at once.
 bool triangle_clear(const Vertices& p, Vec2d a, Vec2d b, std::ptrdiff_t first, std::ptrdiff_t last,
                     double radius) {
+  const double min_x = std::min({0.0, a.x, b.x}) - radius;
+  const double max_x = std::max({0.0, a.x, b.x}) + radius;
+  const double min_y = std::min({0.0, a.y, b.y}) - radius;
+  const double max_y = std::max({0.0, a.y, b.y}) + radius;
   for (std::ptrdiff_t j = first; j <= last; ++j) {
-    if (detail::triangle_segment_distance({0.0, 0.0}, a, b, p.edge_start(j), p.edge_end(j)) <
-        radius) {
+    const Vec2d e0 = p.edge_start(j);
+    const Vec2d e1 = p.edge_end(j);
+    if (std::max(e0.x, e1.x) < min_x || std::min(e0.x, e1.x) > max_x ||
+        std::max(e0.y, e1.y) < min_y || std::min(e0.y, e1.y) > max_y) {
+      continue;
+    }
+    if (detail::triangle_segment_distance({0.0, 0.0}, a, b, e0, e1) < radius) {
       return false;
     }
   }
@@ -161,6 +171,11 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     out.set_rho_m(k1, round_down(rk1));
   }
   return true;
+}
+
+float boundary_clearance_m(const StarPolygon& region) {
+  const Vertices verts(region);
+  return static_cast<float>(min_edge_distance_to_centre(verts, region.vertex_count()));
 }
 
 float sweep_clearance_m(const StarPolygon& region, core::Point2 p) {

@@ -76,13 +76,17 @@ void extract_slice(const FreeRange& free_range, float h_m, const ExtractionParam
   }
 }
 
-// Shrinks by the robot radius plus the margin; if the robot already stands closer than
-// that to the boundary (a step taken on an earlier, coarser view can end there), by the
-// radius alone, so that it can still move away. False if even the bare disc touches.
+// Shrinks by the robot radius plus the margin. If the robot already stands closer than that
+// to the boundary (a step planned on an earlier, coarser view can end there), by its
+// present clearance instead (less 1 mm), so it can still move along or away but never
+// closer; false (nowhere to go) once the clearance is below the bare robot radius.
 inline bool shrink_for_robot(const StarPolygon& free, float robot_radius_m, float margin_m,
                              StarPolygon& out) {
-  return shrink_by_radius(free, robot_radius_m + margin_m, out) ||
-         shrink_by_radius(free, robot_radius_m, out);
+  if (shrink_by_radius(free, robot_radius_m + margin_m, out)) {
+    return true;
+  }
+  const float clearance = boundary_clearance_m(free) - 0.001F;
+  return clearance >= robot_radius_m && shrink_by_radius(free, clearance, out);
 }
 
 // The local map of one cycle, in the robot frame.

@@ -22,6 +22,9 @@ bool intersect_into(StarPolygon& into, const StarPolygon& other);
 // boundary: the robot cannot move safely at all.
 bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygon& out);
 
+// Distance [m] from the centre to the polygon's boundary (the robot's present clearance).
+[[nodiscard]] float boundary_clearance_m(const StarPolygon& region);
+
 // Smallest distance [m] from the segment [0, p] (robot frame) to the polygon's boundary;
 // the brute-force reference the tests and the planner's checks use (O(n)).
 [[nodiscard]] float sweep_clearance_m(const StarPolygon& region, core::Point2 p);

@@ -26,12 +26,14 @@ struct ValueIterationParams {
   std::size_t state_count = 200;    // about this many states per plan (jittered grid)
   std::size_t sweeps = 20;          // Bellman backups, each followed by an ALN fit
   float window_half_size_m = 4.0F;  // states are sampled in this square around the robot
-  float robot_radius_m = 0.2F;      // a state must keep the robot's disc off obstacle points
-  float fit_tolerance = 0.005F;     // ALN fit RMS, as a fraction of the targets' spread
-  std::size_t max_pieces = 48;      // ALN piece cap (≤ kMaxValuePieces)
-  std::size_t fit_rounds = 12;      // ALN split rounds per fit (trainer max_iterations)
-  std::size_t fit_passes = 8;       // assign/refit passes per round (trainer max_refit_passes)
-  std::uint32_t seed = 1;           // state sampling: same seed, same plan
+  // A state and a move must keep this far [m] from every obstacle point: the robot radius
+  // plus the polygon's clearance margin, so plans keep off walls as the polygon does.
+  float robot_radius_m = 0.25F;
+  float fit_tolerance = 0.005F;  // ALN fit RMS, as a fraction of the targets' spread
+  std::size_t max_pieces = 48;   // ALN piece cap (≤ kMaxValuePieces)
+  std::size_t fit_rounds = 12;   // ALN split rounds per fit (trainer max_iterations)
+  std::size_t fit_passes = 8;    // assign/refit passes per round (trainer max_refit_passes)
+  std::uint32_t seed = 1;        // state sampling: same seed, same plan
 };
 
 // Direction of action a [rad, world frame]: a·45°.

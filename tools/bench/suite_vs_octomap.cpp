@@ -1,0 +1,314 @@
+// Benchmark suite "vs-octomap": navigation polygon from the ALN occupancy model vs from OctoMap.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "algo/aln/aln.h"
+#include "algo/aln/samples.h"
+#include "algo/aln/trainer.h"
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/ray_samples.h"
+#include "algo/mapping/aln_free_range.h"
+#include "algo/mapping/extraction.h"
+#include "algo/mapping/polygon_ops.h"
+#include "bench.h"
+#include "synthetic_rooms.h"
+
+#if defined(BOTICELLI_HAVE_OCTOMAP)
+#include <octomap/OcTree.h>
+#include <octomap/Pointcloud.h>
+#endif
+
+namespace boticelli::bench {
+namespace {
+
+constexpr const char* kSuite = "vs-octomap";
+constexpr std::size_t kMaxPieces = 256;
+constexpr float kSeamMarginRad = 0.5F;
+constexpr std::size_t kFeatures = 5000;
+constexpr std::size_t kMaxRaySamples = 200000;
+constexpr double kGridStepM = 0.02;  // ground-truth area integration
+
+using Model = aln::Aln<float, 3, kMaxPieces>;
+using Trainer = aln::Trainer<float, 3, kMaxPieces>;
+using AlnSample = aln::Sample<float, 3>;
+
+// Large objects live outside the stack.
+Model g_model;
+Model g_best;
+Trainer g_trainer;
+mapping::AlnFreeRange<float, kMaxPieces> g_free_range;
+core::FixedVector<evidence::RaySample, kMaxRaySamples> g_ray_samples;
+mapping::LocalMap g_map;
+mapping::StarPolygon g_scratch;
+
+// The robot: PTU 1 m above the floor (the rooms' sensor height), body from 5 cm above the
+// floor to the PTU, radius 0.2 m; five slices; the thesis's m_safe = 0.6.
+mapping::ExtractionParams extraction_params(const SyntheticRoom& room) {
+  mapping::ExtractionParams p;
+  p.ptu_height_m = static_cast<float>(room.sensor().z);
+  p.lowest_height_m = 0.05F;
+  p.robot_height_m = static_cast<float>(room.sensor().z);
+  p.height_count = 5;
+  p.bounding_radius_m = 3.0F;
+  return p;
+}
+
+void configure_model(Model& model, const SyntheticRoom& room) {
+  const double h_lo = -room.sensor().z;
+  const double h_hi = room.spec().wall_height_m - room.sensor().z;
+  model.set_input_range(0, -kSeamMarginRad, 2.0F * std::numbers::pi_v<float> + kSeamMarginRad);
+  model.set_input_range(1, static_cast<float>(h_lo), static_cast<float>(h_hi));
+  model.set_input_range(2, 0.0F, static_cast<float>(room.spec().max_range_m * 1.2));
+  model.set_output_range(0.0F, 1.0F);
+  // Eqs 4.27-4.28 in metres: |∂F/∂α| < 1 per rad, |∂F/∂h| < 10 per m, ∂F/∂r > 0.
+  model.set_weight_bounds(0, -1.0F, 1.0F);
+  model.set_weight_bounds(1, -10.0F, 10.0F);
+  model.set_weight_bounds(2, 1e-4F, std::numeric_limits<float>::infinity());
+}
+
+// Ray samples (Fig 4.2b), zero pads in featureless directions and seam copies (§4.9.1).
+std::vector<AlnSample> build_samples(const SyntheticRoom& room,
+                                     const std::vector<evidence::Reading>& readings) {
+  g_ray_samples.clear();
+  const evidence::RaySampleParams params;
+  (void)evidence::append_ray_samples(readings, params, g_ray_samples,
+                                     evidence::OccupancyBound::kPlausibility);
+  evidence::PadRegion region;
+  region.h_min_m = static_cast<float>(-room.sensor().z);
+  region.h_max_m = static_cast<float>(room.spec().wall_height_m - room.sensor().z);
+  region.r_max_m = static_cast<float>(room.spec().max_range_m);
+  evidence::PadRandom random{12345U};
+  (void)evidence::append_featureless_pads(readings, region, evidence::FeaturelessPadParams{},
+                                          random, g_ray_samples);
+  (void)evidence::append_seam_copies(g_ray_samples, kSeamMarginRad);
+  std::vector<AlnSample> samples(g_ray_samples.size());
+  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
+    const evidence::RaySample& s = g_ray_samples[i];
+    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
+    samples[i].y = s.occupancy;
+  }
+  return samples;
+}
+
+double model_rms(const Model& m, const std::vector<AlnSample>& samples) {
+  double sse = 0.0;
+  for (const AlnSample& s : samples) {
+    const double r = static_cast<double>(m(s.x) - s.y);
+    sse += r * r;
+  }
+  return samples.empty() ? 0.0 : std::sqrt(sse / static_cast<double>(samples.size()));
+}
+
+// Trains and keeps the best model seen at the end of any split round (as suite thesis-table).
+void train(const std::vector<AlnSample>& samples) {
+  aln::TrainerConfig cfg;
+  const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
+  cfg.epsilon = eps != nullptr && *eps != '\0' ? std::atof(eps) : 0.15;
+  cfg.max_iterations = 10;
+  cfg.max_pieces = kMaxPieces;
+  g_trainer.configure(cfg);
+  double best = std::numeric_limits<double>::infinity();
+  if (!g_trainer.start(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model)) {
+    return;
+  }
+  while (!g_trainer.done()) {
+    const std::size_t round = g_trainer.stats().iterations;
+    (void)g_trainer.step(samples.size());
+    if (g_trainer.stats().iterations != round || g_trainer.done()) {
+      const double rms = model_rms(g_model, samples);
+      if (rms < best) {
+        best = rms;
+        g_best = g_model;
+      }
+    }
+  }
+}
+
+// Ground truth at a floor point: free at every slice height (inside the room, not in the
+// box) — the slices are where the robot's body is.
+bool truly_free(const SyntheticRoom& room, const mapping::ExtractionParams& p, double x, double y) {
+  for (std::size_t i = 0; i < p.height_count; ++i) {
+    const double z = room.sensor().z + static_cast<double>(mapping::slice_height_m(p, i));
+    if (room.solid({x, y, z}) || !room.inside_room({x, y, z})) {
+      return false;
+    }
+  }
+  return true;
+}
+
+struct Quality {
+  double safety = 0.0;      // polygon area that is truly free / polygon area
+  double coverage = 0.0;    // truly free area in the circle that the polygon holds
+  double nav_safety = 0.0;  // navigable area whose robot disc is truly free / its area
+  double area_m2 = 0.0;
+};
+
+// Area integration on a kGridStepM grid over the bounding circle around the sensor.
+Quality quality(const SyntheticRoom& room, const mapping::ExtractionParams& p,
+                const mapping::StarPolygon& free, const mapping::StarPolygon& nav) {
+  const double cx = room.sensor().x;
+  const double cy = room.sensor().y;
+  const double bound = static_cast<double>(p.bounding_radius_m);
+  const double robot = static_cast<double>(p.robot_radius_m);
+  std::size_t in_poly = 0;
+  std::size_t in_poly_free = 0;
+  std::size_t free_cells = 0;
+  std::size_t in_nav = 0;
+  std::size_t in_nav_safe = 0;
+  for (double y = -bound; y <= bound; y += kGridStepM) {
+    for (double x = -bound; x <= bound; x += kGridStepM) {
+      if (x * x + y * y > bound * bound) continue;
+      const bool is_free = truly_free(room, p, cx + x, cy + y);
+      const core::Point2 q{static_cast<float>(x), static_cast<float>(y)};
+      const bool inside = free.contains(q);
+      free_cells += is_free ? 1 : 0;
+      in_poly += inside ? 1 : 0;
+      in_poly_free += (inside && is_free) ? 1 : 0;
+      if (nav.contains(q)) {
+        ++in_nav;
+        bool disc_free = is_free;
+        for (int k = 0; k < 24 && disc_free; ++k) {
+          const double a = 2.0 * std::numbers::pi * k / 24.0;
+          disc_free =
+              truly_free(room, p, cx + x + robot * std::cos(a), cy + y + robot * std::sin(a));
+        }
+        in_nav_safe += disc_free ? 1 : 0;
+      }
+    }
+  }
+  Quality qy;
+  qy.safety = in_poly > 0 ? static_cast<double>(in_poly_free) / static_cast<double>(in_poly) : 1.0;
+  qy.coverage =
+      free_cells > 0 ? static_cast<double>(in_poly_free) / static_cast<double>(free_cells) : 0.0;
+  qy.nav_safety = in_nav > 0 ? static_cast<double>(in_nav_safe) / static_cast<double>(in_nav) : 1.0;
+  qy.area_m2 = static_cast<double>(in_poly) * kGridStepM * kGridStepM;
+  return qy;
+}
+
+void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
+          double build_ms, double extract_ms, const Quality& q, std::size_t pieces) {
+  JsonLine(kSuite, spec.name)
+      .text("method", method)
+      .num("resolution_m", resolution_m)
+      .integer("pieces", static_cast<std::int64_t>(pieces))
+      .integer("model_bytes", static_cast<std::int64_t>(model_bytes))
+      .num("build_ms", build_ms)
+      .num("extract_ms", extract_ms)
+      .num("safety", q.safety)
+      .num("coverage", q.coverage)
+      .num("nav_safety", q.nav_safety)
+      .emit();
+}
+
+double ms_since(std::int64_t t0) {
+  return static_cast<double>(now_ns() - t0) * 1e-6;
+}
+
+#if defined(BOTICELLI_HAVE_OCTOMAP)
+// The same slices, threshold and shrink, with the free range found by OctoMap's own ray
+// casting through the octree (unknown cells count as free: their prior 0.5 < m_safe).
+void octomap_polygon(const octomap::OcTree& tree, const SyntheticRoom& room,
+                     const mapping::ExtractionParams& p, mapping::LocalMap& out,
+                     mapping::StarPolygon& slice) {
+  const double max_range = static_cast<double>(p.bounding_radius_m);
+  for (std::size_t i = 0; i < p.height_count; ++i) {
+    const double z = room.sensor().z + static_cast<double>(mapping::slice_height_m(p, i));
+    mapping::StarPolygon& target = i == 0 ? out.free : slice;
+    target.set_vertex_count(p.vertex_count);
+    const octomap::point3d origin(static_cast<float>(room.sensor().x),
+                                  static_cast<float>(room.sensor().y), static_cast<float>(z));
+    for (std::size_t k = 0; k < target.vertex_count(); ++k) {
+      const float a = target.angle_rad(k);
+      const octomap::point3d dir(std::cos(a), std::sin(a), 0.0F);
+      octomap::point3d end;
+      float rho = p.bounding_radius_m;
+      if (tree.castRay(origin, dir, end, true, max_range)) {
+        rho = std::min(rho, static_cast<float>((end - origin).norm()));
+        // The hit is a cell centre; its near face is half a cell closer.
+        rho = std::max(0.0F, rho - static_cast<float>(tree.getResolution()) * 0.5F);
+      }
+      target.set_rho_m(k, rho);
+    }
+    if (i > 0) {
+      (void)mapping::intersect_into(out.free, slice);
+    }
+  }
+  out.can_move =
+      mapping::shrink_for_robot(out.free, p.robot_radius_m, p.clearance_margin_m, out.navigable);
+}
+#endif
+
+int run() {
+  const char* rooms[] = {"cylinder_centre", "cylinder_offcentre_outliers", "rectangle",
+                         "corridor",        "cylinder_box_view1",          "rectangle_box_case1"};
+  const int reps = 20;
+  for (const char* name : rooms) {
+    const RoomSpec* spec = find_environment(name);
+    if (spec == nullptr) continue;
+    const SyntheticRoom room(*spec);
+    const mapping::ExtractionParams p = extraction_params(room);
+    const std::vector<evidence::Reading> readings = room.generate_readings(kFeatures, 7U);
+
+    // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink.
+    std::int64_t t0 = now_ns();
+    const std::vector<AlnSample> samples = build_samples(room, readings);
+    configure_model(g_model, room);
+    train(samples);
+    const double build_ms = ms_since(t0);
+    t0 = now_ns();
+    for (int r = 0; r < reps; ++r) {
+      (void)g_free_range.set_model(g_best, p.safe_occupancy);
+      mapping::extract_local_map(g_free_range, p, g_map, g_scratch);
+      do_not_optimize(g_map.navigable.rho_m(0));
+    }
+    const double extract_ms = ms_since(t0) / reps;
+    const std::size_t bytes =
+        g_best.piece_count() * sizeof(Model::PieceType) + g_best.node_count() * sizeof(Model::Node);
+    emit(*spec, "aln", 0.0, bytes, build_ms, extract_ms,
+         quality(room, p, g_map.free, g_map.navigable), g_best.piece_count());
+
+#if defined(BOTICELLI_HAVE_OCTOMAP)
+    for (const double res : {0.1, 0.05}) {
+      t0 = now_ns();
+      octomap::OcTree tree(res);
+      tree.setOccupancyThres(static_cast<double>(p.safe_occupancy));
+      octomap::Pointcloud cloud;
+      for (const evidence::Reading& rd : readings) {
+        const Vec3 w = room.world_of(rd);
+        cloud.push_back(static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z));
+      }
+      const Vec3 s = room.sensor();
+      tree.insertPointCloud(cloud,
+                            octomap::point3d(static_cast<float>(s.x), static_cast<float>(s.y),
+                                             static_cast<float>(s.z)));
+      tree.updateInnerOccupancy();
+      const double oct_build_ms = ms_since(t0);
+      static mapping::LocalMap oct_map;
+      static mapping::StarPolygon oct_slice;
+      t0 = now_ns();
+      const int oct_reps = 3;
+      for (int r = 0; r < oct_reps; ++r) {
+        octomap_polygon(tree, room, p, oct_map, oct_slice);
+      }
+      const double oct_extract_ms = ms_since(t0) / oct_reps;
+      emit(*spec, "octomap", res, tree.memoryUsage(), oct_build_ms, oct_extract_ms,
+           quality(room, p, oct_map.free, oct_map.navigable), 0);
+    }
+#endif
+  }
+  return 0;
+}
+
+[[maybe_unused]] const bool g_registered =
+    register_suite({kSuite, "navigation polygon: ALN model vs OctoMap (0.1 m, 0.05 m)", &run});
+
+}  // namespace
+}  // namespace boticelli::bench
