@@ -76,6 +76,32 @@ TEST(WorldLoader, ThesisRoomHidesTheTargetFromTheStartBehindThePartition) {
   DOUBLES_EQUAL(2.0, max_z, 1e-4);
 }
 
+TEST(WorldLoader, TheExplorationRoomsHideTheTargetFromTheStartButNotFromEverywhere) {
+  struct Case {
+    const char* world;
+    float seen_from_x_m, seen_from_y_m;  // a free place with the target in plain view
+  };
+  const Case cases[] = {{"thesis_room", -1.0F, 1.8F},
+                        {"l_shaped_room", 1.5F, -1.5F},
+                        {"two_rooms_doorway", 2.0F, 0.5F}};
+  const boticelli::stereo::RigModel rig;
+  for (const Case& c : cases) {
+    const std::string path = world_path(c.world);
+    CHECK_TEXT(load_world(path.c_str(), g_world, g_error, sizeof g_error), g_error);
+    CHECK_TEXT(g_sim.init(g_world, rig, SimParams{}, g_error, sizeof g_error), g_error);
+    auto first_hit = [&](float x_m, float y_m) {
+      const Eigen::Vector3f eye(x_m, y_m, 0.6F);
+      std::size_t surface = 0;
+      float t = 0.0F;
+      CHECK(cast_ray(g_world, eye, g_world.target_point_m - eye, surface, t));
+      return t < 0.999F ? std::string(g_world.surfaces[surface].model) : std::string("target");
+    };
+    CHECK_TEXT(first_hit(g_world.start.x_m, g_world.start.y_m) != "target", c.world);
+    CHECK_TEXT(g_sim.clearance_m(c.seen_from_x_m, c.seen_from_y_m) > 0.0F, c.world);
+    STRCMP_EQUAL_TEXT("target", first_hit(c.seen_from_x_m, c.seen_from_y_m).c_str(), c.world);
+  }
+}
+
 TEST(WorldLoader, PosesComposeModelThenLinkThenVisual) {
   const std::string models =
       "<model name=\"m\"><pose>1 0 0 0 0 1.5707963</pose>"
