@@ -1,5 +1,4 @@
-// Small ray-casting renderer for stereo tests and the benchmark: textured rectangles seen from rig
-// poses, YUYV out.
+// Small ray-casting renderer for stereo tests and bench: textured rectangles, YUYV out.
 #pragma once
 
 #include <cstdint>

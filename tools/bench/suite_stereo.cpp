@@ -1,5 +1,4 @@
-// Benchmark suite "stereo": time and depth accuracy per frame pair, ours against OpenCV's GFTT +
-// pyramidal LK.
+// Benchmark suite "stereo": time and depth accuracy per frame pair, ours against OpenCV.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

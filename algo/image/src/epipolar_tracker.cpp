@@ -1,5 +1,4 @@
-// Feature tracking along the epipolar band with Eq 3.1 match error and parabolic sub-pixel
-// refinement.
+// Tracking along the epipolar band: Eq 3.1 match error, parabola and 1-D Lucas-Kanade refinement.
 #include "algo/image/epipolar_tracker.h"
 
 #include <array>

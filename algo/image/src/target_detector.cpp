@@ -1,5 +1,4 @@
-// Green-triangle corner detector: colour segmentation, shape test, white surround, edge-line
-// vertex.
+// Green-triangle corner detector: colour blobs, shape test, white surround, edge-line vertex.
 #include "algo/image/target_detector.h"
 
 #include <algorithm>

@@ -1,5 +1,4 @@
-// Frame-pair processing: features → epipolar tracks → triangulation → Readings with Eq 3.8
-// evidence.
+// Frame-pair processing: features → epipolar tracks → triangulation → Readings (Eq 3.8).
 #include "algo/stereo/stereo_processor.h"
 
 #include <cmath>

@@ -1,5 +1,4 @@
-// Epipolar tracking (§3.4.1, App. A): 5x5 window match error (Eq 3.1) along a 3 px band, sub-pixel
-// refined.
+// Epipolar tracking (§3.4.1, App. A): Eq 3.1 match error along a 3 px band, sub-pixel refined.
 #pragma once
 
 #include <cstdint>

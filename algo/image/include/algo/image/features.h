@@ -1,5 +1,4 @@
-// Feature selection (§3.4.1): pixels with the strongest vertical intensity derivative in the
-// central band.
+// Feature selection (§3.4.1): strongest vertical intensity derivatives in the central band.
 #pragma once
 
 #include <array>

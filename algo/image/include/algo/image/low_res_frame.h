@@ -1,5 +1,4 @@
-// Low-resolution frame: YUYV from the camera averaged in 4x4 blocks to luma (float) and chroma (U,
-// V).
+// Low-resolution frame: camera YUYV averaged in 4x4 blocks to luma and chroma planes.
 #pragma once
 
 #include <array>

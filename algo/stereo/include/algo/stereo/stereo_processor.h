@@ -1,5 +1,4 @@
-// Single-camera stereo on one frame pair (§3.4.1): downsample, select, track, triangulate, evidence
-// → Readings.
+// Single-camera stereo on one frame pair (§3.4.1): features, tracks, triangulation → Readings.
 #pragma once
 
 #include <cstddef>

@@ -1,5 +1,4 @@
-// Triangulation of a feature seen from two camera poses: exact (Eq 3.2) and the thesis's fast form
-// (Eq 3.4).
+// Triangulation from two camera poses: exact (Eq 3.2) and the thesis's fast form (Eq 3.4).
 #pragma once
 
 #include <Eigen/Core>
