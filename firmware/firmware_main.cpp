@@ -142,7 +142,9 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   g_parameters = ParameterTable{};
   g_runtime.emplace(hal, config, store);
   Runtime& rt = *g_runtime;
-  if (store != nullptr) rt.saver.start();
+  // On a real-time board the state is written by a thread of its own (fsync can take tens
+  // of milliseconds on an SD card); on the simulation it is written in the background slot.
+  if (store != nullptr && config.realtime) rt.saver.start();
   ServiceNotifier& notifier = rt.notifier;
   if (!notifier.open()) std::fprintf(stderr, "boticelli: %s\n", notifier.error());
   Executive& executive = rt.executive;

@@ -30,6 +30,19 @@ void StateSaver::start() {
 }
 
 bool StateSaver::submit(const MissionState& state) {
+  if (!thread_.joinable()) {
+    // Not started: save right here (simulation, tests).
+    char error[256] = "";
+    const bool ok = store_.save(state, error, sizeof error);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (ok) {
+      ++saved_;
+    } else {
+      ++failures_;
+      std::snprintf(error_, sizeof error_, "%s", error);
+    }
+    return true;
+  }
   std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
   if (!lock.owns_lock()) return false;
   pending_ = state;

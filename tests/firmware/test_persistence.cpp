@@ -322,6 +322,22 @@ TEST(Persistence, AKilledRunResumesWithNothingLostAndNothingCorrupt) {
   CHECK(last_loaded >= 6U);
 }
 
+TEST(Persistence, WithoutItsThreadTheSaverWritesEachStateAtOnce) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  auto owner = std::make_unique<StateSaver>(g_store);
+  for (std::uint64_t c = 1; c <= 3; ++c) {
+    make_state(c, g_a);
+    CHECK(owner->submit(g_a));
+    CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+    CHECK_EQUAL(c, g_b.cycle);
+  }
+  owner->flush();
+  CHECK_EQUAL(3U, owner->saved());
+}
+
+// qemu-user (the cross presets' test runner) hangs in thread creation on some hosts; the
+// writer thread is tested by the native builds.
+#ifndef BOTICELLI_TESTS_UNDER_EMULATOR
 TEST(Persistence, TheWriterThreadEndsWithTheNewestSubmittedState) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   {
@@ -343,3 +359,4 @@ TEST(Persistence, TheWriterThreadEndsWithTheNewestSubmittedState) {
   make_state(30, g_a);
   CHECK(g_a == g_b);
 }
+#endif

@@ -24,7 +24,8 @@ class StateSaver {
   StateSaver(const StateSaver&) = delete;
   StateSaver& operator=(const StateSaver&) = delete;
 
-  // Starts the writer thread (allocates: call at init).
+  // Starts the writer thread (allocates: call at init). Without it submit() saves in the
+  // caller's thread (the sim board, where the clock stands still while code runs anyway).
   void start();
   // Hands a copy of `state` to the writer; false (nothing changed) when the writer is just
   // taking the previous one: call again in a later slice.
