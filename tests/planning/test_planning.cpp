@@ -30,9 +30,9 @@ constexpr float kBoundM = 3.0F;
 constexpr float kRobotRadiusM = 0.2F;
 constexpr std::size_t kMaxWalls = 12;
 constexpr std::size_t kTestStates = 100;
-constexpr std::size_t kTestSweeps = 12;
-constexpr std::size_t kTestFitRounds = 6;
-constexpr std::size_t kTestFitPasses = 3;
+constexpr std::size_t kTestSweeps = 10;
+constexpr std::size_t kTestFitRounds = 5;
+constexpr std::size_t kTestFitPasses = 2;
 
 // A robot in a world of wall segments: it sees the walls as the free polygon would show
 // them (ray cast at the polygon's vertex angles, bounded), keeps global lists, plans and
