@@ -247,7 +247,7 @@ bool parse_attribute_float(const XMLElement* e, const char* name, float& out, Er
   char* end = nullptr;
   errno = 0;
   const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v) || std::fabs(v) > 1e6) {
     return errors.fail(e->GetLineNum(), "<%s %s='%.20s'> is not a number", e->Name(), name, text);
   }
   out = static_cast<float>(v);
