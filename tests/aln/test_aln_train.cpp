@@ -343,3 +343,42 @@ TEST(AlnTrain, TrainsInOneAndFourDimensions) {
   CHECK(m4.piece_count() <= 2);
   CHECK(t4.stats().rms < 1e-3);
 }
+
+TEST(AlnTrain, TheOverallRmsRuleStopsAtEpsilonWithNoMorePiecesThanThePerPieceRule) {
+  const std::size_t n = fill_room(2000, 0.0, 44);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.02;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  cfg.split_rule = aln::SplitRule::kOverallRms;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  CHECK(g_trainer3.stats().rms <= 0.02);
+  CHECK(g_model3b.piece_count() <= g_model3.piece_count());
+  CHECK(g_model3b.pieces_within_bounds());
+}
+
+TEST(AlnTrain, HuberWeightsKeepTheFitCloseToTheCleanFunctionDespiteOutliers) {
+  const std::size_t n = fill_room(3000, 0.05, 45);
+  set_room_ranges(g_model3);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.1;
+  cfg.max_iterations = 6;
+  cfg.robust = aln::RobustWeighting::kHuber;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  CHECK(g_trainer3.stats().robust_rms < g_trainer3.stats().rms);
+  aln_test::Rng rng(46);
+  double sse = 0.0;
+  for (int k = 0; k < 1000; ++k) {
+    const Eigen::Vector3f x(static_cast<float>(rng.uniform(-3.0, 3.0)),
+                            static_cast<float>(rng.uniform(0.0, 20.0)),
+                            static_cast<float>(rng.uniform(0.0, 100.0)));
+    const double e =
+        static_cast<double>(g_model3.evaluate(x).value) - cylinder_room(static_cast<double>(x(2)));
+    sse += e * e;
+  }
+  CHECK(std::sqrt(sse / 1000.0) < 0.1);
+}
