@@ -60,14 +60,17 @@ std::ptrdiff_t edge_window(const StarPolygon& p, double radius, double d_min) {
   return std::min(w, static_cast<std::ptrdiff_t>(p.vertex_count() / 2 + 1));
 }
 
-// Clearance of the triangle (0, a, b) from the edges j ∈ [first, last] is at least R. An
-// edge whose bounding box is more than R away from the triangle's is skipped at once.
+// Clearance of the triangle (0, a, b) from the edges j ∈ [first, last] is at least R.
+// The sides 0–a and 0–b are clear already (each vertex is at most the first contact of its
+// ray), and no edge reaches inside the triangle (the only edge in the sector lies beyond
+// both vertices, the others outside the wedge), so only the chord a–b needs checking. An
+// edge whose bounding box is more than R away from the chord's is skipped at once.
 bool triangle_clear(const Vertices& p, Vec2d a, Vec2d b, std::ptrdiff_t first, std::ptrdiff_t last,
                     double radius) {
-  const double min_x = std::min({0.0, a.x, b.x}) - radius;
-  const double max_x = std::max({0.0, a.x, b.x}) + radius;
-  const double min_y = std::min({0.0, a.y, b.y}) - radius;
-  const double max_y = std::max({0.0, a.y, b.y}) + radius;
+  const double min_x = std::min(a.x, b.x) - radius;
+  const double max_x = std::max(a.x, b.x) + radius;
+  const double min_y = std::min(a.y, b.y) - radius;
+  const double max_y = std::max(a.y, b.y) + radius;
   for (std::ptrdiff_t j = first; j <= last; ++j) {
     const Vec2d e0 = p.edge_start(j);
     const Vec2d e1 = p.edge_end(j);
@@ -75,7 +78,7 @@ bool triangle_clear(const Vertices& p, Vec2d a, Vec2d b, std::ptrdiff_t first, s
         std::max(e0.y, e1.y) < min_y || std::min(e0.y, e1.y) > max_y) {
       continue;
     }
-    if (detail::triangle_segment_distance({0.0, 0.0}, a, b, e0, e1) < radius) {
+    if (detail::segment_segment_distance(a, b, e0, e1) < radius) {
       return false;
     }
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "algo/aln/aln.h"
 #include "algo/aln/invert.h"
@@ -40,12 +41,17 @@ class AlnFreeRange {
     }
     typename Model::Vec x;
     x << static_cast<Scalar>(alpha_rad), static_cast<Scalar>(h_m), safe_occupancy_;
-    return static_cast<float>(inverse_.evaluate_alpha_beta(x).value);
+    // Successive calls walk along α at one height: the last responsible piece is a good
+    // first guess (alpha-beta with a hint; same value as without).
+    const aln::EvalResult<Scalar> e = inverse_.evaluate_alpha_beta(x, hint_);
+    hint_ = e.piece;
+    return static_cast<float>(e.value);
   }
 
  private:
   Model inverse_{};
   Scalar safe_occupancy_ = Scalar(0.6);
+  mutable std::uint16_t hint_ = 0;
   bool valid_ = false;
 };
 
