@@ -479,3 +479,22 @@ TEST(CameraTask, HandsEachFrameBackAndTurnsUnhealthyOnlyAfterAStall) {
   for (int i = 0; i < 3; ++i, t += 10000) task.run(t);
   CHECK(task.healthy());
 }
+
+TEST(Executive, CountsATaskStarvedByALongStallAsUnhealthyUntilItRunsAgain) {
+  TimedTask fast(clock, 100);
+  TimedTask slow(clock, 100);
+  fast.slow_every = 30;
+  fast.slow_cost_us = 450000;  // one 450 ms stall in frame 30
+  add({"fast", 10000, 500}, fast);
+  add({"slow", 100000, 500}, slow);
+  start();
+  frames(29);
+  CHECK_TRUE(exec.all_healthy());
+  frames(1);  // the stall: "slow" last ran more than two periods ago
+  CHECK_FALSE(exec.all_healthy());
+  std::uint64_t slow_runs = slow.runs;
+  while (slow.runs == slow_runs) exec.run_frame();
+  fast.slow_every = 0;
+  exec.run_frame();
+  CHECK_TRUE(exec.all_healthy());
+}
