@@ -1,6 +1,8 @@
 // Rpi4Board: wiring of the Linux HAL for the reference robot (see rpi4_board.h, board_config.h).
 #include "rpi4_board.h"
 
+#include "../console_mode.h"
+
 #include <cstdio>
 
 namespace boticelli::boards::rpi4 {
@@ -51,7 +53,7 @@ bool Rpi4Board::init(const firmware::Options& options, char* error, std::size_t 
     std::snprintf(error, error_size, "the rpi4 board drives real devices; --world is for sim");
     return false;
   }
-  console_.select(options.console, options.console_path);
+  console_.select(console_mode(options.console), options.console_path);
   // The GPIO lines are requested here: without the e-stop line the robot must not run.
   if (!estop_.init()) {
     std::snprintf(error, error_size, "e-stop line: %s", estop_.error());

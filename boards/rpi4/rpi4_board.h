@@ -4,9 +4,9 @@
 #include <cstddef>
 
 #include "board_config.h"
-#include "console_port.h"
 #include "firmware/board.h"
 #include "hal/hal.h"
+#include "hal/linux/console_port.h"
 #include "hal/linux/base_odrive_can.h"
 #include "hal/linux/camera_v4l2.h"
 #include "hal/linux/clock_posix.h"
@@ -41,7 +41,7 @@ class Rpi4Board final : public firmware::Board {
   hal_linux::DigitalInGpiod bumper_;
   hal_linux::DigitalOutGpiod status_led_;
   hal_linux::WatchdogLinux watchdog_;
-  ConsolePort console_;
+  hal_linux::ConsolePort console_;
   hal::Hal hal_;
 };
 

@@ -1,6 +1,8 @@
 // SimBoard: wiring of the sim HAL from board_config.h and the world file (see sim_board.h).
 #include "sim_board.h"
 
+#include "../console_mode.h"
+
 #include <cstdio>
 
 namespace boticelli::boards::sim {
@@ -16,7 +18,7 @@ SimBoard::SimBoard()
       status_led_(sim_),
       clock_(sim_),
       watchdog_(sim_),
-      console_(config_.console_baud),
+      console_("/dev/tty", config_.console_baud),
       hal_{camera_, pan_tilt_, base_, estop_, bumper_, status_led_, console_, clock_, watchdog_} {}
 
 bool SimBoard::init(const firmware::Options& options, char* error, std::size_t error_size) {
@@ -40,7 +42,7 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
     return false;
   }
   if (!camera_.setup(settings_.camera_fps, error, error_size)) return false;
-  console_.select(options.console, options.console_path);
+  console_.select(console_mode(options.console), options.console_path);
   return true;
 }
 

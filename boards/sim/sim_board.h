@@ -7,6 +7,7 @@
 #include "board_config.h"
 #include "firmware/board.h"
 #include "hal/hal.h"
+#include "hal/linux/console_port.h"
 #include "hal/sim/base_sim.h"
 #include "hal/sim/camera_sim.h"
 #include "hal/sim/clock_sim.h"
@@ -17,7 +18,6 @@
 #include "hal/sim/textures.h"
 #include "hal/sim/watchdog_sim.h"
 #include "hal/sim/world.h"
-#include "sim_console.h"
 
 namespace boticelli::boards::sim {
 
@@ -60,7 +60,7 @@ class SimBoard final : public firmware::Board {
   hal::sim::LedOutputSim status_led_;
   hal::sim::ClockSim clock_;
   hal::sim::WatchdogSim watchdog_;
-  SimConsole console_;
+  hal_linux::ConsolePort console_;
   hal::Hal hal_;
 };
 

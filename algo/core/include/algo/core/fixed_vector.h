@@ -36,7 +36,7 @@ class FixedVectorBase {
     }
   }
   void clear() { size_ = 0; }
-  // Shrinks, or grows up to capacity with value-initialised elements; returns the new size.
+  // Shrinks, or grows up to capacity with value-initialised elements; returns the size after.
   std::size_t resize(std::size_t n) {
     if (n > capacity_) {
       n = capacity_;

@@ -1,6 +1,5 @@
-// ConsolePort: console selection and pseudo-terminal set-up for the rpi4 board (see
-// console_port.h).
-#include "console_port.h"
+// ConsolePort: console line selection and pseudo-terminal set-up (see console_port.h).
+#include "hal/linux/console_port.h"
 
 #include <fcntl.h>
 #include <stdlib.h>
@@ -10,35 +9,37 @@
 #include <cstdio>
 #include <cstring>
 
-namespace boticelli::boards::rpi4 {
-ConsolePort::ConsolePort(const char* uart_device, std::uint32_t baud)
-    : uart_device_(uart_device), baud_(baud) {}
+namespace boticelli::hal_linux {
+
+ConsolePort::ConsolePort(const char* default_device, std::uint32_t baud)
+    : default_device_(default_device), baud_(baud) {}
 
 ConsolePort::~ConsolePort() {
   if (pty_slave_fd_ >= 0) ::close(pty_slave_fd_);
 }
 
-void ConsolePort::select(firmware::ConsoleKind kind, const char* path) {
-  kind_ = kind;
-  switch (kind) {
-    case firmware::ConsoleKind::kStdio:
+void ConsolePort::select(ConsoleMode mode, const char* device_path) {
+  mode_ = mode;
+  switch (mode) {
+    case ConsoleMode::kStdio:
       active_ = &stdio_;
       break;
-    case firmware::ConsoleKind::kPty:
+    case ConsoleMode::kPty:
       // Opening the multiplexer creates a new pair; the termios port holds the master.
-      tty_.emplace(hal_linux::SerialConfig{"/dev/ptmx", baud_});
+      tty_.emplace(SerialConfig{"/dev/ptmx", baud_});
       active_ = &*tty_;
       break;
-    case firmware::ConsoleKind::kPath:
-      tty_.emplace(hal_linux::SerialConfig{path != nullptr ? path : uart_device_, baud_});
+    case ConsoleMode::kDevice:
+      tty_.emplace(SerialConfig{device_path != nullptr ? device_path : default_device_, baud_});
       active_ = &*tty_;
       break;
   }
 }
 
 bool ConsolePort::open() {
+  error_[0] = '\0';
   if (!active_->open()) return false;
-  if (kind_ != firmware::ConsoleKind::kPty) return true;
+  if (mode_ != ConsoleMode::kPty) return true;
   const int master = tty_->fd();
   char slave[128] = "";
   if (::grantpt(master) != 0 || ::unlockpt(master) != 0 ||
@@ -67,4 +68,4 @@ const char* ConsolePort::error() const {
   return error_[0] != '\0' ? error_ : active_->error();
 }
 
-}  // namespace boticelli::boards::rpi4
+}  // namespace boticelli::hal_linux
