@@ -67,9 +67,7 @@ TEST(AllocationGuard, PassesOnAllocationFreeCode) {
 }
 
 TEST(AllocationGuard, RestoresTheAllocatorsSoLaterAllocationsAreNotCounted) {
-  {
-    boticelli::test::AllocationGuard guard;
-  }
+  { boticelli::test::AllocationGuard guard; }
   std::vector<int> values(10, 1);
   boticelli::test::AllocationGuard guard;
   UNSIGNED_LONGS_EQUAL(0U, guard.allocations());

@@ -8,7 +8,9 @@ using boticelli::core::FixedVector;
 using boticelli::core::FixedVectorBase;
 
 namespace {
-int sum(const FixedVectorBase<int>& values) { return std::accumulate(values.begin(), values.end(), 0); }
+int sum(const FixedVectorBase<int>& values) {
+  return std::accumulate(values.begin(), values.end(), 0);
+}
 }  // namespace
 
 TEST_GROUP(FixedVector){};

@@ -81,7 +81,9 @@ AllocationGuard::AllocationGuard() {
   g_counting.store(true, std::memory_order_relaxed);
 }
 
-AllocationGuard::~AllocationGuard() { stop(); }
+AllocationGuard::~AllocationGuard() {
+  stop();
+}
 
 void AllocationGuard::stop() {
   if (!active_) {
@@ -94,6 +96,8 @@ void AllocationGuard::stop() {
   setCurrentMallocAllocator(g_malloc_counter.previous());
 }
 
-std::size_t AllocationGuard::allocations() const { return g_count.load(std::memory_order_relaxed); }
+std::size_t AllocationGuard::allocations() const {
+  return g_count.load(std::memory_order_relaxed);
+}
 
 }  // namespace boticelli::test

@@ -31,13 +31,13 @@ class AllocationGuard {
 }  // namespace boticelli::test
 
 // Runs `statement` and fails the test if it allocated on the heap.
-#define CHECK_NO_ALLOCATION(statement)                                                  \
-  do {                                                                                  \
-    std::size_t boticelli_allocs_ = 0;                                                  \
-    {                                                                                   \
-      boticelli::test::AllocationGuard boticelli_guard_;                                \
-      statement;                                                                        \
-      boticelli_allocs_ = boticelli_guard_.allocations();                               \
-    }                                                                                   \
+#define CHECK_NO_ALLOCATION(statement)                                                    \
+  do {                                                                                    \
+    std::size_t boticelli_allocs_ = 0;                                                    \
+    {                                                                                     \
+      boticelli::test::AllocationGuard boticelli_guard_;                                  \
+      statement;                                                                          \
+      boticelli_allocs_ = boticelli_guard_.allocations();                                 \
+    }                                                                                     \
     UNSIGNED_LONGS_EQUAL_TEXT(0U, boticelli_allocs_, "heap allocations in: " #statement); \
   } while (false)

@@ -10,8 +10,12 @@ namespace {
 bool g_json = false;
 }  // namespace
 
-void set_json(bool on) { g_json = on; }
-bool json() { return g_json; }
+void set_json(bool on) {
+  g_json = on;
+}
+bool json() {
+  return g_json;
+}
 
 JsonLine::JsonLine(const char* suite, const char* name) {
   if (g_json) {

@@ -51,8 +51,8 @@ inline void do_not_optimize(const T& value) {
 
 }  // namespace boticelli::bench
 
-#define BOTICELLI_BENCH_SUITE(id, description)                                               \
-  static int bench_suite_##id();                                                            \
-  [[maybe_unused]] static const bool bench_registered_##id =                                \
-      boticelli::bench::register_suite({#id, description, &bench_suite_##id});               \
+#define BOTICELLI_BENCH_SUITE(id, description)                                 \
+  static int bench_suite_##id();                                               \
+  [[maybe_unused]] static const bool bench_registered_##id =                   \
+      boticelli::bench::register_suite({#id, description, &bench_suite_##id}); \
   static int bench_suite_##id()

@@ -11,9 +11,9 @@ namespace boticelli::hal {
 struct Odometry {
   double x_m = 0.0;
   double y_m = 0.0;
-  double yaw_rad = 0.0;       // counter-clockwise from +x
-  float v_m_s = 0.0F;         // forward speed
-  float omega_rad_s = 0.0F;   // yaw rate
+  double yaw_rad = 0.0;      // counter-clockwise from +x
+  float v_m_s = 0.0F;        // forward speed
+  float omega_rad_s = 0.0F;  // yaw rate
   std::uint64_t timestamp_us = 0;
 };
 

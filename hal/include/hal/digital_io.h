@@ -1,4 +1,5 @@
-// DigitalIn / DigitalOut: GPIO lines (e-stop, bumper, status LED); logical levels, polarity handled below.
+// DigitalIn / DigitalOut: GPIO lines (e-stop, bumper, status LED); logical levels, polarity handled
+// below.
 #pragma once
 
 #include "hal/noncopyable.h"

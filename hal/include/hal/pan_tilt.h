@@ -12,15 +12,15 @@ struct PanTiltLimits {
   float pan_max_rad = 0.0F;
   float tilt_min_rad = 0.0F;
   float tilt_max_rad = 0.0F;
-  float pan_resolution_rad = 0.0F;   // one position step
+  float pan_resolution_rad = 0.0F;  // one position step
   float tilt_resolution_rad = 0.0F;
 };
 
 struct PanTiltState {
-  float pan_rad = 0.0F;    // current position (last reported by the unit)
+  float pan_rad = 0.0F;  // current position (last reported by the unit)
   float tilt_rad = 0.0F;
-  bool moving = false;     // a commanded move has not completed yet
-  bool fault = false;      // the unit reported an error or stopped answering; see error()
+  bool moving = false;  // a commanded move has not completed yet
+  bool fault = false;   // the unit reported an error or stopped answering; see error()
 };
 
 class PanTilt : private NonCopyable {

@@ -12,9 +12,13 @@ template <typename T>
 inline constexpr T kTwoPi = T(2) * std::numbers::pi_v<T>;
 
 template <typename T>
-constexpr T deg_to_rad(T deg) { return deg * kPi<T> / T(180); }
+constexpr T deg_to_rad(T deg) {
+  return deg * kPi<T> / T(180);
+}
 template <typename T>
-constexpr T rad_to_deg(T rad) { return rad * T(180) / kPi<T>; }
+constexpr T rad_to_deg(T rad) {
+  return rad * T(180) / kPi<T>;
+}
 
 // [rad] → [0, 2π): the pan angle α of a Reading.
 template <typename T>

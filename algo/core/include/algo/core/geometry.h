@@ -1,4 +1,5 @@
-// Small plane geometry shared by mapping, planning and persistence: points and poses in the world frame.
+// Small plane geometry shared by mapping, planning and persistence: points and poses in the world
+// frame.
 #pragma once
 
 #include <cmath>
@@ -18,7 +19,9 @@ struct Pose2 {
   float yaw_rad = 0.0F;
 };
 
-inline float distance_m(Point2 a, Point2 b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+inline float distance_m(Point2 a, Point2 b) {
+  return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m);
+}
 
 // Robot frame → world frame.
 inline Point2 to_world(const Pose2& pose, Point2 p) {
