@@ -190,10 +190,12 @@ bool decode_body(Reader& r, MissionState& s) {
   std::uint64_t model_bytes = 0;
   if (!r.keyed("model", v) || !parse_u64(v, model_bytes)) return r.fail("bad model size");
   if (model_bytes > MissionState::kMaxModelBytes) return r.fail("model larger than the capacity");
-  if (r.rest.size() < model_bytes + 1) return r.fail("truncated file");
-  if (r.rest[model_bytes] != '\n') return r.fail("model size does not match");
-  if (!s.set_model(r.rest.substr(0, model_bytes))) return r.fail("bad model text");
-  r.rest.remove_prefix(model_bytes + 1);
+  // Bounded by the capacity above, so it fits a size_t on 32-bit boards too.
+  const auto model_size = static_cast<std::size_t>(model_bytes);
+  if (r.rest.size() < model_size + 1) return r.fail("truncated file");
+  if (r.rest[model_size] != '\n') return r.fail("model size does not match");
+  if (!s.set_model(r.rest.substr(0, model_size))) return r.fail("bad model text");
+  r.rest.remove_prefix(model_size + 1);
   std::uint64_t entries = 0;
   if (!r.keyed("log", v) || !parse_u64(v, entries)) return r.fail("bad log size");
   if (entries > MissionState::kMaxLogEntries) return r.fail("more log lines than the capacity");
