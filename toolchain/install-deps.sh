@@ -35,7 +35,7 @@ cross_pkgs=(
 )
 armhf_pkgs=(
   g++-arm-linux-gnueabihf
-  libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf libpng-dev:armhf
+  libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf
 )
 bench_pkgs=(libopencv-dev liboctomap-dev)
 
