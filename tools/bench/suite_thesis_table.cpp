@@ -14,6 +14,7 @@
 #include "algo/aln/samples.h"
 #include "algo/aln/trainer.h"
 #include "algo/core/fixed_vector.h"
+#include "algo/evidence/occupancy_model.h"
 #include "algo/evidence/ray_samples.h"
 #include "algo/fusion/evidence_grid.h"
 #include "bench.h"
@@ -25,7 +26,6 @@ namespace {
 constexpr const char* kSuite = "thesis-table";
 constexpr std::size_t kMaxPieces = 512;
 constexpr std::size_t kMaxFeatures = 50000;
-constexpr float kSeamMarginRad = 0.5F;   // §4.9.1 copies beyond [0, 2π]
 constexpr float kFreeBelow = 0.6F;       // §5.4 safe occupancy
 constexpr double kTestSpacingM = 0.1;    // test points: cell centres of a 0.1 m lattice
 constexpr double kThesisEpsilon = 0.15;  // §4.8.2
@@ -151,17 +151,10 @@ std::size_t env_size(const char* name, std::size_t fallback) {
 }
 
 void configure_model(Model& model, const SyntheticRoom& room) {
-  const double h_lo = -room.sensor().z;
-  const double h_hi = room.spec().wall_height_m - room.sensor().z;
-  model.set_input_range(0, -kSeamMarginRad, 2.0F * std::numbers::pi_v<float> + kSeamMarginRad);
-  model.set_input_range(1, static_cast<float>(h_lo), static_cast<float>(h_hi));
-  model.set_input_range(2, 0.0F, static_cast<float>(room.spec().max_range_m * 1.2));
-  model.set_output_range(0.0F, 1.0F);
-  // Eq 4.28: |∂F/∂α| < 1 per rad; |∂F/∂h| < 1 per dm = 10 per m (units.h).
-  model.set_weight_bounds(0, -1.0F, 1.0F);
-  model.set_weight_bounds(1, -10.0F, 10.0F);
-  // Eq 4.27: c_l > 0 (monotone in r), a small positive lower bound; no upper bound.
-  model.set_weight_bounds(2, 1e-4F, std::numeric_limits<float>::infinity());
+  evidence::configure_occupancy_model(
+      model, static_cast<float>(-room.sensor().z),
+      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
+      static_cast<float>(room.spec().max_range_m * 1.2));
 }
 
 // RMS of a model over the samples: plain, or (robust runs) over the 95% smallest
@@ -265,7 +258,7 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
     *pad_count =
         evidence::append_featureless_pads(readings, region, pad_params, random, g_ray_samples);
   }
-  (void)evidence::append_seam_copies(g_ray_samples, kSeamMarginRad);
+  (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
   std::vector<AlnSample> samples(g_ray_samples.size());
   for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
     const evidence::RaySample& s = g_ray_samples[i];

@@ -1,0 +1,36 @@
+// The occupancy model's domain and the thesis's constraints on it (Eqs 4.27–4.28), in one place.
+#pragma once
+
+#include <limits>
+#include <numbers>
+
+namespace boticelli::evidence {
+
+// How far the α = 0/2π seam copies reach beyond [0, 2π) (§4.9.1) [rad].
+inline constexpr float kSeamMarginRad = 0.5F;
+
+// Slope bounds of the occupancy model F(α, h, r) in SI units (the thesis gives them per dm;
+// see algo/core/units.h): |∂F/∂α| < 1 per rad, |∂F/∂h| < 1 per dm = 10 per m (Eq 4.28),
+// and ∂F/∂r > 0 (Eq 4.27: monotone in r, so the model can be inverted in r, §5.4.1) as a
+// small positive lower bound with no upper bound.
+inline constexpr float kMaxAlphaSlopePerRad = 1.0F;
+inline constexpr float kMaxHeightSlopePerM = 10.0F;
+inline constexpr float kMinRangeSlopePerM = 1e-4F;
+
+// Sets the input box and the weight bounds of an occupancy ALN with inputs (α, h, r) and
+// output occupancy in [0, 1]. `Model` is an aln::Aln<Scalar, 3, Pieces>. Heights are
+// relative to the PTU centre [m]; `max_range_m` is the farthest r the model must cover.
+template <typename Model>
+void configure_occupancy_model(Model& model, float lowest_h_m, float highest_h_m,
+                               float max_range_m) {
+  constexpr float kTwoPi = 2.0F * std::numbers::pi_v<float>;
+  model.set_input_range(0, -kSeamMarginRad, kTwoPi + kSeamMarginRad);
+  model.set_input_range(1, lowest_h_m, highest_h_m);
+  model.set_input_range(2, 0.0F, max_range_m);
+  model.set_output_range(0.0F, 1.0F);
+  model.set_weight_bounds(0, -kMaxAlphaSlopePerRad, kMaxAlphaSlopePerRad);
+  model.set_weight_bounds(1, -kMaxHeightSlopePerM, kMaxHeightSlopePerM);
+  model.set_weight_bounds(2, kMinRangeSlopePerM, std::numeric_limits<float>::infinity());
+}
+
+}  // namespace boticelli::evidence
