@@ -105,6 +105,31 @@ TEST(Shrink, TheRobotDiscNeverLeavesTheFreeRegionOnAnyStraightPathToAPointInside
   }
 }
 
+TEST(Shrink, StaysSafeForFewAndForTheMostVertices) {
+  // The shrink's edge search works in angular gaps between a ray and an edge; with few
+  // vertices its window wraps round the polygon, with the most it is narrow.
+  Random rng(23);
+  constexpr float kRadius = 0.2F;
+  for (const std::size_t n : {std::size_t{3}, std::size_t{4}, std::size_t{5}, std::size_t{7},
+                              std::size_t{12}, std::size_t{33}, std::size_t{720}}) {
+    StarPolygon free;
+    boticelli::test::random_star_polygon(rng, free, n);
+    StarPolygon nav;
+    if (!boticelli::mapping::shrink_by_radius(free, kRadius, nav)) {
+      continue;  // the disc at the centre touches the boundary: nothing to check
+    }
+    float worst = 1e9F;
+    for (std::size_t k = 0; k < nav.vertex_count(); ++k) {
+      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(free, nav.vertex(k)));
+    }
+    for (int i = 0; i < 100; ++i) {
+      worst = std::fmin(worst,
+                        boticelli::mapping::sweep_clearance_m(free, random_point_inside(rng, nav)));
+    }
+    CHECK_TRUE(worst >= kRadius - 1e-5F);
+  }
+}
+
 TEST(Shrink, IsTightAlongTheVertexRaysAndLosesAlmostNoArea) {
   // Exact, not merely safe: along almost every vertex ray the disc touches the boundary
   // 5 mm beyond the shrunk vertex. Where the free distance jumps between two rays the

@@ -64,6 +64,25 @@ inline double segment_segment_distance(Vec2d a, Vec2d b, Vec2d c, Vec2d d) {
                    point_segment_distance(c, a, b), point_segment_distance(d, a, b)});
 }
 
+// Squared distance from point p to segment [a, b].
+inline double point_segment_distance2(Vec2d p, Vec2d a, Vec2d b) {
+  const Vec2d e = b - a;
+  const double len2 = dot(e, e);
+  double t = len2 > 0.0 ? dot(p - a, e) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  const Vec2d d = p - (a + t * e);
+  return dot(d, d);
+}
+
+// segment_segment_distance(a, b, c, d) < radius, without square roots and stopping at the
+// first endpoint that is close enough.
+inline bool segments_closer_than(Vec2d a, Vec2d b, Vec2d c, Vec2d d, double radius) {
+  const double r2 = radius * radius;
+  return segments_intersect(a, b, c, d) || point_segment_distance2(a, c, d) < r2 ||
+         point_segment_distance2(b, c, d) < r2 || point_segment_distance2(c, a, b) < r2 ||
+         point_segment_distance2(d, a, b) < r2;
+}
+
 inline bool point_in_triangle(Vec2d p, Vec2d a, Vec2d b, Vec2d c) {
   const double d1 = cross(b - a, p - a);
   const double d2 = cross(c - b, p - b);
