@@ -15,6 +15,7 @@
 #include "algo/aln/samples.h"
 #include "algo/aln/trainer.h"
 #include "algo/core/fixed_vector.h"
+#include "algo/evidence/occupancy_model.h"
 #include "algo/evidence/ray_samples.h"
 #include "algo/mapping/aln_free_range.h"
 #include "algo/mapping/extraction.h"
@@ -32,7 +33,6 @@ namespace {
 
 constexpr const char* kSuite = "vs-octomap";
 constexpr std::size_t kMaxPieces = 256;
-constexpr float kSeamMarginRad = 0.5F;
 constexpr std::size_t kFeatures = 5000;
 constexpr std::size_t kMaxRaySamples = 200000;
 constexpr double kGridStepM = 0.02;  // ground-truth area integration
@@ -63,16 +63,10 @@ mapping::ExtractionParams extraction_params(const SyntheticRoom& room) {
 }
 
 void configure_model(Model& model, const SyntheticRoom& room) {
-  const double h_lo = -room.sensor().z;
-  const double h_hi = room.spec().wall_height_m - room.sensor().z;
-  model.set_input_range(0, -kSeamMarginRad, 2.0F * std::numbers::pi_v<float> + kSeamMarginRad);
-  model.set_input_range(1, static_cast<float>(h_lo), static_cast<float>(h_hi));
-  model.set_input_range(2, 0.0F, static_cast<float>(room.spec().max_range_m * 1.2));
-  model.set_output_range(0.0F, 1.0F);
-  // Eqs 4.27-4.28 in metres: |∂F/∂α| < 1 per rad, |∂F/∂h| < 10 per m, ∂F/∂r > 0.
-  model.set_weight_bounds(0, -1.0F, 1.0F);
-  model.set_weight_bounds(1, -10.0F, 10.0F);
-  model.set_weight_bounds(2, 1e-4F, std::numeric_limits<float>::infinity());
+  evidence::configure_occupancy_model(
+      model, static_cast<float>(-room.sensor().z),
+      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
+      static_cast<float>(room.spec().max_range_m * 1.2));
 }
 
 // Ray samples (Fig 4.2b), zero pads in featureless directions and seam copies (§4.9.1).
@@ -89,7 +83,7 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
   evidence::PadRandom random{12345U};
   (void)evidence::append_featureless_pads(readings, region, evidence::FeaturelessPadParams{},
                                           random, g_ray_samples);
-  (void)evidence::append_seam_copies(g_ray_samples, kSeamMarginRad);
+  (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
   std::vector<AlnSample> samples(g_ray_samples.size());
   for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
     const evidence::RaySample& s = g_ray_samples[i];
