@@ -1,4 +1,5 @@
-// Obstacle and exploration points from the free polygon (§5.4.4) and the global lists' merging.
+// Obstacle and exploration points from the free polygon (§5.4.4), exploration points from the
+// belief–plausibility gap (§7.2.3) and the global lists' merging.
 #include "algo/mapping/map_points.h"
 
 #include <algorithm>
@@ -16,7 +17,96 @@ bool near_any(const PointList& list, core::Point2 p, float radius_m) {
                      [&](const core::Point2& q) { return core::distance_m(p, q) < radius_m; });
 }
 
+// Width of the unknown band along vertex ray k [m]: how much farther the belief model (lower
+// bound of occupancy) than the plausibility model (upper bound) calls the floor free, both
+// cut to the bounding circle. Bel ≤ Pl (Eq 4.16–4.18) makes it ≥ 0 for exact fits; a negative
+// value is a fit that broke the order, not an unknown region. NaN if a ρ is NaN.
+float gap_width_m(const StarPolygon& belief_free, const StarPolygon& plausibility_free,
+                  std::size_t k, float bounding_radius_m) {
+  return std::min(belief_free.rho_m(k), bounding_radius_m) -
+         std::min(plausibility_free.rho_m(k), bounding_radius_m);
+}
+
+bool is_gap_ray(const StarPolygon& belief_free, const StarPolygon& plausibility_free, std::size_t k,
+                float bounding_radius_m, float min_gap_m) {
+  const float gap = gap_width_m(belief_free, plausibility_free, k, bounding_radius_m);
+  return gap > 0.0F && gap >= min_gap_m;  // false for NaN
+}
+
+// The gap point on vertex ray k: §7.2.3 asks for the points of high uncertainty Pl − Bel, the
+// band (ρ_pl, ρ_bel]. Only the plausibility polygon is proven free (it is the navigation
+// polygon, §5.4), so a point in the band could not be reached or even approached safely; the
+// point goes to the near edge of the band, inset_m inside the plausibility boundary (at most
+// half way to the robot), where the robot can drive and look into the unknown.
+core::Point2 gap_point(const StarPolygon& plausibility_free, std::size_t k, float bounding_radius_m,
+                       float inset_m) {
+  const float rho = std::max(std::min(plausibility_free.rho_m(k), bounding_radius_m), 0.0F);
+  const float d = rho - std::clamp(inset_m, 0.0F, 0.5F * rho);
+  const float a = plausibility_free.angle_rad(k);
+  return {d * std::cos(a), d * std::sin(a)};
+}
+
 }  // namespace
+
+bool extract_gap_exploration_points(const StarPolygon& belief_free,
+                                    const StarPolygon& plausibility_free, float bounding_radius_m,
+                                    const MapPointParams& params, PointList& exploration_robot) {
+  const std::size_t n = plausibility_free.vertex_count();
+  if (belief_free.vertex_count() != n) {
+    return false;
+  }
+  const float min_gap = params.exploration_gap_m;
+  auto gap = [&](std::size_t k) {
+    return is_gap_ray(belief_free, plausibility_free, k % n, bounding_radius_m, min_gap);
+  };
+  // Start at a class change so no sector wraps round the seam; none: all gap or none.
+  std::size_t start = n;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (gap(k) != gap(k + n - 1)) {
+      start = k;
+      break;
+    }
+  }
+  if (start == n) {
+    if (!gap(0)) {
+      return true;
+    }
+    start = 0;
+  }
+  bool ok = true;
+  std::size_t done = 0;
+  while (done < n) {
+    const std::size_t first = (start + done) % n;
+    const bool in_gap = gap(first);
+    std::size_t len = 1;
+    while (done + len < n && gap(first + len) == in_gap) {
+      ++len;
+    }
+    done += len;
+    if (!in_gap) {
+      continue;
+    }
+    // Length of the arc the sector's points lie on.
+    float length_m = 0.0F;
+    for (std::size_t i = 0; i + 1 < len; ++i) {
+      const std::size_t k = (first + i) % n;
+      length_m += core::distance_m(
+          gap_point(plausibility_free, k, bounding_radius_m, params.gap_point_inset_m),
+          gap_point(plausibility_free, (k + 1) % n, bounding_radius_m, params.gap_point_inset_m));
+    }
+    auto count = static_cast<std::size_t>(
+        std::ceil(length_m / std::max(params.exploration_spacing_m, 1e-3F)));
+    count = std::clamp<std::size_t>(count, 1, len);
+    for (std::size_t i = 0; i < count; ++i) {
+      // Evenly spaced vertex angles in the sector, centred (as on the bounding circle).
+      const std::size_t offset = (2 * i + 1) * len / (2 * count);
+      ok = exploration_robot.push_back(gap_point(plausibility_free, (first + offset) % n,
+                                                 bounding_radius_m, params.gap_point_inset_m)) &&
+           ok;
+    }
+  }
+  return ok;
+}
 
 bool extract_map_points(const StarPolygon& free, float bounding_radius_m,
                         const MapPointParams& params, PointList& obstacles_robot,

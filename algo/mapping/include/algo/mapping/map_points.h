@@ -1,5 +1,5 @@
-// Obstacle points inside the bounding circle and exploration points on it (§5.4.4), and their
-// global lists.
+// Obstacle points inside the bounding circle and exploration points on it (§5.4.4) or where the
+// belief and plausibility polygons disagree (§7.2.3), and their global lists.
 #pragma once
 
 #include <cstddef>
@@ -21,6 +21,13 @@ struct MapPointParams {
   float exploration_merge_radius_m = 0.35F;  // likewise for exploration points [m]
   // An exploration point this far inside a later free polygon has been explored [m].
   float explored_margin_m = 0.1F;
+  // §7.2.3 belief–plausibility exploration: a ray whose belief free distance exceeds its
+  // plausibility free distance (both cut to the bounding circle) by at least this much
+  // crosses an unknown band, the polygon form of a high uncertainty interval Pl − Bel [m].
+  float exploration_gap_m = 0.5F;
+  // Such a point sits this far inside the plausibility boundary [m]; less than
+  // explored_margin_m, so the polygon the point came from does not count it as explored.
+  float gap_point_inset_m = 0.05F;
 };
 
 // §5.4.4: splits the free polygon's boundary (robot frame) into sectors on the bounding
@@ -31,6 +38,19 @@ struct MapPointParams {
 bool extract_map_points(const StarPolygon& free, float bounding_radius_m,
                         const MapPointParams& params, PointList& obstacles_robot,
                         PointList& exploration_robot);
+
+// §7.2.3: exploration points where the belief model (lower bound of occupancy, so the larger
+// free polygon) and the plausibility model (upper bound, the navigation polygon) disagree.
+// A vertex ray is a gap ray if min(ρ_bel, R) − min(ρ_pl, R) ≥ exploration_gap_m (R the
+// bounding radius); consecutive gap rays (across the seam at angle 0 too) form a sector, and
+// each sector gets one point per exploration_spacing_m of the arc the points lie on (at least
+// one), at evenly spaced vertex angles, gap_point_inset_m inside the plausibility boundary:
+// the nearest place the robot can surely reach from which it looks into the unknown band.
+// Appends to exploration_robot (robot frame); returns false if the list was full. Returns
+// false and appends nothing if the two polygons' vertex counts differ.
+bool extract_gap_exploration_points(const StarPolygon& belief_free,
+                                    const StarPolygon& plausibility_free, float bounding_radius_m,
+                                    const MapPointParams& params, PointList& exploration_robot);
 
 inline constexpr std::size_t kMaxObstaclePoints = 4096;
 inline constexpr std::size_t kMaxExplorationPoints = 512;
