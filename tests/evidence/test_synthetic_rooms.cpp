@@ -1,4 +1,5 @@
 // Tests of the synthetic range data of the thesis's simulated rooms (tools/bench/synthetic_rooms).
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -94,4 +95,68 @@ TEST(SyntheticRooms, TheSameSeedGivesTheSameReadings) {
     DOUBLES_EQUAL(a[i].r_m, b[i].r_m, 0.0);
     DOUBLES_EQUAL(a[i].alpha_rad, b[i].alpha_rad, 0.0);
   }
+}
+
+TEST(SyntheticRooms, TheCameraSeesTheBoxFromAboveAndInFrontAndNeverTheFloor) {
+  const SyntheticRoom room(*find_environment("cylinder_box_view1"));  // box at x ∈ [0.75, 1.25]
+  const std::vector<evidence::Reading> readings =
+      room.generate_camera_readings(CameraScan{}, 3000, 3U);
+  LONGS_EQUAL(3000, readings.size());
+  std::size_t on_top = 0;
+  std::size_t on_front = 0;
+  for (const evidence::Reading& r : readings) {
+    const Vec3 p = room.world_of(r);
+    CHECK(p.z > 1e-4);  // the floor has no features
+    if (distance_xy(p) < 2.5 - 1e-4) {
+      CHECK(p.x >= 0.75 - 1e-4 && p.x <= 1.25 + 1e-4 && p.z <= 0.5 + 1e-4);
+      on_top += std::fabs(p.z - 0.5) < 1e-4 ? 1 : 0;
+      on_front += std::fabs(p.x - 0.75) < 1e-4 ? 1 : 0;
+    } else {
+      DOUBLES_EQUAL(2.5, distance_xy(p), 1e-4);
+    }
+    // The first surface on the line of sight: the way there is free and seen.
+    const Vec3 s = room.sensor();
+    const Vec3 before{s.x + 0.98 * (p.x - s.x), s.y + 0.98 * (p.y - s.y), s.z + 0.98 * (p.z - s.z)};
+    CHECK(room.visible_free(before));
+  }
+  // The box fills about 1/50 of the 0.5-rad-down images' field: dozens of features each side.
+  CHECK(on_top > 20);
+  CHECK(on_front > 20);
+}
+
+TEST(SyntheticRooms, TheCameraCoversEveryPanDirectionAndTheWallsFromFootToTop) {
+  const SyntheticRoom room(*find_environment("rectangle"));
+  const std::vector<evidence::Reading> readings =
+      room.generate_camera_readings(CameraScan{}, 3000, 9U);
+  std::vector<int> sectors(36, 0);
+  double z_min = 10.0;
+  double z_max = -10.0;
+  for (const evidence::Reading& r : readings) {
+    const Vec3 p = room.world_of(r);
+    z_min = std::min(z_min, p.z);
+    z_max = std::max(z_max, p.z);
+    ++sectors[static_cast<std::size_t>(static_cast<double>(r.alpha_rad) / (2.0 * 3.14159266) *
+                                       36.0) %
+              36];
+  }
+  for (const int count : sectors) {
+    CHECK(count > 20);  // 3000 / 36 ≈ 83 on average
+  }
+  CHECK(z_min < 0.2);
+  CHECK(z_max > 1.7);
+}
+
+TEST(SyntheticRooms, TheSameSeedGivesTheSameCameraReadingsAndAnotherSeedOthers) {
+  const SyntheticRoom room(*find_environment("cylinder_box_view2"));
+  const std::vector<evidence::Reading> a = room.generate_camera_readings(CameraScan{}, 200, 42U);
+  const std::vector<evidence::Reading> b = room.generate_camera_readings(CameraScan{}, 200, 42U);
+  const std::vector<evidence::Reading> c = room.generate_camera_readings(CameraScan{}, 200, 43U);
+  LONGS_EQUAL(a.size(), b.size());
+  bool differs = false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    DOUBLES_EQUAL(a[i].r_m, b[i].r_m, 0.0);
+    DOUBLES_EQUAL(a[i].alpha_rad, b[i].alpha_rad, 0.0);
+    differs = differs || a[i].alpha_rad != c[i].alpha_rad;
+  }
+  CHECK(differs);
 }

@@ -257,7 +257,9 @@ int run() {
     if (spec == nullptr) continue;
     const SyntheticRoom room(*spec);
     const mapping::ExtractionParams p = extraction_params(room);
-    const std::vector<evidence::Reading> readings = room.generate_readings(kFeatures, 7U);
+    // As the camera sees the room: 15 pans × 2 tilts (level and 0.5 rad down).
+    const std::vector<evidence::Reading> readings =
+        room.generate_camera_readings(CameraScan{}, kFeatures, 7U);
 
     // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink.
     std::int64_t t0 = cpu_ns();

@@ -340,4 +340,60 @@ std::vector<evidence::Reading> SyntheticRoom::generate_readings(
   return out;
 }
 
+std::vector<evidence::Reading> SyntheticRoom::generate_camera_readings(
+    const CameraScan& scan, std::size_t features, std::uint32_t seed,
+    double outlier_fraction_override) const {
+  const double outliers =
+      outlier_fraction_override >= 0.0 ? outlier_fraction_override : spec_.outlier_fraction;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<evidence::Reading> out;
+  const std::size_t tilts = std::min(scan.tilt_count, scan.tilt_rad.size());
+  const std::size_t images = scan.pan_positions * tilts;
+  if (images == 0 || !(scan.focal_px > 0.0)) {
+    return out;
+  }
+  out.reserve(features);
+  const Vec3 s = spec_.sensor;
+  const double pan_offset = kTwoPi * unit(rng);
+  for (std::size_t image = 0; image < images; ++image) {
+    // Images share the features evenly; the first ones take the remainder.
+    const std::size_t quota = features / images + (image < features % images ? 1 : 0);
+    const double pan = pan_offset + kTwoPi * static_cast<double>(image / tilts) /
+                                        static_cast<double>(scan.pan_positions);
+    const double tilt = scan.tilt_rad[image % tilts];
+    const double cp = std::cos(pan);
+    const double sp = std::sin(pan);
+    const double ct = std::cos(tilt);
+    const double st = std::sin(tilt);
+    const auto max_attempts =
+        static_cast<std::size_t>(scan.attempts_per_feature * static_cast<double>(quota)) + 1;
+    std::size_t found = 0;
+    for (std::size_t attempt = 0; attempt < max_attempts && found < quota; ++attempt) {
+      // Pixel → camera frame (x forward, y left, z up) → tilt about y → pan about z.
+      const double u = scan.width_px * unit(rng);
+      const double v = scan.height_px * unit(rng);
+      const double yc = -(u - 0.5 * scan.width_px) / scan.focal_px;
+      const double zc = -(v - 0.5 * scan.height_px) / scan.focal_px;
+      const double xt = ct - zc * st;  // forward after tilting (tilt < 0 looks down)
+      const double zt = st + zc * ct;
+      Vec3 d{xt * cp - yc * sp, xt * sp + yc * cp, zt};
+      const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+      d = {d.x / len, d.y / len, d.z / len};
+      const Hit hit = cast_from_sensor(d);
+      if (!hit.featured || !(hit.distance_m <= spec_.max_range_m)) {
+        continue;
+      }
+      double t = hit.distance_m;
+      if (unit(rng) < outliers) {
+        t *= 0.5;  // §4.8.2: outliers appear twice as close as they are
+      }
+      out.push_back(reading_of({s.x + d.x * t, s.y + d.y * t, s.z + d.z * t},
+                               static_cast<float>(spec_.feature_m)));
+      ++found;
+    }
+  }
+  return out;
+}
+
 }  // namespace boticelli::bench

@@ -1,6 +1,7 @@
 // Synthetic range data for the environments of thesis §4.8.2, with analytic ground truth.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -43,6 +44,24 @@ struct RoomSpec {
   double wall_height_m = 2.0;
   double feature_m = 0.9;
   double max_range_m = 4.5;  // visibility of the sensor (§3.4)
+};
+
+// How the camera looks at the room (DESIGN.md "Look", thesis §3.4): a pinhole camera on
+// the PTU centre, one image per (pan, tilt) position. Defaults: the thesis's 160×120 image
+// with F = 150 px (56° × 44° field of view, as the sim board's camera), about 15 pan
+// positions, and two tilts — level (walls up to 22° above the horizon) and 0.5 rad down
+// (the floor and low obstacles from 0.5 m to the walls' foot).
+struct CameraScan {
+  std::size_t pan_positions = 15;
+  std::array<double, 4> tilt_rad = {0.0, -0.5, 0.0, 0.0};  // the first tilt_count are used
+  std::size_t tilt_count = 2;
+  double width_px = 160.0;
+  double height_px = 120.0;
+  double focal_px = 150.0;
+  // A feature detector keeps the best features of a textured image; an image that sees
+  // mostly featureless floor yields fewer. Pixels tried per image, as a multiple of its
+  // share of features, before it gives up.
+  double attempts_per_feature = 20.0;
 };
 
 // Axis-aligned bounds [m].
@@ -89,6 +108,16 @@ class SyntheticRoom {
   // is moved to half its distance. Deterministic for a seed.
   [[nodiscard]] std::vector<evidence::Reading> generate_readings(
       std::size_t features, std::uint32_t seed, double outlier_fraction_override = -1.0) const;
+
+  // `features` readings as the camera finds them (CameraScan): the share of each image is
+  // taken at uniformly random pixels whose line of sight first meets a featured surface
+  // (walls and the box, not the floor) within max_range_m; the pan positions start at a
+  // random offset. So low obstacles are seen from above and in front, as the robot sees
+  // them, and nothing is seen through them. Outliers as generate_readings. Deterministic
+  // for a seed; fewer than `features` only if the images see too little texture.
+  [[nodiscard]] std::vector<evidence::Reading> generate_camera_readings(
+      const CameraScan& scan, std::size_t features, std::uint32_t seed,
+      double outlier_fraction_override = -1.0) const;
 
   // (α, h, r) about the sensor ↔ world frame.
   [[nodiscard]] evidence::Reading reading_of(const Vec3& world_point, float m) const;
