@@ -19,6 +19,7 @@
 #include "algo/evidence/ray_samples.h"
 #include "algo/mapping/aln_free_range.h"
 #include "algo/mapping/extraction.h"
+#include "algo/mapping/feature_guard.h"
 #include "algo/mapping/polygon_ops.h"
 #include "bench.h"
 #include "synthetic_rooms.h"
@@ -49,6 +50,8 @@ mapping::AlnFreeRange<float, kMaxPieces> g_free_range;
 core::FixedVector<evidence::RaySample, kMaxRaySamples> g_ray_samples;
 mapping::LocalMap g_map;
 mapping::StarPolygon g_scratch;
+core::FixedVector<mapping::GuardPoint, mapping::kMaxGuardCandidates> g_candidates;
+core::FixedVector<core::Point2, mapping::kMaxGuardPoints> g_guard;
 
 // The robot: PTU 1 m above the floor (the rooms' sensor height), body from 5 cm above the
 // floor to the PTU, radius 0.2 m; five slices; the thesis's m_safe = 0.6.
@@ -189,14 +192,17 @@ Quality quality(const SyntheticRoom& room, const mapping::ExtractionParams& p,
 }
 
 void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
-          double build_ms, double extract_ms, const Quality& q, std::size_t pieces) {
+          double build_ms, double extract_ms, double shrink_ms, const Quality& q,
+          std::size_t pieces, std::size_t guard_points) {
   JsonLine(kSuite, spec.name)
       .text("method", method)
       .num("resolution_m", resolution_m)
       .integer("pieces", static_cast<std::int64_t>(pieces))
+      .integer("guard_points", static_cast<std::int64_t>(guard_points))
       .integer("model_bytes", static_cast<std::int64_t>(model_bytes))
       .num("build_ms", build_ms)
       .num("extract_ms", extract_ms)
+      .num("shrink_ms", shrink_ms)
       .num("safety", q.safety)
       .num("coverage", q.coverage)
       .num("nav_safety", q.nav_safety)
@@ -266,18 +272,44 @@ int run() {
     const std::vector<AlnSample> samples = build_samples(room, readings);
     configure_model(g_model, room);
     train(samples);
+    // The feature guard: readings the fit calls free, kept where they cluster.
+    g_candidates.clear();
+    g_guard.clear();
+    const auto occupancy = [](float a, float h, float r) {
+      return static_cast<float>(g_best(Model::Vec(a, h, r)));
+    };
+    (void)mapping::collect_unexplained_features(readings, occupancy, p,
+                                                mapping::FeatureGuardParams{}, g_candidates);
+    (void)mapping::corroborated_points(g_candidates, mapping::FeatureGuardParams{}, g_guard);
     const double build_ms = ms_since(t0);
     t0 = cpu_ns();
     for (int r = 0; r < reps; ++r) {
       (void)g_free_range.set_model(g_best, p.safe_occupancy);
-      mapping::extract_local_map(g_free_range, p, g_map, g_scratch);
+      mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
       do_not_optimize(g_map.navigable.rho_m(0));
     }
     const double extract_ms = ms_since(t0) / reps;
-    const std::size_t bytes =
-        g_best.piece_count() * sizeof(Model::PieceType) + g_best.node_count() * sizeof(Model::Node);
-    emit(*spec, "aln", 0.0, bytes, build_ms, extract_ms,
-         quality(room, p, g_map.free, g_map.navigable), g_best.piece_count());
+    t0 = cpu_ns();
+    for (int r = 0; r < reps; ++r) {
+      (void)mapping::shrink_by_radius(g_map.free, p.robot_radius_m + p.clearance_margin_m,
+                                      g_scratch);
+      do_not_optimize(g_scratch.rho_m(0));
+    }
+    const double shrink_ms = ms_since(t0) / reps;
+    if (std::getenv("DUMP") != nullptr) {
+      char fn[128];
+      std::snprintf(fn, sizeof fn, "/tmp/poly_%s.txt", spec->name);
+      FILE* f = std::fopen(fn, "w");
+      for (std::size_t k = 0; k < g_map.free.vertex_count(); ++k)
+        std::fprintf(f, "%.9g %.9g\n", static_cast<double>(g_map.free.rho_m(k)),
+                     static_cast<double>(g_map.navigable.rho_m(k)));
+      std::fclose(f);
+    }
+    const std::size_t bytes = g_best.piece_count() * sizeof(Model::PieceType) +
+                              g_best.node_count() * sizeof(Model::Node) +
+                              g_guard.size() * sizeof(core::Point2);
+    emit(*spec, "aln", 0.0, bytes, build_ms, extract_ms, shrink_ms,
+         quality(room, p, g_map.free, g_map.navigable), g_best.piece_count(), g_guard.size());
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
     for (const double res : {0.1, 0.05}) {
@@ -303,8 +335,15 @@ int run() {
         octomap_polygon(tree, room, p, oct_map, oct_slice);
       }
       const double oct_extract_ms = ms_since(t0) / oct_reps;
-      emit(*spec, "octomap", res, tree.memoryUsage(), oct_build_ms, oct_extract_ms,
-           quality(room, p, oct_map.free, oct_map.navigable), 0);
+      t0 = cpu_ns();
+      for (int r = 0; r < oct_reps; ++r) {
+        (void)mapping::shrink_by_radius(oct_map.free, p.robot_radius_m + p.clearance_margin_m,
+                                        oct_slice);
+        do_not_optimize(oct_slice.rho_m(0));
+      }
+      const double oct_shrink_ms = ms_since(t0) / oct_reps;
+      emit(*spec, "octomap", res, tree.memoryUsage(), oct_build_ms, oct_extract_ms, oct_shrink_ms,
+           quality(room, p, oct_map.free, oct_map.navigable), 0, 0);
     }
 #endif
   }

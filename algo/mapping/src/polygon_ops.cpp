@@ -23,8 +23,17 @@ Vec2d unit(const StarPolygon& p, std::size_t k) {
 class Vertices {
  public:
   explicit Vertices(const StarPolygon& p) : n_(static_cast<std::ptrdiff_t>(p.vertex_count())) {
+    // Unit vectors by rotation, anchored to cos/sin every 32 steps (rounding stays ~1e-15).
+    const double step = core::kTwoPi<double> / static_cast<double>(p.vertex_count());
+    const double cs = std::cos(step);
+    const double sn = std::sin(step);
     for (std::size_t k = 0; k < p.vertex_count(); ++k) {
-      unit_[k] = unit(p, k);
+      if (k % 32 == 0) {
+        unit_[k] = unit(p, k);
+      } else {
+        const Vec2d u = unit_[k - 1];
+        unit_[k] = {u.x * cs - u.y * sn, u.x * sn + u.y * cs};
+      }
       v_[k] = static_cast<double>(p.rho_m(k)) * unit_[k];
     }
     for (std::size_t j = 0; j < p.vertex_count(); ++j) {
@@ -61,29 +70,6 @@ double min_edge_distance_to_centre(const Vertices& v, std::size_t n) {
   return d;
 }
 
-// Per-edge form of the window below. Edge j lies in the sector between the rays j and j+1
-// (the polygon is star-shaped about the centre), and all its points are at least
-// centre_distance(j) = d_j from the centre. A point at distance d and angle δ ≥ 0 from a ray
-// (or from a wedge of rays) is at least d·sin δ from it if δ ≤ 90°, else at least d. So edge
-// j cannot come within R of a ray or wedge that is `gap` whole sectors away from it if
-// d_j·sin(gap·step) ≥ R (or gap·step ≥ 90°, since d_j ≥ d_min > R). `sin_gap[g]` holds
-// sin(g·step); the test keeps a relative slack so rounding never skips an edge that counts.
-bool edge_out_of_reach(const Vertices& v, std::ptrdiff_t j, std::ptrdiff_t gap,
-                       const std::array<double, kMaxPolygonVertices / 4 + 2>& sin_gap,
-                       std::ptrdiff_t quarter, double radius) {
-  if (gap <= 0) return false;
-  if (gap >= quarter) return true;
-  return v.centre_distance(j) * sin_gap[static_cast<std::size_t>(gap)] > radius * (1.0 + 1e-6);
-}
-
-// (j − k) mod n, in [0, n).
-std::ptrdiff_t forward_offset(std::ptrdiff_t j, std::ptrdiff_t k, std::ptrdiff_t n) {
-  std::ptrdiff_t f = j - k;
-  while (f < 0) f += n;
-  while (f >= n) f -= n;
-  return f;
-}
-
 // Edges farther (in angle) than `window` from a ray or sector are at least `radius` away:
 // a boundary point at distance d ≥ d_min from the centre and angle δ ≥ asin(R/d_min) from
 // a wedge is at least d·sin δ ≥ R from it (δ ≤ 90°), or at least d > R (δ > 90°).
@@ -99,8 +85,8 @@ std::ptrdiff_t edge_window(const StarPolygon& p, double radius, double d_min) {
 // ray), and no edge reaches inside the triangle (the only edge in the sector lies beyond
 // both vertices, the others outside the wedge), so only the chord a–b needs checking. An
 // edge whose bounding box is more than R away from the chord's is skipped at once.
-// `near` lists the edges of the window that edge_out_of_reach does not rule out for this
-// sector (the others are more than R from the whole wedge, hence from the chord).
+// `near` lists the edges that can come within R of the part of the wedge the chord lies in
+// (the others are farther from it, hence from the chord).
 bool triangle_clear(const Vertices& p, Vec2d a, Vec2d b, const std::int16_t* near,
                     std::size_t near_count, double radius) {
   const double min_x = std::min(a.x, b.x) - radius;
@@ -122,9 +108,42 @@ bool triangle_clear(const Vertices& p, Vec2d a, Vec2d b, const std::int16_t* nea
   return true;
 }
 
+// The largest t in [0, t_max] for which the segment [b, t·u] (|u| = 1) stays at least R
+// from c, given that [b, 0] does: as t grows the segment turns about b, and it first
+// touches the disc where it is tangent to it (the moving end itself meets the disc only
+// beyond the ray's first contact, which t_max does not exceed). Each of the two tangents
+// from b counts if it meets the ray at t ≥ 0 with its tangent point on the segment.
+double tangent_limit(Vec2d b, Vec2d u, Vec2d c, double radius, double t_max) {
+  const Vec2d d = c - b;
+  const double l2 = detail::dot(d, d);
+  const double r2 = radius * radius;
+  if (!(l2 > r2)) {
+    return 0.0;  // not expected: b is clear of every disc
+  }
+  const double l = std::sqrt(l2);
+  const double sin_b = radius / l;
+  const double cos_b = std::sqrt(l2 - r2) / l;
+  double best = t_max;
+  for (const double sign : {1.0, -1.0}) {
+    // d turned by ±β (sin β = R / |d|): the tangent's direction, of length |d|; the
+    // tangent point is b + cos β · dir.
+    const Vec2d dir{d.x * cos_b - sign * d.y * sin_b, sign * d.x * sin_b + d.y * cos_b};
+    const double den = detail::cross(u, dir);
+    if (den == 0.0) continue;
+    const double t = detail::cross(b, dir) / den;
+    if (!(t >= 0.0 && t < best)) continue;
+    const double s_end = detail::dot(t * u - b, dir) / l2;  // the segment's end, in |dir|
+    if (cos_b <= s_end) best = t;
+  }
+  return best;
+}
+
 // How far below the largest clear length a pulled-in vertex may end (10 µm, the precision
 // the tests check the swept disc to; tightness is checked at 5 mm).
 constexpr double kBisectionTolerance_m = 1e-5;
+// How far a chord may reach into the R-neighbourhood and still count as touching it
+// (1 µm: rounding, not geometry; the stored ρ are floats, 0.24 µm apart at 3 m).
+constexpr double kChordTolerance_m = 1e-6;
 
 // Stored ρ never rounds outwards.
 float round_down(double v) {
@@ -160,108 +179,243 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   }
   const std::ptrdiff_t w = edge_window(free_region, radius, d_min);
   const auto nn = static_cast<std::ptrdiff_t>(n);
-  // sin of whole multiples of the angular step, up to 90° (the per-edge reach test).
+  // sin and cos of whole multiples of the angular step below 90° (`quarter` of them).
   const double step = core::kTwoPi<double> / static_cast<double>(n);
-  const auto quarter = static_cast<std::ptrdiff_t>(std::ceil(core::kTwoPi<double> / 4.0 / step));
+  std::ptrdiff_t quarter = 0;
+  while (static_cast<double>(quarter) * step < 0.5 * core::kPi<double> - 1e-12) ++quarter;
   std::array<double, kMaxPolygonVertices / 4 + 2> sin_gap{};
   std::array<double, kMaxPolygonVertices / 4 + 2> cos_gap{};
-  for (std::ptrdiff_t g = 0; g < quarter && static_cast<std::size_t>(g) < sin_gap.size(); ++g) {
+  for (std::ptrdiff_t g = 0; g < quarter; ++g) {
     sin_gap[static_cast<std::size_t>(g)] = std::sin(static_cast<double>(g) * step);
     cos_gap[static_cast<std::size_t>(g)] = std::cos(static_cast<double>(g) * step);
   }
+  const auto wrap = [nn](std::ptrdiff_t k) {
+    while (k < 0) k += nn;
+    while (k >= nn) k -= nn;
+    return static_cast<std::size_t>(k);
+  };
 
-  // 1. Each vertex ray: first contact with the radius-neighbourhood of the boundary (the
-  //    union of the edges' stadiums). The robot's centre can go that far along the ray and
-  //    no farther.
+  // 1. Each vertex ray: first contact with the radius-neighbourhood of the boundary, the
+  //    union of the edges' stadiums. The robot's centre can go that far along the ray and
+  //    no farther. A stadium is two discs and two straight sides; the discs are the
+  //    vertices' (shared by neighbouring edges), and of the sides only the inner one (the
+  //    edge moved R towards the centre) can be met first: the centre lies on the inner
+  //    side of every edge's line (the polygon is star-shaped about it), more than R away.
+  //    So each ray's contact is the nearest of the vertex discs and inner sides it meets,
+  //    and each disc or side is visited only for the rays that can meet it.
+  std::array<double, kMaxPolygonVertices> t{};
   for (std::size_t k = 0; k < n; ++k) {
-    const Vec2d u = verts.unit_at(k);
-    const auto kk = static_cast<std::ptrdiff_t>(k);
-    double t = static_cast<double>(free_region.rho_m(k));
-    // Nearest edges first (gap g: edges k + g and k − 1 − g), so that t is small early and
-    // the lower bound below rules out most of the others.
-    for (std::ptrdiff_t g = 0; g <= w; ++g) {
-      // The angular gap in whole steps, the shorter way round (small n).
-      const std::ptrdiff_t gap = std::max<std::ptrdiff_t>(0, std::min(g, nn - g - 1));
-      for (const std::ptrdiff_t j : {kk + g, kk - 1 - g}) {
-        if (edge_out_of_reach(verts, j, gap, sin_gap, quarter, radius)) continue;
-        // A point q of edge j lies at angle θ ∈ [gap·step, (gap+1)·step] from the ray and
-        // |q| ≥ d_j. The ray is within R of q only for t ≥ |q| cos θ − √(R² − |q|² sin² θ),
-        // which is at least d_j cos((gap+1)·step) − √(R² − d_j² sin²(gap·step)) (θ < 90°).
-        // An edge whose bound is beyond the contact found so far cannot lower it.
-        if (gap + 1 < quarter) {
-          const double dj = verts.centre_distance(j);
-          const double s = dj * sin_gap[static_cast<std::size_t>(gap)];
-          const double lower = dj * cos_gap[static_cast<std::size_t>(gap + 1)] -
-                               std::sqrt(std::max(0.0, radius * radius - s * s));
-          if (lower > t + 1e-9) continue;
-        }
-        t = std::min(t, detail::ray_stadium_hit(u, verts.edge_start(j), verts.edge_end(j), radius));
+    t[k] = static_cast<double>(free_region.rho_m(k));
+  }
+  const double r2 = radius * radius;
+  //    (a) The inner side of edge j: the segment [v_j, v_j+1] moved R along the edge's
+  //        inward normal. Rays j and j+1 face its line (they pass through the edge's ends
+  //        on the outer side); walking away from them, the point where a ray meets the
+  //        line moves monotonically along it, so each walk stops once it has passed the
+  //        side's end or no longer faces the line.
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto jj = static_cast<std::ptrdiff_t>(j);
+    const Vec2d a = verts.edge_start(jj);
+    const Vec2d e = verts.edge_end(jj) - a;
+    const double len2 = detail::dot(e, e);
+    if (!(len2 > 0.0)) continue;  // a point: its disc is all there is
+    const double len = std::sqrt(len2);
+    const Vec2d outward{e.y / len, -e.x / len};
+    const double offset = detail::dot(outward, a) - radius;  // > 0: the line's distance − R
+    const Vec2d p0 = a - radius * outward;
+    // Returns false once the ray no longer faces the line; else its contact t and the
+    // contact's place s along the side (0 at its start, 1 at its end).
+    const auto meet = [&](std::size_t k, double& tk, double& s) {
+      const Vec2d u = verts.unit_at(k);
+      const double facing = detail::dot(outward, u);
+      if (!(facing > 0.0)) return false;
+      tk = offset / facing;
+      s = detail::dot(tk * u - p0, e) / len2;
+      return true;
+    };
+    for (std::ptrdiff_t g = 0; g < nn; ++g) {  // rays j, j − 1, ...: s falls
+      const std::size_t k = wrap(jj - g);
+      double tk = 0.0;
+      double s = 0.0;
+      if (!meet(k, tk, s) || s < 0.0) break;
+      if (s <= 1.0) t[k] = std::min(t[k], tk);
+    }
+    for (std::ptrdiff_t g = 0; g < nn; ++g) {  // rays j + 1, j + 2, ...: s rises
+      const std::size_t k = wrap(jj + 1 + g);
+      double tk = 0.0;
+      double s = 0.0;
+      if (!meet(k, tk, s) || s > 1.0) break;
+      if (s >= 0.0) t[k] = std::min(t[k], tk);
+    }
+  }
+  //    (b) The disc of radius R about vertex i, at distance ρ_i from the centre: the ray
+  //        g steps away meets it iff ρ_i sin(g·step) < R, at ρ_i cos(g·step) −
+  //        √(R² − ρ_i² sin²(g·step)) (g·step < 90°, and ρ_i > R).
+  for (std::size_t i = 0; i < n; ++i) {
+    const double rho = static_cast<double>(free_region.rho_m(i));
+    const auto ii = static_cast<std::ptrdiff_t>(i);
+    for (std::ptrdiff_t g = 0; g < quarter; ++g) {
+      const double s = rho * sin_gap[static_cast<std::size_t>(g)];
+      if (!(s < radius)) break;
+      const double base = rho * cos_gap[static_cast<std::size_t>(g)];
+      const double h2 = r2 - s * s;
+      for (const std::ptrdiff_t k : {ii + g, ii - g}) {
+        double& tk = t[wrap(k)];
+        const double lead = base - tk;  // the hit base − √h2 is below tk iff lead < √h2
+        if (lead < 0.0 || lead * lead < h2) tk = std::min(tk, base - std::sqrt(h2));
       }
     }
-    out.set_rho_m(k, round_down(t));
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    out.set_rho_m(k, round_down(t[k]));
   }
 
   // 2. Each sector: the triangle (0, v_k, v_{k+1}) swept by the disc must stay clear of the
   //    boundary; a straight edge between two exact vertices can cut the round corner the
-  //    disc makes around a reflex vertex.
-  //    Shrinking a vertex only shrinks the already checked neighbouring triangle.
+  //    disc makes around a reflex vertex. Its sides are clear (step 1), so only the chord
+  //    can come within R of an edge. First every edge is tried against the chords of the
+  //    sectors it can reach (gap g whole sectors away: d_j sin(g·step) < R, as in
+  //    edge_out_of_reach); an edge whose two ends lie R or more beyond the chord's line is
+  //    clear of it at once (every point of its stadium lies on the far side). The sectors
+  //    that fail are pulled in below.
+  std::array<Vec2d, kMaxPolygonVertices> chord_normal{};
+  std::array<double, kMaxPolygonVertices> chord_offset{};
+  std::array<double, kMaxPolygonVertices> chord_reach{};
+  std::array<std::uint8_t, kMaxPolygonVertices> fails{};
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t k1 = k + 1 == n ? 0 : k + 1;
+    const Vec2d a = static_cast<double>(out.rho_m(k)) * verts.unit_at(k);
+    const Vec2d b = static_cast<double>(out.rho_m(k1)) * verts.unit_at(k1);
+    const Vec2d c = b - a;
+    const double len = detail::norm(c);
+    chord_normal[k] = len > 0.0 ? Vec2d{c.y / len, -c.x / len} : Vec2d{0.0, 0.0};
+    chord_offset[k] = detail::dot(chord_normal[k], a);
+    chord_reach[k] = std::max(detail::norm(a), detail::norm(b));
+  }
+  const double beyond = radius * (1.0 + 1e-6);
+  double reach_max = 0.0;
+  for (std::size_t k = 0; k < n; ++k) reach_max = std::max(reach_max, chord_reach[k]);
+  // A chord on the R-neighbourhood touches it within rounding (on a circle every chord lies
+  // on an edge's inner side): contacts up to kChordTolerance_m deep count as touching.
+  const double chord_radius = radius - kChordTolerance_m;
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto jj = static_cast<std::ptrdiff_t>(j);
+    const Vec2d e0 = verts.edge_start(jj);
+    const Vec2d e1 = verts.edge_end(jj);
+    const double dj = verts.centre_distance(jj);
+    // Sector kk, `gap` whole sectors away from the edge's own (0 for it and its two
+    // neighbours): every point q of the edge has |q| ≥ d_j and an angle ≥ gap·step from
+    // the sector's wedge, and every point of the chord lies in the wedge within m_k =
+    // max(ρ_k, ρ_k+1) of the centre. The distance from such a q to that part of the wedge
+    // grows with |q| and with the angle, so it is at least its value at (d_j, gap·step):
+    // d_j sin(gap·step) if the foot of the perpendicular falls within m_k, else the
+    // distance to the wedge's corner at m_k. Only edges that bound lets through, and that
+    // do not lie R beyond the chord's line, are measured exactly.
+    const auto try_sector = [&](std::ptrdiff_t kk, std::ptrdiff_t gap) {
+      const std::size_t k = wrap(kk);
+      if (fails[k] != 0) return;
+      const double mk = chord_reach[k];
+      const double cg = cos_gap[static_cast<std::size_t>(gap)];
+      const double sg = sin_gap[static_cast<std::size_t>(gap)];
+      const double bound2 =
+          dj * cg <= mk ? (dj * sg) * (dj * sg) : dj * dj + mk * mk - 2.0 * dj * mk * cg;
+      if (bound2 >= beyond * beyond) return;
+      const Vec2d cn = chord_normal[k];
+      if (detail::dot(cn, e0) - chord_offset[k] >= chord_radius &&
+          detail::dot(cn, e1) - chord_offset[k] >= chord_radius) {
+        return;
+      }
+      const std::size_t k1 = k + 1 == n ? 0 : k + 1;
+      const Vec2d a = static_cast<double>(out.rho_m(k)) * verts.unit_at(k);
+      const Vec2d b = static_cast<double>(out.rho_m(k1)) * verts.unit_at(k1);
+      if (detail::segments_closer_than(a, b, e0, e1, chord_radius)) fails[k] = 1;
+    };
+    try_sector(jj, 0);
+    try_sector(jj + 1, 0);
+    try_sector(jj - 1, 0);
+    for (std::ptrdiff_t gap = 1; gap < quarter && gap < nn; ++gap) {
+      // The bound falls as m_k grows: with the largest m_k it holds for every sector, and
+      // it grows with the gap, so no farther sector can be reached either.
+      const double cg = cos_gap[static_cast<std::size_t>(gap)];
+      const double sg = sin_gap[static_cast<std::size_t>(gap)];
+      const double bound2 = dj * cg <= reach_max
+                                ? (dj * sg) * (dj * sg)
+                                : dj * dj + reach_max * reach_max - 2.0 * dj * reach_max * cg;
+      if (!(bound2 < beyond * beyond)) break;
+      try_sector(jj + 1 + gap, gap);
+      try_sector(jj - 1 - gap, gap);
+    }
+  }
+
+  //    Pulling a vertex in only shrinks the neighbouring triangles, which stay clear.
   std::array<std::int16_t, kMaxPolygonVertices + 8> near{};
   for (std::size_t k = 0; k < n; ++k) {
+    if (fails[k] == 0) continue;
     const std::size_t k1 = (k + 1) % n;
     const auto kk = static_cast<std::ptrdiff_t>(k);
-    const std::ptrdiff_t first = kk - w - 1;
-    const std::ptrdiff_t last = kk + w + 1;
     const Vec2d uk = verts.unit_at(k);
     const Vec2d uk1 = verts.unit_at(k1);
     double rk = static_cast<double>(out.rho_m(k));
     double rk1 = static_cast<double>(out.rho_m(k1));
-    // The window's edges that can come within R of the wedge between rays k and k+1.
+    // Every chord tried below lies in the triangle (0, v_k, v_k+1), within m_k of the
+    // centre: only the edges the bound of try_sector lets through can fail it.
+    const double mk = std::max(rk, rk1);
     std::size_t near_count = 0;
-    for (std::ptrdiff_t j = first; j <= last; ++j) {
-      const std::ptrdiff_t f = forward_offset(j, kk, nn);
-      const std::ptrdiff_t gap = f == 0 ? 0 : std::min(f - 1, nn - f - 1);
-      if (!edge_out_of_reach(verts, j, gap, sin_gap, quarter, radius)) {
-        near[near_count++] = static_cast<std::int16_t>(j);
+    const auto consider = [&](std::ptrdiff_t j, std::ptrdiff_t gap) {
+      const double dj = verts.centre_distance(j);
+      const double cg = cos_gap[static_cast<std::size_t>(gap)];
+      const double sg = sin_gap[static_cast<std::size_t>(gap)];
+      const double bound2 =
+          dj * cg <= mk ? (dj * sg) * (dj * sg) : dj * dj + mk * mk - 2.0 * dj * mk * cg;
+      if (bound2 < beyond * beyond) near[near_count++] = static_cast<std::int16_t>(j);
+    };
+    consider(kk, 0);
+    consider(kk + 1, 0);
+    consider(kk - 1, 0);
+    for (std::ptrdiff_t gap = 1; gap <= w && gap < quarter && 2 * gap + 1 < nn; ++gap) {
+      consider(kk + 1 + gap, gap);
+      consider(kk - 1 - gap, gap);
+    }
+    // The edges the chord comes too close to (none: a neighbour's pull already cleared it).
+    std::array<std::int16_t, kMaxPolygonVertices + 8> failing{};
+    std::size_t failing_count = 0;
+    for (std::size_t i = 0; i < near_count; ++i) {
+      const std::ptrdiff_t j = near[i];
+      if (!triangle_clear(verts, rk * uk, rk1 * uk1, &near[i], 1, chord_radius)) {
+        failing[failing_count++] = static_cast<std::int16_t>(j);
       }
     }
-    if (triangle_clear(verts, rk * uk, rk1 * uk1, near.data(), near_count, radius)) {
+    if (failing_count == 0) {
       continue;
     }
-    // Every chord tried below lies in the triangle (0, v_k, v_k+1): only the edges that
-    // come within R of that triangle can fail it.
-    {
-      const Vec2d a = rk * uk;
-      const Vec2d b = rk1 * uk1;
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < near_count; ++i) {
-        const std::ptrdiff_t j = near[i];
-        if (detail::triangle_segment_distance({0.0, 0.0}, a, b, verts.edge_start(j),
-                                              verts.edge_end(j)) < radius * (1.0 + 1e-6)) {
-          near[kept++] = near[i];
-        }
-      }
-      near_count = kept;
-    }
-    // Largest clear length of one vertex with the other fixed (bisection; length 0 is
-    // always clear since d_min > R, and clearance only grows as a vertex moves in).
-    // Most failures are the exact contact itself: both vertices sit on the R-neighbourhood
-    // and the chord touches it within rounding. So the bracket [hi (1 − 2⁻²⁰), hi] is tried
-    // first. The bisection stops once the bracket is below kBisectionTolerance_m or the
-    // stored float's resolution (2⁻²⁴ relative); `lo` is always a length checked clear, so
+    // Largest clear length of one vertex with the other fixed. Length 0 is always clear
+    // (d_min > R), and clearance only grows as a vertex moves in. Mostly the chord cuts the
+    // round corner the disc makes about a reflex vertex: then the limit is where the chord,
+    // turning about the fixed vertex, becomes tangent to the disc of one of the failing
+    // edges' ends (tangent_limit), and one check confirms it against all near edges.
+    // Otherwise (a straight side, or several edges at once) a bisection below that limit
+    // finds it; it stops once the bracket is below kBisectionTolerance_m or the stored
+    // float's resolution (2⁻²⁴ relative). The length kept is always one checked clear, so
     // the tolerance costs at most that much tightness, never safety.
-    auto bisect = [&](bool move_k, double other) {
+    auto limit = [&](bool move_k, double other) {
       const auto clear_at = [&](double len) {
-        return move_k
-                   ? triangle_clear(verts, len * uk, other * uk1, near.data(), near_count, radius)
-                   : triangle_clear(verts, other * uk, len * uk1, near.data(), near_count, radius);
+        return move_k ? triangle_clear(verts, len * uk, other * uk1, near.data(), near_count,
+                                       chord_radius)
+                      : triangle_clear(verts, other * uk, len * uk1, near.data(), near_count,
+                                       chord_radius);
       };
-      double lo = 0.0;
+      const Vec2d fixed = move_k ? other * uk1 : other * uk;
+      const Vec2d moving = move_k ? uk : uk1;
       double hi = move_k ? rk : rk1;
-      const double tolerance = std::max(hi * 0x1p-24, kBisectionTolerance_m);
-      const double near_hi = hi * (1.0 - 0x1p-20);
-      if (clear_at(near_hi)) {
-        lo = near_hi;
+      for (std::size_t i = 0; i < failing_count; ++i) {
+        hi = tangent_limit(fixed, moving, verts.edge_start(failing[i]), radius, hi);
+        hi = tangent_limit(fixed, moving, verts.edge_end(failing[i]), radius, hi);
       }
+      if (clear_at(hi)) {
+        return hi;
+      }
+      double lo = 0.0;
+      const double tolerance = std::max(hi * 0x1p-24, kBisectionTolerance_m);
       for (int it = 0; it < 60 && hi - lo > tolerance; ++it) {
         const double mid = 0.5 * (lo + hi);
         (clear_at(mid) ? lo : hi) = mid;
@@ -269,8 +423,8 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       return lo;
     };
     // Pull in vertex k or vertex k+1, whichever keeps the larger triangle (area ∝ ρ_k ρ_k+1).
-    const double new_k = bisect(true, rk1);
-    const double new_k1 = bisect(false, rk);
+    const double new_k = limit(true, rk1);
+    const double new_k1 = limit(false, rk);
     if (new_k * rk1 >= rk * new_k1) {
       rk = new_k;
     } else {
@@ -297,6 +451,32 @@ float sweep_clearance_m(const StarPolygon& region, core::Point2 p) {
                                                      verts.edge_end(jj)));
   }
   return static_cast<float>(d);
+}
+
+void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
+  const std::size_t n = free.vertex_count();
+  const float step = free.angle_step_rad();
+  for (const core::Point2& q : points) {
+    const float d = std::hypot(q.x_m, q.y_m);
+    float theta = std::atan2(q.y_m, q.x_m);
+    if (theta < 0.0F) {
+      theta += core::kTwoPi<float>;
+    }
+    // The sector [θ_k, θ_k+1] holding the point. A point on (or within rounding of) one of
+    // its rays also lies in the sector beyond that ray: then vertices k − 1 .. k + 2 are
+    // cut, which covers both sectors whichever of the two rays it is.
+    auto k = static_cast<std::size_t>(theta / step);
+    k = std::min(k, n - 1);
+    const float cut = d > 0.0F ? std::nextafter(d, 0.0F) : 0.0F;
+    const float offset = theta - static_cast<float>(k) * step;
+    const bool near_ray = offset < 1e-5F || step - offset < 1e-5F;
+    const std::size_t first = near_ray ? k + n - 1 : k;
+    const std::size_t last = near_ray ? k + 2 : k + 1;
+    for (std::size_t i = first; i <= last; ++i) {
+      const std::size_t v = i % n;
+      free.set_rho_m(v, std::min(free.rho_m(v), cut));
+    }
+  }
 }
 
 }  // namespace boticelli::mapping

@@ -2,6 +2,8 @@
 // (§5.4.1).
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -28,6 +30,15 @@ class AlnFreeRange {
       }
     }
     valid_ = aln::invert(occupancy, 2, inverse_);
+    // The inverse's tree in post order (children before parents), for the block evaluation.
+    op_count_ = 0;
+    if (valid_) {
+      for (const std::uint16_t n : inverse_.post_order()) {
+        const auto& node = inverse_.node(n);
+        ops_[op_count_++] =
+            Op{node.kind, node.kind == aln::NodeKind::kPiece ? node.a : std::uint16_t{0}};
+      }
+    }
     return valid_;
   }
   [[nodiscard]] bool valid() const { return valid_; }
@@ -48,9 +59,69 @@ class AlnFreeRange {
     return static_cast<float>(e.value);
   }
 
+  // r [m] at the `count` pan angles α_k = k·step_rad (the vertex angles of a StarPolygon,
+  // computed the same way) at height h [m], into out[0 .. count). The same function as
+  // operator(), evaluated for kBlock angles at a time: at one height each piece of the
+  // inverse is a line in α (its h and m terms fold into the constant), and the MIN/MAX tree
+  // combines whole blocks, children before parents, with no branches per angle. The values
+  // agree with operator() to float rounding (the terms are summed in another order).
+  void ranges_at_height(float h_m, float step_rad, std::size_t count, float* out) const {
+    if (!valid_) {
+      std::fill(out, out + count, 0.0F);
+      return;
+    }
+    const std::size_t pieces = inverse_.piece_count();
+    for (std::size_t p = 0; p < pieces; ++p) {
+      const auto& piece = inverse_.piece(p);
+      constant_[p] = piece.bias + piece.weight(1) * static_cast<Scalar>(h_m) +
+                     piece.weight(2) * safe_occupancy_;
+      slope_[p] = piece.weight(0);
+    }
+    for (std::size_t k0 = 0; k0 < count; k0 += kBlock) {
+      std::array<Scalar, kBlock> alpha{};
+      for (std::size_t i = 0; i < kBlock; ++i) {
+        alpha[i] = static_cast<Scalar>(static_cast<float>(k0 + i) * step_rad);
+      }
+      std::size_t top = 0;
+      for (std::size_t o = 0; o < op_count_; ++o) {
+        const Op op = ops_[o];
+        if (op.kind == aln::NodeKind::kPiece) {
+          const Scalar c = constant_[op.piece];
+          const Scalar a = slope_[op.piece];
+          Block& v = stack_[top++];
+          for (std::size_t i = 0; i < kBlock; ++i) v[i] = c + a * alpha[i];
+        } else {
+          --top;
+          const Block& second = stack_[top];
+          Block& first = stack_[top - 1];
+          if (op.kind == aln::NodeKind::kMax) {
+            for (std::size_t i = 0; i < kBlock; ++i) first[i] = std::max(first[i], second[i]);
+          } else {
+            for (std::size_t i = 0; i < kBlock; ++i) first[i] = std::min(first[i], second[i]);
+          }
+        }
+      }
+      const std::size_t end = std::min(count, k0 + kBlock);
+      for (std::size_t k = k0; k < end; ++k) out[k] = static_cast<float>(stack_[0][k - k0]);
+    }
+  }
+
  private:
   Model inverse_{};
   Scalar safe_occupancy_ = Scalar(0.6);
+  static constexpr std::size_t kBlock = 16;
+  using Block = std::array<Scalar, kBlock>;
+  struct Op {
+    aln::NodeKind kind = aln::NodeKind::kPiece;
+    std::uint16_t piece = 0;
+  };
+  std::array<Op, Model::kMaxNodes> ops_{};
+  std::size_t op_count_ = 0;
+  // Working memory of ranges_at_height (the evaluation stack holds at most one block per
+  // piece): part of the object, so nothing is allocated.
+  mutable std::array<Scalar, MaxPieces> constant_{};
+  mutable std::array<Scalar, MaxPieces> slope_{};
+  mutable std::array<Block, MaxPieces> stack_{};
   mutable std::uint16_t hint_ = 0;
   bool valid_ = false;
 };

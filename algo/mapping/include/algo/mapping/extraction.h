@@ -3,8 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
+#include <span>
 
 #include "algo/core/angles.h"
 #include "algo/mapping/polygon_ops.h"
@@ -57,14 +59,29 @@ inline float horizontal_free_distance_m(float r_m, float h_m, float bounding_rad
 // F(α, h, r) = m_safe (the inverted occupancy model, §5.4.1). Near the seam α = 0 the model
 // is also read at α + 2π (and just below 2π at α − 2π), where the α-wrapped samples were
 // fitted too (§4.9.1), and the smaller distance is kept: both describe the same direction.
+// A free-range function that can also fill a whole slice at once
+// (`ranges_at_height(h, step, count, out)`, e.g. AlnFreeRange) is asked that way.
 template <typename FreeRange>
 void extract_slice(const FreeRange& free_range, float h_m, const ExtractionParams& p,
                    StarPolygon& out) {
   out.set_vertex_count(p.vertex_count);
   const float two_pi = core::kTwoPi<float>;
+  std::array<float, kMaxPolygonVertices> ranges;  // filled below before use
+  constexpr bool kBatch = requires(const FreeRange& f, float* r) {
+    f.ranges_at_height(0.0F, 0.0F, std::size_t{0}, r);
+  };
+  if constexpr (kBatch) {
+    free_range.ranges_at_height(h_m, out.angle_step_rad(), out.vertex_count(), ranges.data());
+  }
   for (std::size_t k = 0; k < out.vertex_count(); ++k) {
     const float alpha = out.angle_rad(k);
-    float rho = horizontal_free_distance_m(free_range(alpha, h_m), h_m, p.bounding_radius_m);
+    float r = 0.0F;
+    if constexpr (kBatch) {
+      r = ranges[k];
+    } else {
+      r = free_range(alpha, h_m);
+    }
+    float rho = horizontal_free_distance_m(r, h_m, p.bounding_radius_m);
     if (alpha < p.seam_margin_rad) {
       rho = std::min(rho, horizontal_free_distance_m(free_range(alpha + two_pi, h_m), h_m,
                                                      p.bounding_radius_m));
@@ -99,15 +116,18 @@ struct LocalMap {
 // §5.4.2: slices at height_count heights from the floor to the robot's top, intersected,
 // then shrunk exactly by the robot radius. The slope bounds on h in the model (Eq 4.25)
 // are what make a finite set of heights sufficient.
+// `guard_points` (robot frame, e.g. from the feature guard, feature_guard.h) are obstacles
+// the model may not hold: the polygon is pulled in front of them before the shrink.
 template <typename FreeRange>
 void extract_local_map(const FreeRange& free_range, const ExtractionParams& p, LocalMap& out,
-                       StarPolygon& scratch) {
+                       StarPolygon& scratch, std::span<const core::Point2> guard_points = {}) {
   const std::size_t n = std::clamp<std::size_t>(p.height_count, 1, kMaxHeights);
   extract_slice(free_range, slice_height_m(p, 0), p, out.free);
   for (std::size_t i = 1; i < n; ++i) {
     extract_slice(free_range, slice_height_m(p, i), p, scratch);
     (void)intersect_into(out.free, scratch);
   }
+  exclude_points(guard_points, out.free);
   out.can_move = shrink_by_radius(out.free, p.robot_radius_m + p.clearance_margin_m, out.navigable);
 }
 

@@ -1,6 +1,9 @@
 // Intersection and exact robot-radius shrink of star-shaped navigation polygons (§5.4.2).
 #pragma once
 
+#include <span>
+
+#include "algo/core/geometry.h"
 #include "algo/mapping/star_polygon.h"
 
 namespace boticelli::mapping {
@@ -28,5 +31,11 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
 // Smallest distance [m] from the segment [0, p] (robot frame) to the polygon's boundary;
 // the brute-force reference the tests and the planner's checks use (O(n)).
 [[nodiscard]] float sweep_clearance_m(const StarPolygon& region, core::Point2 p);
+
+// Pulls the polygon in front of each point (robot frame): both vertices of the sector
+// holding it are cut to just below the point's distance, so the sector's triangle (inside
+// the disc of the larger of the two) no longer contains it; a point within rounding of a
+// vertex ray cuts both sectors beside that ray. Points at the centre close the polygon.
+void exclude_points(std::span<const core::Point2> points, StarPolygon& free);
 
 }  // namespace boticelli::mapping
