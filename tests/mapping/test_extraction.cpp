@@ -1,4 +1,5 @@
 // Tests of the map extraction from an occupancy ALN, the map points and the global lists.
+#include <array>
 #include <cmath>
 #include <cstddef>
 
@@ -224,4 +225,82 @@ TEST(MapPoints, ExtractionAndMergingDoNotAllocate) {
   });
   CHECK_TRUE(map.can_move);
   CHECK_TRUE(obstacles.size() > 0);
+}
+
+TEST_GROUP(BlockInverse){};
+
+namespace {
+// A jagged 9-piece occupancy model: MAX and MIN of planes in (α, h, r), monotone in r.
+void jagged_room(Occupancy& model) {
+  Occupancy::PieceType pieces[9];
+  for (std::size_t j = 0; j < 9; ++j) {
+    const auto fj = static_cast<float>(j);
+    pieces[j].set(
+        Eigen::Vector3f(0.3F * std::sin(1.7F * fj), 2.0F * std::cos(fj), 0.8F + 0.2F * fj),
+        Eigen::Vector3f(0.7F * fj, 0.1F * fj - 0.4F, 1.5F + 0.1F * fj), 0.6F);
+  }
+  using Node = Occupancy::Node;
+  using boticelli::aln::NodeKind;
+  // MAX(MIN(p0, p1, p2), MIN(p3, MAX(p4, p5)), MAX(p6, MIN(p7, p8)))
+  const Node nodes[17] = {
+      {NodeKind::kMax, 1, 2},   {NodeKind::kMin, 3, 4},   {NodeKind::kMax, 5, 6},
+      {NodeKind::kPiece, 0, 0}, {NodeKind::kMin, 7, 8},   {NodeKind::kMin, 9, 10},
+      {NodeKind::kMax, 11, 12}, {NodeKind::kPiece, 1, 0}, {NodeKind::kPiece, 2, 0},
+      {NodeKind::kPiece, 3, 0}, {NodeKind::kMax, 13, 14}, {NodeKind::kPiece, 6, 0},
+      {NodeKind::kMin, 15, 16}, {NodeKind::kPiece, 4, 0}, {NodeKind::kPiece, 5, 0},
+      {NodeKind::kPiece, 7, 0}, {NodeKind::kPiece, 8, 0}};
+  CHECK_TRUE(model.assign(nodes, pieces));
+}
+}  // namespace
+
+TEST(BlockInverse, AWholeSliceAtOnceEqualsOneAngleAtATime) {
+  static Occupancy model;
+  jagged_room(model);
+  static mapping::AlnFreeRange<float, 16> free_range;
+  CHECK_TRUE(free_range.set_model(model, 0.6F));
+  mapping::StarPolygon polygon(360);
+  std::array<float, 400> block{};
+  for (const float h : {-0.5F, -0.1F, 0.0F, 0.3F}) {
+    for (const float offset : {0.0F, 6.2831853F, -6.2831853F}) {
+      free_range.ranges_at_height(h, polygon.angle_step_rad(), 7, 353, offset, block.data());
+      for (std::size_t i = 0; i < 353; ++i) {
+        const float alpha = polygon.angle_rad(7 + i) + offset;
+        const float one = free_range(alpha, h);
+        DOUBLES_EQUAL(one, block[i], 1e-5 * (1.0 + std::fabs(static_cast<double>(one))));
+      }
+    }
+  }
+}
+
+TEST(BlockInverse, TheExtractionGivesTheSameSlicesEitherWayIncludingTheSeam) {
+  static Occupancy model;
+  jagged_room(model);
+  static mapping::AlnFreeRange<float, 16> free_range;
+  CHECK_TRUE(free_range.set_model(model, 0.6F));
+  // The same function without the block interface: the one-angle path of extract_slice.
+  auto one_at_a_time = [](float alpha, float h) { return free_range(alpha, h); };
+  mapping::ExtractionParams p = params();
+  p.seam_margin_rad = 0.3F;
+  mapping::StarPolygon a;
+  mapping::StarPolygon b;
+  for (const float h : {-0.3F, 0.0F, 0.1F}) {
+    mapping::extract_slice(free_range, h, p, a);
+    mapping::extract_slice(one_at_a_time, h, p, b);
+    for (std::size_t k = 0; k < a.vertex_count(); ++k) {
+      DOUBLES_EQUAL(b.rho_m(k), a.rho_m(k), 1e-5);
+    }
+  }
+}
+
+TEST(BlockInverse, WithoutAValidModelNothingIsFree) {
+  static Occupancy model;
+  Occupancy::PieceType piece;
+  piece.set(Eigen::Vector3f(0.0F, 0.0F, -1.0F), Eigen::Vector3f::Zero(), 0.5F);
+  model.reset(piece);
+  static mapping::AlnFreeRange<float, 16> free_range;
+  CHECK_FALSE(free_range.set_model(model, 0.6F));
+  std::array<float, 20> out{};
+  out.fill(7.0F);
+  free_range.ranges_at_height(0.0F, 0.1F, 0, 20, 0.0F, out.data());
+  for (const float r : out) DOUBLES_EQUAL(0.0, r, 0.0);
 }

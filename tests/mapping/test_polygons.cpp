@@ -1,6 +1,7 @@
 // Tests of the star polygon, its intersection and its exact shrink against brute force.
 #include <cmath>
 #include <cstddef>
+#include <span>
 
 #include "algo/mapping/polygon_ops.h"
 #include "algo/mapping/star_polygon.h"
@@ -175,4 +176,102 @@ TEST(Shrink, ADiscAlreadyTouchingAnObstacleLeavesNowhereToGo) {
   StarPolygon nav;
   CHECK_FALSE(boticelli::mapping::shrink_by_radius(free, 0.2F, nav));
   DOUBLES_EQUAL(0.0, nav.max_rho_m(), 0.0);
+}
+
+TEST(Shrink, StaysSafeAndTightWhenJaggedWallsComeCloseToTheRobot) {
+  // Walls 0.3-1 m away and a 0.25 m robot: every disc and side reaches across dozens of
+  // rays, most corners are reflex, and the shrink's candidate pruning is tested hardest.
+  Random rng(77);
+  constexpr float kRadius = 0.25F;
+  int checked = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    StarPolygon free;
+    boticelli::test::random_star_polygon(rng, free);
+    for (std::size_t k = 0; k < free.vertex_count(); ++k) {
+      free.set_rho_m(k, 0.3F + (free.rho_m(k) - 0.6F) * 0.3F);
+    }
+    StarPolygon nav;
+    if (!boticelli::mapping::shrink_by_radius(free, kRadius, nav)) {
+      continue;
+    }
+    ++checked;
+    float worst = 1e9F;
+    std::size_t tight = 0;
+    for (std::size_t k = 0; k < nav.vertex_count(); ++k) {
+      const Point2 v = nav.vertex(k);
+      const Point2 w = nav.vertex((k + 1) % nav.vertex_count());
+      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(free, v));
+      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(
+                                   free, {0.5F * (v.x_m + w.x_m), 0.5F * (v.y_m + w.y_m)}));
+      const float a = nav.angle_rad(k);
+      const float beyond = nav.rho_m(k) + 0.005F;
+      if (boticelli::mapping::sweep_clearance_m(
+              free, {beyond * std::cos(a), beyond * std::sin(a)}) < kRadius) {
+        ++tight;
+      }
+    }
+    for (int i = 0; i < 300; ++i) {
+      worst = std::fmin(worst,
+                        boticelli::mapping::sweep_clearance_m(free, random_point_inside(rng, nav)));
+    }
+    CHECK_TRUE(worst >= kRadius - 1e-5F);
+    CHECK_TRUE(tight >= nav.vertex_count() * 90 / 100);
+  }
+  CHECK_TRUE(checked >= 6);
+}
+
+TEST(Shrink, ARegularPolygonShrinksWithoutPullingInAnyVertex) {
+  // Every corner of a circle's 360-gon turns left: no disc is met first and every chord
+  // lies on an edge's inner side, so each vertex sits at the exact contact.
+  StarPolygon circle(360);
+  circle.fill(1.0F);
+  StarPolygon out;
+  CHECK_TRUE(boticelli::mapping::shrink_by_radius(circle, 0.3F, out));
+  const double inner_side = 1.0 * std::cos(0.5 * 3.14159265358979 / 180.0) - 0.3;
+  for (std::size_t k = 0; k < 360; ++k) {
+    DOUBLES_EQUAL(inner_side / std::cos(0.5 * 3.14159265358979 / 180.0), out.rho_m(k), 1e-6);
+  }
+}
+
+TEST_GROUP(ExcludePoints){};
+
+TEST(ExcludePoints, APointIsLeftOutsideAndOnlyItsSectorMoves) {
+  StarPolygon free(360);
+  free.fill(2.0F);
+  const Point2 q{1.2F * std::cos(0.3F), 1.2F * std::sin(0.3F)};  // between rays 17 and 18
+  CHECK_TRUE(free.contains(q));
+  boticelli::mapping::exclude_points(std::span<const Point2>(&q, 1), free);
+  CHECK_FALSE(free.contains(q));
+  const float d = std::hypot(q.x_m, q.y_m);
+  CHECK_TRUE(free.rho_m(17) < d && free.rho_m(18) < d);
+  DOUBLES_EQUAL(1.2, free.rho_m(17), 1e-5);
+  DOUBLES_EQUAL(2.0, free.rho_m(16), 0.0);
+  DOUBLES_EQUAL(2.0, free.rho_m(19), 0.0);
+}
+
+TEST(ExcludePoints, APointOnAVertexRayCutsBothSectorsBesideIt) {
+  StarPolygon free(360);
+  free.fill(2.0F);
+  const float a = free.angle_rad(90);
+  const Point2 q{1.0F * std::cos(a), 1.0F * std::sin(a)};
+  boticelli::mapping::exclude_points(std::span<const Point2>(&q, 1), free);
+  CHECK_FALSE(free.contains(q));
+  // Whether rounding puts it just before or just after ray 90, no triangle holds it.
+  for (const float da : {-1e-4F, 0.0F, 1e-4F}) {
+    CHECK_FALSE(free.contains({1.0F * std::cos(a + da), 1.0F * std::sin(a + da)}));
+  }
+  const float d = std::hypot(q.x_m, q.y_m);
+  CHECK_TRUE(free.rho_m(89) < d && free.rho_m(90) < d && free.rho_m(91) < d);
+}
+
+TEST(ExcludePoints, PointsAcrossTheSeamAndAtTheCentreAreHandled) {
+  StarPolygon free(360);
+  free.fill(2.0F);
+  const Point2 pts[2] = {{1.5F, -1e-3F}, {0.0F, 0.0F}};
+  boticelli::mapping::exclude_points(std::span<const Point2>(&pts[0], 1), free);
+  CHECK_FALSE(free.contains(pts[0]));
+  const float d = std::hypot(pts[0].x_m, pts[0].y_m);
+  CHECK_TRUE(free.rho_m(359) < d && free.rho_m(0) < d);
+  boticelli::mapping::exclude_points(std::span<const Point2>(&pts[1], 1), free);
+  DOUBLES_EQUAL(0.0, free.max_rho_m(), 0.0);  // an obstacle at the centre closes it
 }

@@ -296,15 +296,6 @@ int run() {
       do_not_optimize(g_scratch.rho_m(0));
     }
     const double shrink_ms = ms_since(t0) / reps;
-    if (std::getenv("DUMP") != nullptr) {
-      char fn[128];
-      std::snprintf(fn, sizeof fn, "/tmp/poly_%s.txt", spec->name);
-      FILE* f = std::fopen(fn, "w");
-      for (std::size_t k = 0; k < g_map.free.vertex_count(); ++k)
-        std::fprintf(f, "%.9g %.9g\n", static_cast<double>(g_map.free.rho_m(k)),
-                     static_cast<double>(g_map.navigable.rho_m(k)));
-      std::fclose(f);
-    }
     const std::size_t bytes = g_best.piece_count() * sizeof(Model::PieceType) +
                               g_best.node_count() * sizeof(Model::Node) +
                               g_guard.size() * sizeof(core::Point2);

@@ -57,9 +57,9 @@ class Vertices {
     return static_cast<std::size_t>(j);
   }
   std::ptrdiff_t n_;
-  std::array<Vec2d, kMaxPolygonVertices> unit_{};
-  std::array<Vec2d, kMaxPolygonVertices> v_{};
-  std::array<double, kMaxPolygonVertices> centre_distance_{};
+  std::array<Vec2d, kMaxPolygonVertices> unit_;  // the first n_ set by the constructor
+  std::array<Vec2d, kMaxPolygonVertices> v_;
+  std::array<double, kMaxPolygonVertices> centre_distance_;
 };
 
 double min_edge_distance_to_centre(const Vertices& v, std::size_t n) {
@@ -189,9 +189,13 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     sin_gap[static_cast<std::size_t>(g)] = std::sin(static_cast<double>(g) * step);
     cos_gap[static_cast<std::size_t>(g)] = std::cos(static_cast<double>(g) * step);
   }
-  const auto wrap = [nn](std::ptrdiff_t k) {
-    while (k < 0) k += nn;
-    while (k >= nn) k -= nn;
+  // Indices here stay within n of [0, n): one correction wraps them.
+  const auto wrap = [nn](std::ptrdiff_t k) __attribute__((always_inline)) {
+    if (k < 0) {
+      k += nn;
+    } else if (k >= nn) {
+      k -= nn;
+    }
     return static_cast<std::size_t>(k);
   };
 
@@ -203,7 +207,12 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   //    side of every edge's line (the polygon is star-shaped about it), more than R away.
   //    So each ray's contact is the nearest of the vertex discs and inner sides it meets,
   //    and each disc or side is visited only for the rays that can meet it.
-  std::array<double, kMaxPolygonVertices> t{};
+  std::array<double, kMaxPolygonVertices> t;  // the first n set below
+  // Per edge: the rays between which its inner side lies (unwrapped indices).
+  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_first;
+  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_last;
+  // Per vertex: true if the boundary turns right there (a reflex corner of the free region).
+  std::array<std::uint8_t, kMaxPolygonVertices> reflex;
   for (std::size_t k = 0; k < n; ++k) {
     t[k] = static_cast<double>(free_region.rho_m(k));
   }
@@ -224,36 +233,66 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     const double offset = detail::dot(outward, a) - radius;  // > 0: the line's distance − R
     const Vec2d p0 = a - radius * outward;
     // Returns false once the ray no longer faces the line; else its contact t and the
-    // contact's place s along the side (0 at its start, 1 at its end).
-    const auto meet = [&](std::size_t k, double& tk, double& s) {
+    // contact's place s along the side (0 at its start, 1 at its end), and the place s'
+    // where it meets the side at distance R' = R − kChordTolerance_m from the edge (the
+    // one step 2 checks chords against).
+    const double inv_len2 = 1.0 / len2;
+    const double p0_along = detail::dot(p0, e);
+    const auto meet = [&](std::size_t k, double& tk, double& s, double& s_tol) {
       const Vec2d u = verts.unit_at(k);
       const double facing = detail::dot(outward, u);
       if (!(facing > 0.0)) return false;
-      tk = offset / facing;
-      s = detail::dot(tk * u - p0, e) / len2;
+      const double inv_facing = 1.0 / facing;  // the one division per ray
+      const double ue = detail::dot(u, e);
+      tk = offset * inv_facing;
+      s = (tk * ue - p0_along) * inv_len2;
+      s_tol = s + kChordTolerance_m * ue * inv_facing * inv_len2;
       return true;
     };
-    for (std::ptrdiff_t g = 0; g < nn; ++g) {  // rays j, j − 1, ...: s falls
+    // Each walk ends at the first ray beyond both sides (or no longer facing their line),
+    // so both lie within the sectors between the two rays where the walks end.
+    std::ptrdiff_t g = 0;
+    for (; g < nn; ++g) {  // rays j, j − 1, ...: s falls
       const std::size_t k = wrap(jj - g);
       double tk = 0.0;
       double s = 0.0;
-      if (!meet(k, tk, s) || s < 0.0) break;
-      if (s <= 1.0) t[k] = std::min(t[k], tk);
+      double s_tol = 0.0;
+      if (!meet(k, tk, s, s_tol) || (s < 0.0 && s_tol < 0.0)) break;
+      if (s >= 0.0 && s <= 1.0) t[k] = std::min(t[k], tk);
     }
-    for (std::ptrdiff_t g = 0; g < nn; ++g) {  // rays j + 1, j + 2, ...: s rises
+    side_first[j] = jj - g;
+    for (g = 0; g < nn; ++g) {  // rays j + 1, j + 2, ...: s rises
       const std::size_t k = wrap(jj + 1 + g);
       double tk = 0.0;
       double s = 0.0;
-      if (!meet(k, tk, s) || s > 1.0) break;
-      if (s >= 0.0) t[k] = std::min(t[k], tk);
+      double s_tol = 0.0;
+      if (!meet(k, tk, s, s_tol) || (s > 1.0 && s_tol > 1.0)) break;
+      if (s >= 0.0 && s <= 1.0) t[k] = std::min(t[k], tk);
     }
+    side_last[j] = jj + 1 + g;
   }
   //    (b) The disc of radius R about vertex i, at distance ρ_i from the centre: the ray
   //        g steps away meets it iff ρ_i sin(g·step) < R, at ρ_i cos(g·step) −
   //        √(R² − ρ_i² sin²(g·step)) (g·step < 90°, and ρ_i > R).
+  //        Only the discs of reflex vertices can be met first. At a vertex where the
+  //        boundary turns left or goes straight, the free region's corner is convex and
+  //        holds the direction to the centre (the polygon is star-shaped). A point
+  //        p = v_i + R·w of the disc outside both neighbouring stadiums has w·e_i ≤ 0 and
+  //        w·e_i−1 ≥ 0: w lies in the corner's polar cone, so w·v_i ≥ 0. But a ray from the
+  //        centre enters the disc on its near half (w·v_i < 0), and any other point of the
+  //        disc is inside a neighbouring stadium, which the ray entered earlier through
+  //        another disc or side. A turn within 1e-6 rad of straight counts as reflex (the
+  //        disc then lowers a contact by at most R·1e-12 if at all, and costs only time).
   for (std::size_t i = 0; i < n; ++i) {
-    const double rho = static_cast<double>(free_region.rho_m(i));
     const auto ii = static_cast<std::ptrdiff_t>(i);
+    const Vec2d e_in = verts.edge_end(ii - 1) - verts.edge_start(ii - 1);
+    const Vec2d e_out = verts.edge_end(ii) - verts.edge_start(ii);
+    reflex[i] = detail::cross(e_in, e_out) <
+                        -1e-6 * std::sqrt(detail::dot(e_in, e_in) * detail::dot(e_out, e_out))
+                    ? 1
+                    : 0;
+    if (reflex[i] == 0) continue;
+    const double rho = static_cast<double>(free_region.rho_m(i));
     for (std::ptrdiff_t g = 0; g < quarter; ++g) {
       const double s = rho * sin_gap[static_cast<std::size_t>(g)];
       if (!(s < radius)) break;
@@ -278,10 +317,17 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   //    edge_out_of_reach); an edge whose two ends lie R or more beyond the chord's line is
   //    clear of it at once (every point of its stadium lies on the far side). The sectors
   //    that fail are pulled in below.
-  std::array<Vec2d, kMaxPolygonVertices> chord_normal{};
-  std::array<double, kMaxPolygonVertices> chord_offset{};
-  std::array<double, kMaxPolygonVertices> chord_reach{};
-  std::array<std::uint8_t, kMaxPolygonVertices> fails{};
+  std::array<Vec2d, kMaxPolygonVertices> chord_normal;  // the first n set below
+  std::array<double, kMaxPolygonVertices> chord_offset;
+  std::array<double, kMaxPolygonVertices> chord_reach;
+  // The edges each chord comes too close to. Every edge that can come within R of any
+  // chord inside the sector's triangle comes within R of its first chord: its stadium
+  // cannot lie inside the triangle (the only edge in the wedge lies beyond both vertices)
+  // and cannot cross the triangle's clear sides, so it crosses that chord. So these lists
+  // are all the pull-ins below need; a sector with more than fit is searched again.
+  constexpr std::size_t kMaxFailing = 6;
+  std::array<std::array<std::int16_t, kMaxFailing>, kMaxPolygonVertices> failing;
+  std::array<std::uint8_t, kMaxPolygonVertices> fails{};  // count, kMaxFailing + 1: too many
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t k1 = k + 1 == n ? 0 : k + 1;
     const Vec2d a = static_cast<double>(out.rho_m(k)) * verts.unit_at(k);
@@ -298,57 +344,75 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   // A chord on the R-neighbourhood touches it within rounding (on a circle every chord lies
   // on an edge's inner side): contacts up to kChordTolerance_m deep count as touching.
   const double chord_radius = radius - kChordTolerance_m;
-  for (std::size_t j = 0; j < n; ++j) {
-    const auto jj = static_cast<std::ptrdiff_t>(j);
+  // Edge j against the chord of sector kk: recorded if closer than R (less the tolerance).
+  // An edge whose two ends lie R or more beyond the chord's line is clear of it at once
+  // (every point of its stadium lies on the far side).
+  const auto record = [&](std::size_t k, std::ptrdiff_t jj) __attribute__((always_inline)) {
+    const auto j = static_cast<std::int16_t>(wrap(jj));
+    for (std::size_t i = 0; i < std::min<std::size_t>(fails[k], kMaxFailing); ++i) {
+      if (failing[k][i] == j) return;  // found twice
+    }
+    if (fails[k] < kMaxFailing) failing[k][fails[k]] = j;
+    ++fails[k];
+  };
+  const auto try_sector = [&](std::ptrdiff_t kk, std::ptrdiff_t jj) __attribute__((always_inline)) {
+    const std::size_t k = wrap(kk);
+    if (fails[k] > kMaxFailing) return;
     const Vec2d e0 = verts.edge_start(jj);
     const Vec2d e1 = verts.edge_end(jj);
-    const double dj = verts.centre_distance(jj);
-    // Sector kk, `gap` whole sectors away from the edge's own (0 for it and its two
-    // neighbours): every point q of the edge has |q| ≥ d_j and an angle ≥ gap·step from
-    // the sector's wedge, and every point of the chord lies in the wedge within m_k =
-    // max(ρ_k, ρ_k+1) of the centre. The distance from such a q to that part of the wedge
-    // grows with |q| and with the angle, so it is at least its value at (d_j, gap·step):
-    // d_j sin(gap·step) if the foot of the perpendicular falls within m_k, else the
-    // distance to the wedge's corner at m_k. Only edges that bound lets through, and that
-    // do not lie R beyond the chord's line, are measured exactly.
-    const auto try_sector = [&](std::ptrdiff_t kk, std::ptrdiff_t gap) {
+    const Vec2d cn = chord_normal[k];
+    if (detail::dot(cn, e0) - chord_offset[k] >= chord_radius &&
+        detail::dot(cn, e1) - chord_offset[k] >= chord_radius) {
+      return;
+    }
+    const std::size_t k1 = k + 1 == n ? 0 : k + 1;
+    const Vec2d a = static_cast<double>(out.rho_m(k)) * verts.unit_at(k);
+    const Vec2d b = static_cast<double>(out.rho_m(k1)) * verts.unit_at(k1);
+    if (detail::segments_closer_than(a, b, e0, e1, chord_radius)) record(k, jj);
+  };
+  //    Which edges to try against which chords. If a point x of the triangle lies within
+  //    R' (R less the tolerance) of the boundary, then along the ray from the centre to x
+  //    the first contact with the R'-neighbourhood lies in the triangle too (the triangle
+  //    is star-shaped about the centre), below the chord, on an inner side or a reflex
+  //    vertex's disc (step 1 (b): no other disc is ever met first). So the chord comes
+  //    within R' of that side's edge, or of that vertex's edges (which end at its centre).
+  //    The candidates are thus: each edge against the sectors its inner side lies in
+  //    (from step 1 (a), one sector wider each way for the R' side lying 1 µm farther
+  //    out), and the two edges at each reflex vertex against every sector its disc
+  //    reaches (ρ_i sin(gap·step) < R, gap whole sectors away).
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto jj = static_cast<std::ptrdiff_t>(j);
+    const std::ptrdiff_t first = side_first[j];
+    const std::ptrdiff_t last = side_last[j] - 1;
+    for (std::ptrdiff_t kk = first; kk <= last && kk - first < nn; ++kk) try_sector(kk, jj);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (reflex[i] == 0) continue;
+    const auto ii = static_cast<std::ptrdiff_t>(i);
+    const double rho = static_cast<double>(free_region.rho_m(i));
+    std::ptrdiff_t reach = 0;
+    while (reach + 1 < quarter && rho * sin_gap[static_cast<std::size_t>(reach + 1)] < beyond) {
+      ++reach;
+    }
+    // The disc against the chords it reaches; a chord that comes within R' of the vertex
+    // comes within R' of both its edges.
+    const Vec2d vi = verts.edge_start(ii);
+    for (std::ptrdiff_t kk = ii - 1 - reach; kk <= ii + reach && kk - (ii - 1 - reach) < nn; ++kk) {
       const std::size_t k = wrap(kk);
-      if (fails[k] != 0) return;
-      const double mk = chord_reach[k];
-      const double cg = cos_gap[static_cast<std::size_t>(gap)];
-      const double sg = sin_gap[static_cast<std::size_t>(gap)];
-      const double bound2 =
-          dj * cg <= mk ? (dj * sg) * (dj * sg) : dj * dj + mk * mk - 2.0 * dj * mk * cg;
-      if (bound2 >= beyond * beyond) return;
-      const Vec2d cn = chord_normal[k];
-      if (detail::dot(cn, e0) - chord_offset[k] >= chord_radius &&
-          detail::dot(cn, e1) - chord_offset[k] >= chord_radius) {
-        return;
-      }
+      if (fails[k] > kMaxFailing) continue;
+      if (detail::dot(chord_normal[k], vi) - chord_offset[k] >= chord_radius) continue;
       const std::size_t k1 = k + 1 == n ? 0 : k + 1;
       const Vec2d a = static_cast<double>(out.rho_m(k)) * verts.unit_at(k);
       const Vec2d b = static_cast<double>(out.rho_m(k1)) * verts.unit_at(k1);
-      if (detail::segments_closer_than(a, b, e0, e1, chord_radius)) fails[k] = 1;
-    };
-    try_sector(jj, 0);
-    try_sector(jj + 1, 0);
-    try_sector(jj - 1, 0);
-    for (std::ptrdiff_t gap = 1; gap < quarter && gap < nn; ++gap) {
-      // The bound falls as m_k grows: with the largest m_k it holds for every sector, and
-      // it grows with the gap, so no farther sector can be reached either.
-      const double cg = cos_gap[static_cast<std::size_t>(gap)];
-      const double sg = sin_gap[static_cast<std::size_t>(gap)];
-      const double bound2 = dj * cg <= reach_max
-                                ? (dj * sg) * (dj * sg)
-                                : dj * dj + reach_max * reach_max - 2.0 * dj * reach_max * cg;
-      if (!(bound2 < beyond * beyond)) break;
-      try_sector(jj + 1 + gap, gap);
-      try_sector(jj - 1 - gap, gap);
+      if (detail::point_segment_distance2(vi, a, b) < chord_radius * chord_radius) {
+        record(k, ii - 1);
+        record(k, ii);
+      }
     }
   }
 
   //    Pulling a vertex in only shrinks the neighbouring triangles, which stay clear.
-  std::array<std::int16_t, kMaxPolygonVertices + 8> near{};
+  std::array<std::int16_t, kMaxPolygonVertices + 8> near;  // the first near_count used
   for (std::size_t k = 0; k < n; ++k) {
     if (fails[k] == 0) continue;
     const std::size_t k1 = (k + 1) % n;
@@ -357,42 +421,65 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     const Vec2d uk1 = verts.unit_at(k1);
     double rk = static_cast<double>(out.rho_m(k));
     double rk1 = static_cast<double>(out.rho_m(k1));
-    // Every chord tried below lies in the triangle (0, v_k, v_k+1), within m_k of the
-    // centre: only the edges the bound of try_sector lets through can fail it.
-    const double mk = std::max(rk, rk1);
     std::size_t near_count = 0;
-    const auto consider = [&](std::ptrdiff_t j, std::ptrdiff_t gap) {
-      const double dj = verts.centre_distance(j);
-      const double cg = cos_gap[static_cast<std::size_t>(gap)];
-      const double sg = sin_gap[static_cast<std::size_t>(gap)];
-      const double bound2 =
-          dj * cg <= mk ? (dj * sg) * (dj * sg) : dj * dj + mk * mk - 2.0 * dj * mk * cg;
-      if (bound2 < beyond * beyond) near[near_count++] = static_cast<std::int16_t>(j);
-    };
-    consider(kk, 0);
-    consider(kk + 1, 0);
-    consider(kk - 1, 0);
-    for (std::ptrdiff_t gap = 1; gap <= w && gap < quarter && 2 * gap + 1 < nn; ++gap) {
-      consider(kk + 1 + gap, gap);
-      consider(kk - 1 - gap, gap);
-    }
-    // The edges the chord comes too close to (none: a neighbour's pull already cleared it).
-    std::array<std::int16_t, kMaxPolygonVertices + 8> failing{};
-    std::size_t failing_count = 0;
-    for (std::size_t i = 0; i < near_count; ++i) {
-      const std::ptrdiff_t j = near[i];
-      if (!triangle_clear(verts, rk * uk, rk1 * uk1, &near[i], 1, chord_radius)) {
-        failing[failing_count++] = static_cast<std::int16_t>(j);
+    if (fails[k] <= kMaxFailing) {
+      for (std::size_t i = 0; i < fails[k]; ++i) near[near_count++] = failing[k][i];
+    } else {
+      // Too many to list: every edge the bound lets through for this triangle (all its
+      // chords lie in the wedge within m_k of the centre).
+      const double mk = std::max(rk, rk1);
+      const auto consider = [&](std::ptrdiff_t j, std::ptrdiff_t gap) {
+        const double dj = verts.centre_distance(j);
+        const double cg = cos_gap[static_cast<std::size_t>(gap)];
+        const double sg = sin_gap[static_cast<std::size_t>(gap)];
+        const double bound2 =
+            dj * cg <= mk ? (dj * sg) * (dj * sg) : dj * dj + mk * mk - 2.0 * dj * mk * cg;
+        if (bound2 < beyond * beyond) near[near_count++] = static_cast<std::int16_t>(j);
+      };
+      consider(kk, 0);
+      consider(kk + 1, 0);
+      consider(kk - 1, 0);
+      for (std::ptrdiff_t gap = 1; gap <= w && gap < quarter && 2 * gap + 1 < nn; ++gap) {
+        consider(kk + 1 + gap, gap);
+        consider(kk - 1 - gap, gap);
       }
     }
-    if (failing_count == 0) {
+    // The edges the present chord comes too close to (none if a neighbour's pull-in
+    // already cleared it).
+    std::array<std::int16_t, kMaxPolygonVertices + 8> close;  // the first close_count used
+    std::size_t close_count = 0;
+    for (std::size_t i = 0; i < near_count; ++i) {
+      if (!triangle_clear(verts, rk * uk, rk1 * uk1, &near[i], 1, chord_radius)) {
+        close[close_count++] = near[i];
+      }
+    }
+    if (close_count == 0) {
       continue;
+    }
+    // The close edges' ends (vertex indices) that the chord itself comes within R' of:
+    // the discs whose round corners it cuts.
+    std::array<std::int16_t, 2 * (kMaxPolygonVertices + 8)> corners;
+    std::size_t corner_count = 0;
+    {
+      const Vec2d a = rk * uk;
+      const Vec2d b = rk1 * uk1;
+      for (std::size_t i = 0; i < close_count; ++i) {
+        for (const std::ptrdiff_t v : {std::ptrdiff_t{close[i]}, std::ptrdiff_t{close[i]} + 1}) {
+          const auto vi = static_cast<std::int16_t>(wrap(v));
+          bool seen = false;
+          for (std::size_t q = 0; q < corner_count && !seen; ++q) seen = corners[q] == vi;
+          if (!seen && detail::point_segment_distance2(verts.edge_start(vi), a, b) <
+                           chord_radius * chord_radius) {
+            corners[corner_count++] = vi;
+          }
+        }
+      }
     }
     // Largest clear length of one vertex with the other fixed. Length 0 is always clear
     // (d_min > R), and clearance only grows as a vertex moves in. Mostly the chord cuts the
     // round corner the disc makes about a reflex vertex: then the limit is where the chord,
-    // turning about the fixed vertex, becomes tangent to the disc of one of the failing
-    // edges' ends (tangent_limit), and one check confirms it against all near edges.
+    // turning about the fixed vertex, becomes tangent to the disc of one of those corners
+    // (tangent_limit), and one check confirms it against all near edges.
     // Otherwise (a straight side, or several edges at once) a bisection below that limit
     // finds it; it stops once the bracket is below kBisectionTolerance_m or the stored
     // float's resolution (2⁻²⁴ relative). The length kept is always one checked clear, so
@@ -407,9 +494,8 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       const Vec2d fixed = move_k ? other * uk1 : other * uk;
       const Vec2d moving = move_k ? uk : uk1;
       double hi = move_k ? rk : rk1;
-      for (std::size_t i = 0; i < failing_count; ++i) {
-        hi = tangent_limit(fixed, moving, verts.edge_start(failing[i]), radius, hi);
-        hi = tangent_limit(fixed, moving, verts.edge_end(failing[i]), radius, hi);
+      for (std::size_t i = 0; i < corner_count; ++i) {
+        hi = tangent_limit(fixed, moving, verts.edge_start(corners[i]), radius, hi);
       }
       if (clear_at(hi)) {
         return hi;
@@ -458,6 +544,10 @@ void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
   const float step = free.angle_step_rad();
   for (const core::Point2& q : points) {
     const float d = std::hypot(q.x_m, q.y_m);
+    if (!(d > 0.0F)) {
+      free.fill(0.0F);  // an obstacle at the centre: nowhere is free
+      return;
+    }
     float theta = std::atan2(q.y_m, q.x_m);
     if (theta < 0.0F) {
       theta += core::kTwoPi<float>;
@@ -467,13 +557,13 @@ void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
     // cut, which covers both sectors whichever of the two rays it is.
     auto k = static_cast<std::size_t>(theta / step);
     k = std::min(k, n - 1);
-    const float cut = d > 0.0F ? std::nextafter(d, 0.0F) : 0.0F;
+    const float cut = d * (1.0F - 1e-6F);  // a micrometre inside, clear of float rounding
     const float offset = theta - static_cast<float>(k) * step;
     const bool near_ray = offset < 1e-5F || step - offset < 1e-5F;
     const std::size_t first = near_ray ? k + n - 1 : k;
-    const std::size_t last = near_ray ? k + 2 : k + 1;
-    for (std::size_t i = first; i <= last; ++i) {
-      const std::size_t v = i % n;
+    const std::size_t count = near_ray ? 4 : 2;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t v = (first + i) % n;
       free.set_rho_m(v, std::min(free.rho_m(v), cut));
     }
   }

@@ -59,13 +59,15 @@ class AlnFreeRange {
     return static_cast<float>(e.value);
   }
 
-  // r [m] at the `count` pan angles α_k = k·step_rad (the vertex angles of a StarPolygon,
-  // computed the same way) at height h [m], into out[0 .. count). The same function as
-  // operator(), evaluated for kBlock angles at a time: at one height each piece of the
-  // inverse is a line in α (its h and m terms fold into the constant), and the MIN/MAX tree
-  // combines whole blocks, children before parents, with no branches per angle. The values
-  // agree with operator() to float rounding (the terms are summed in another order).
-  void ranges_at_height(float h_m, float step_rad, std::size_t count, float* out) const {
+  // r [m] at height h [m] and the pan angles α_i = (first + i)·step_rad + offset_rad,
+  // i < count, into out[0 .. count): the vertex angles of a StarPolygon computed the same
+  // way (offset ±2π for the seam). The same function as operator(), evaluated for kBlock
+  // angles at a time: at one height each piece of the inverse is a line in α (its h and m
+  // terms fold into the constant), and the MIN/MAX tree combines whole blocks, children
+  // before parents, with no branches per angle. The values agree with operator() to float
+  // rounding (the terms are summed in another order).
+  void ranges_at_height(float h_m, float step_rad, std::size_t first_index, std::size_t count,
+                        float offset_rad, float* out) const {
     if (!valid_) {
       std::fill(out, out + count, 0.0F);
       return;
@@ -80,7 +82,8 @@ class AlnFreeRange {
     for (std::size_t k0 = 0; k0 < count; k0 += kBlock) {
       std::array<Scalar, kBlock> alpha{};
       for (std::size_t i = 0; i < kBlock; ++i) {
-        alpha[i] = static_cast<Scalar>(static_cast<float>(k0 + i) * step_rad);
+        alpha[i] =
+            static_cast<Scalar>(static_cast<float>(first_index + k0 + i) * step_rad + offset_rad);
       }
       std::size_t top = 0;
       for (std::size_t o = 0; o < op_count_; ++o) {

@@ -59,37 +59,54 @@ inline float horizontal_free_distance_m(float r_m, float h_m, float bounding_rad
 // F(α, h, r) = m_safe (the inverted occupancy model, §5.4.1). Near the seam α = 0 the model
 // is also read at α + 2π (and just below 2π at α − 2π), where the α-wrapped samples were
 // fitted too (§4.9.1), and the smaller distance is kept: both describe the same direction.
-// A free-range function that can also fill a whole slice at once
-// (`ranges_at_height(h, step, count, out)`, e.g. AlnFreeRange) is asked that way.
+// A free-range function that can also fill many angles at once
+// (`ranges_at_height(h, step, first, count, offset, out)`, e.g. AlnFreeRange) is asked that
+// way, for the whole slice and for the two seam stretches.
 template <typename FreeRange>
 void extract_slice(const FreeRange& free_range, float h_m, const ExtractionParams& p,
                    StarPolygon& out) {
   out.set_vertex_count(p.vertex_count);
+  const std::size_t n = out.vertex_count();
   const float two_pi = core::kTwoPi<float>;
-  std::array<float, kMaxPolygonVertices> ranges;  // filled below before use
+  const float step = out.angle_step_rad();
+  // Vertices [0, low) lie within the seam margin above α = 0, [high, n) within it below 2π.
+  std::size_t low = 0;
+  while (low < n && out.angle_rad(low) < p.seam_margin_rad) ++low;
+  std::size_t high = n;
+  while (high > low && out.angle_rad(high - 1) > two_pi - p.seam_margin_rad) --high;
   constexpr bool kBatch = requires(const FreeRange& f, float* r) {
-    f.ranges_at_height(0.0F, 0.0F, std::size_t{0}, r);
+    f.ranges_at_height(0.0F, 0.0F, std::size_t{0}, std::size_t{0}, 0.0F, r);
   };
   if constexpr (kBatch) {
-    free_range.ranges_at_height(h_m, out.angle_step_rad(), out.vertex_count(), ranges.data());
-  }
-  for (std::size_t k = 0; k < out.vertex_count(); ++k) {
-    const float alpha = out.angle_rad(k);
-    float r = 0.0F;
-    if constexpr (kBatch) {
-      r = ranges[k];
-    } else {
-      r = free_range(alpha, h_m);
+    std::array<float, kMaxPolygonVertices> r;  // the first n filled below
+    std::array<float, kMaxPolygonVertices> seam;
+    free_range.ranges_at_height(h_m, step, 0, n, 0.0F, r.data());
+    for (std::size_t k = 0; k < n; ++k) {
+      out.set_rho_m(k, horizontal_free_distance_m(r[k], h_m, p.bounding_radius_m));
     }
-    float rho = horizontal_free_distance_m(r, h_m, p.bounding_radius_m);
-    if (alpha < p.seam_margin_rad) {
-      rho = std::min(rho, horizontal_free_distance_m(free_range(alpha + two_pi, h_m), h_m,
-                                                     p.bounding_radius_m));
-    } else if (alpha > two_pi - p.seam_margin_rad) {
-      rho = std::min(rho, horizontal_free_distance_m(free_range(alpha - two_pi, h_m), h_m,
-                                                     p.bounding_radius_m));
+    free_range.ranges_at_height(h_m, step, 0, low, two_pi, seam.data());
+    for (std::size_t k = 0; k < low; ++k) {
+      out.set_rho_m(
+          k, std::min(out.rho_m(k), horizontal_free_distance_m(seam[k], h_m, p.bounding_radius_m)));
     }
-    out.set_rho_m(k, rho);
+    free_range.ranges_at_height(h_m, step, high, n - high, -two_pi, seam.data());
+    for (std::size_t k = high; k < n; ++k) {
+      out.set_rho_m(k, std::min(out.rho_m(k), horizontal_free_distance_m(seam[k - high], h_m,
+                                                                         p.bounding_radius_m)));
+    }
+  } else {
+    for (std::size_t k = 0; k < n; ++k) {
+      const float alpha = out.angle_rad(k);
+      float rho = horizontal_free_distance_m(free_range(alpha, h_m), h_m, p.bounding_radius_m);
+      if (k < low) {
+        rho = std::min(rho, horizontal_free_distance_m(free_range(alpha + two_pi, h_m), h_m,
+                                                       p.bounding_radius_m));
+      } else if (k >= high) {
+        rho = std::min(rho, horizontal_free_distance_m(free_range(alpha - two_pi, h_m), h_m,
+                                                       p.bounding_radius_m));
+      }
+      out.set_rho_m(k, rho);
+    }
   }
 }
 

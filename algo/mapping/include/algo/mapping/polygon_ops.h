@@ -33,8 +33,8 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
 [[nodiscard]] float sweep_clearance_m(const StarPolygon& region, core::Point2 p);
 
 // Pulls the polygon in front of each point (robot frame): both vertices of the sector
-// holding it are cut to just below the point's distance, so the sector's triangle (inside
-// the disc of the larger of the two) no longer contains it; a point within rounding of a
+// holding it are cut to just below the point's distance (by 1 ppm), so the sector's triangle
+// (inside the disc of the larger of the two) no longer contains it; a point within rounding of a
 // vertex ray cuts both sectors beside that ray. Points at the centre close the polygon.
 void exclude_points(std::span<const core::Point2> points, StarPolygon& free);
 

@@ -1,0 +1,168 @@
+// Tests of the feature guard: unexplained features, their corroboration, and the polygon kept
+// clear of them.
+#include <cmath>
+#include <cstddef>
+#include <span>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/reading.h"
+#include "algo/mapping/extraction.h"
+#include "algo/mapping/feature_guard.h"
+#include "algo/mapping/polygon_ops.h"
+
+#include "CppUTest/TestHarness.h"
+#include "alloc_guard.h"
+
+using boticelli::core::FixedVector;
+using boticelli::core::Point2;
+using boticelli::evidence::Reading;
+namespace mapping = boticelli::mapping;
+
+namespace {
+
+// A room whose model sees a wall at 2.5 m in every direction and nothing closer: it calls
+// everything nearer than 2.5 m free (occupancy 0.9 beyond, 0 before).
+float wall_only(float /*alpha*/, float h, float r) {
+  const float rho = std::sqrt(std::fmax(0.0F, r * r - h * h));
+  return rho >= 2.5F ? 0.9F : 0.0F;
+}
+
+// PTU 0.6 m above the floor, robot body 0.05-0.8 m: slices from h = -0.55 to +0.2 m.
+mapping::ExtractionParams robot() {
+  mapping::ExtractionParams p;
+  p.ptu_height_m = 0.6F;
+  p.lowest_height_m = 0.05F;
+  p.robot_height_m = 0.8F;
+  p.robot_radius_m = 0.25F;
+  p.bounding_radius_m = 3.0F;
+  return p;
+}
+
+// A reading of the point at horizontal distance ρ, pan α and height h (PTU frame).
+Reading at(float alpha, float rho, float h, float m = 0.9F) {
+  return {alpha, h, std::sqrt(rho * rho + h * h), m};
+}
+
+// n features on the front face of a small box 1 m ahead: pan ±0.1 rad, heights -0.54..-0.24.
+template <std::size_t N>
+void box_face(FixedVector<Reading, N>& out, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float u = static_cast<float>(i % 7) / 6.0F;
+    const float v = static_cast<float>(i / 7 % 5) / 4.0F;
+    const float alpha = -0.1F + 0.2F * u;
+    (void)out.push_back(
+        at(alpha < 0.0F ? alpha + 6.2831853F : alpha, 1.0F / std::cos(alpha), -0.54F + 0.3F * v));
+  }
+}
+
+}  // namespace
+
+TEST_GROUP(FeatureGuard){};
+
+TEST(FeatureGuard, OnlySurfacesTheModelCallsFreeInTheRobotsHeightBandAreCandidates) {
+  FixedVector<Reading, 8> readings;
+  (void)readings.push_back(at(0.5F, 1.0F, -0.3F));        // in the band, model says free
+  (void)readings.push_back(at(0.5F, 2.6F, -0.3F));        // the model holds it (wall)
+  (void)readings.push_back(at(0.5F, 1.0F, 0.5F));         // above the robot
+  (void)readings.push_back(at(0.5F, 1.0F, -0.58F));       // below the lowest slice
+  (void)readings.push_back(at(0.5F, 1.0F, -0.3F, 0.4F));  // too little evidence
+  (void)readings.push_back(at(2.0F, 1.5F, 0.1F));         // in the band, model says free
+  FixedVector<mapping::GuardPoint, 8> candidates;
+  LONGS_EQUAL(0, mapping::collect_unexplained_features(readings, wall_only, robot(),
+                                                       mapping::FeatureGuardParams{}, candidates));
+  LONGS_EQUAL(2, candidates.size());
+  DOUBLES_EQUAL(std::cos(0.5), candidates[0].x_m, 1e-5);
+  DOUBLES_EQUAL(std::sin(0.5), candidates[0].y_m, 1e-5);
+  DOUBLES_EQUAL(-0.3, candidates[0].h_m, 1e-6);
+  DOUBLES_EQUAL(1.5 * std::cos(2.0), candidates[1].x_m, 1e-5);
+}
+
+TEST(FeatureGuard, AFullCandidateListCountsWhatItCouldNotKeep) {
+  FixedVector<Reading, 8> readings;
+  for (int i = 0; i < 5; ++i)
+    (void)readings.push_back(at(0.1F * static_cast<float>(i), 1.0F, 0.0F));
+  FixedVector<mapping::GuardPoint, 3> candidates;
+  LONGS_EQUAL(2, mapping::collect_unexplained_features(readings, wall_only, robot(),
+                                                       mapping::FeatureGuardParams{}, candidates));
+  LONGS_EQUAL(3, candidates.size());
+}
+
+TEST(FeatureGuard, AClusterIsKeptAndLoneOutliersAreDropped) {
+  FixedVector<mapping::GuardPoint, 32> candidates;
+  for (int i = 0; i < 6; ++i) {  // six features within 4 cm of each other
+    (void)candidates.push_back({1.0F + 0.01F * static_cast<float>(i), 0.2F, -0.3F});
+  }
+  (void)candidates.push_back({-1.0F, 0.5F, -0.2F});  // alone
+  (void)candidates.push_back({0.0F, -1.5F, 0.0F});   // alone
+  (void)candidates.push_back({0.0F, -1.45F, 0.0F});  // one neighbour is not enough
+  FixedVector<Point2, 32> kept;
+  CHECK_TRUE(mapping::corroborated_points(candidates, mapping::FeatureGuardParams{}, kept));
+  LONGS_EQUAL(6, kept.size());
+  for (const Point2& q : kept) {
+    CHECK_TRUE(q.x_m >= 1.0F && q.x_m <= 1.06F);
+  }
+  // A stricter rule drops the cluster too.
+  mapping::FeatureGuardParams strict;
+  strict.min_neighbours = 6;
+  kept.clear();
+  CHECK_TRUE(mapping::corroborated_points(candidates, strict, kept));
+  LONGS_EQUAL(0, kept.size());
+}
+
+TEST(FeatureGuard, TheNavigablePolygonKeepsTheRobotClearOfABoxTheModelMissed) {
+  FixedVector<Reading, 64> readings;
+  box_face(readings, 35);
+  FixedVector<mapping::GuardPoint, 64> candidates;
+  const mapping::ExtractionParams p = robot();
+  (void)mapping::collect_unexplained_features(readings, wall_only, p, mapping::FeatureGuardParams{},
+                                              candidates);
+  LONGS_EQUAL(35, candidates.size());
+  FixedVector<Point2, 64> guard;
+  CHECK_TRUE(mapping::corroborated_points(candidates, mapping::FeatureGuardParams{}, guard));
+  LONGS_EQUAL(35, guard.size());
+  // The model alone: the wall at 2.5 m (r at h from the occupancy above).
+  auto free_range = [](float, float h) { return std::sqrt(2.5F * 2.5F + h * h); };
+  static mapping::LocalMap map;
+  static mapping::StarPolygon scratch;
+  mapping::extract_local_map(free_range, p, map, scratch);
+  CHECK_TRUE(map.free.contains({1.0F, 0.0F}));  // the model drives into the box
+  mapping::extract_local_map(free_range, p, map, scratch, guard);
+  CHECK_TRUE(map.can_move);
+  for (const Point2& q : guard) {
+    CHECK_FALSE(map.free.contains(q));
+  }
+  // Every straight path to a navigable point stays a robot radius from every box feature.
+  for (std::size_t k = 0; k < map.navigable.vertex_count(); ++k) {
+    const Point2 v = map.navigable.vertex(k);
+    for (const Point2& q : guard) {
+      // Distance from q to the segment [0, v].
+      const float len2 = v.x_m * v.x_m + v.y_m * v.y_m;
+      const float s = len2 > 0.0F
+                          ? std::fmin(1.0F, std::fmax(0.0F, (q.x_m * v.x_m + q.y_m * v.y_m) / len2))
+                          : 0.0F;
+      CHECK_TRUE(std::hypot(q.x_m - s * v.x_m, q.y_m - s * v.y_m) >= p.robot_radius_m);
+    }
+  }
+  // Away from the box nothing changed.
+  DOUBLES_EQUAL(2.5, map.free.rho_m(180), 1e-3);
+}
+
+TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
+  static FixedVector<Reading, 64> readings;
+  box_face(readings, 35);
+  static FixedVector<mapping::GuardPoint, 64> candidates;
+  static FixedVector<Point2, 64> guard;
+  static mapping::LocalMap map;
+  static mapping::StarPolygon scratch;
+  const mapping::ExtractionParams p = robot();
+  auto free_range = [](float, float h) { return std::sqrt(2.5F * 2.5F + h * h); };
+  CHECK_NO_ALLOCATION({
+    candidates.clear();
+    guard.clear();
+    (void)mapping::collect_unexplained_features(readings, wall_only, p,
+                                                mapping::FeatureGuardParams{}, candidates);
+    (void)mapping::corroborated_points(candidates, mapping::FeatureGuardParams{}, guard);
+    mapping::extract_local_map(free_range, p, map, scratch, guard);
+  });
+  LONGS_EQUAL(35, guard.size());
+}
