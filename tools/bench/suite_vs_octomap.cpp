@@ -1,5 +1,6 @@
 // Benchmark suite "vs-octomap": navigation polygon from the ALN occupancy model vs from OctoMap.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -220,6 +221,20 @@ double ms_since(std::int64_t t0) {
   return static_cast<double>(cpu_ns() - t0) * 1e-6;
 }
 
+// Median over `reps` runs of fn() [ms]: robust to the odd run a busy host slows down.
+template <typename Fn>
+double median_ms(int reps, Fn fn) {
+  std::array<double, 64> times{};
+  const auto n = static_cast<std::size_t>(std::clamp(reps, 1, 64));
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::int64_t t0 = cpu_ns();
+    fn();
+    times[r] = ms_since(t0);
+  }
+  std::sort(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(n));
+  return times[n / 2];
+}
+
 #if defined(BOTICELLI_HAVE_OCTOMAP)
 // The same slices, threshold and shrink, with the free range found by OctoMap's own ray
 // casting through the octree (unknown cells count as free: their prior 0.5 < m_safe).
@@ -257,7 +272,7 @@ void octomap_polygon(const octomap::OcTree& tree, const SyntheticRoom& room,
 int run() {
   const char* rooms[] = {"cylinder_centre", "cylinder_offcentre_outliers", "rectangle",
                          "corridor",        "cylinder_box_view1",          "rectangle_box_case1"};
-  const int reps = 20;
+  const int reps = 21;
   for (const char* name : rooms) {
     const RoomSpec* spec = find_environment(name);
     if (spec == nullptr) continue;
@@ -282,20 +297,16 @@ int run() {
                                                 mapping::FeatureGuardParams{}, g_candidates);
     (void)mapping::corroborated_points(g_candidates, mapping::FeatureGuardParams{}, g_guard);
     const double build_ms = ms_since(t0);
-    t0 = cpu_ns();
-    for (int r = 0; r < reps; ++r) {
+    const double extract_ms = median_ms(reps, [&] {
       (void)g_free_range.set_model(g_best, p.safe_occupancy);
       mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
       do_not_optimize(g_map.navigable.rho_m(0));
-    }
-    const double extract_ms = ms_since(t0) / reps;
-    t0 = cpu_ns();
-    for (int r = 0; r < reps; ++r) {
+    });
+    const double shrink_ms = median_ms(reps, [&] {
       (void)mapping::shrink_by_radius(g_map.free, p.robot_radius_m + p.clearance_margin_m,
                                       g_scratch);
       do_not_optimize(g_scratch.rho_m(0));
-    }
-    const double shrink_ms = ms_since(t0) / reps;
+    });
     const std::size_t bytes = g_best.piece_count() * sizeof(Model::PieceType) +
                               g_best.node_count() * sizeof(Model::Node) +
                               g_guard.size() * sizeof(core::Point2);
@@ -320,19 +331,14 @@ int run() {
       const double oct_build_ms = ms_since(t0);
       static mapping::LocalMap oct_map;
       static mapping::StarPolygon oct_slice;
-      t0 = cpu_ns();
-      const int oct_reps = 3;
-      for (int r = 0; r < oct_reps; ++r) {
-        octomap_polygon(tree, room, p, oct_map, oct_slice);
-      }
-      const double oct_extract_ms = ms_since(t0) / oct_reps;
-      t0 = cpu_ns();
-      for (int r = 0; r < oct_reps; ++r) {
+      const int oct_reps = 7;
+      const double oct_extract_ms =
+          median_ms(oct_reps, [&] { octomap_polygon(tree, room, p, oct_map, oct_slice); });
+      const double oct_shrink_ms = median_ms(oct_reps, [&] {
         (void)mapping::shrink_by_radius(oct_map.free, p.robot_radius_m + p.clearance_margin_m,
                                         oct_slice);
         do_not_optimize(oct_slice.rho_m(0));
-      }
-      const double oct_shrink_ms = ms_since(t0) / oct_reps;
+      });
       emit(*spec, "octomap", res, tree.memoryUsage(), oct_build_ms, oct_extract_ms, oct_shrink_ms,
            quality(room, p, oct_map.free, oct_map.navigable), 0, 0);
     }

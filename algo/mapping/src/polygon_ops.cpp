@@ -211,6 +211,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   // Per edge: the rays between which its inner side lies (unwrapped indices).
   std::array<std::ptrdiff_t, kMaxPolygonVertices> side_first;
   std::array<std::ptrdiff_t, kMaxPolygonVertices> side_last;
+  // Per edge: the rays that cross both its inner sides (empty if first > last).
+  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_cross_first;
+  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_cross_last;
   // Per vertex: true if the boundary turns right there (a reflex corner of the free region).
   std::array<std::uint8_t, kMaxPolygonVertices> reflex;
   for (std::size_t k = 0; k < n; ++k) {
@@ -251,6 +254,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     };
     // Each walk ends at the first ray beyond both sides (or no longer facing their line),
     // so both lie within the sectors between the two rays where the walks end.
+    // The rays that cross both sides (at R and at R') are [cross_first, cross_last].
+    std::ptrdiff_t cross_first = jj + 1;
+    std::ptrdiff_t cross_last = jj;
     std::ptrdiff_t g = 0;
     for (; g < nn; ++g) {  // rays j, j − 1, ...: s falls
       const std::size_t k = wrap(jj - g);
@@ -258,7 +264,13 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       double s = 0.0;
       double s_tol = 0.0;
       if (!meet(k, tk, s, s_tol) || (s < 0.0 && s_tol < 0.0)) break;
-      if (s >= 0.0 && s <= 1.0) t[k] = std::min(t[k], tk);
+      if (s >= 0.0 && s <= 1.0) {
+        t[k] = std::min(t[k], tk);
+        if (s_tol >= 0.0 && s_tol <= 1.0) {
+          cross_first = jj - g;
+          cross_last = std::max(cross_last, jj - g);
+        }
+      }
     }
     side_first[j] = jj - g;
     for (g = 0; g < nn; ++g) {  // rays j + 1, j + 2, ...: s rises
@@ -267,9 +279,17 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       double s = 0.0;
       double s_tol = 0.0;
       if (!meet(k, tk, s, s_tol) || (s > 1.0 && s_tol > 1.0)) break;
-      if (s >= 0.0 && s <= 1.0) t[k] = std::min(t[k], tk);
+      if (s >= 0.0 && s <= 1.0) {
+        t[k] = std::min(t[k], tk);
+        if (s_tol >= 0.0 && s_tol <= 1.0) {
+          cross_first = std::min(cross_first, jj + 1 + g);
+          cross_last = jj + 1 + g;
+        }
+      }
     }
     side_last[j] = jj + 1 + g;
+    side_cross_first[j] = cross_first;
+    side_cross_last[j] = cross_last;
   }
   //    (b) The disc of radius R about vertex i, at distance ρ_i from the centre: the ray
   //        g steps away meets it iff ρ_i sin(g·step) < R, at ρ_i cos(g·step) −
@@ -312,14 +332,10 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   // 2. Each sector: the triangle (0, v_k, v_{k+1}) swept by the disc must stay clear of the
   //    boundary; a straight edge between two exact vertices can cut the round corner the
   //    disc makes around a reflex vertex. Its sides are clear (step 1), so only the chord
-  //    can come within R of an edge. First every edge is tried against the chords of the
-  //    sectors it can reach (gap g whole sectors away: d_j sin(g·step) < R, as in
-  //    edge_out_of_reach); an edge whose two ends lie R or more beyond the chord's line is
-  //    clear of it at once (every point of its stadium lies on the far side). The sectors
-  //    that fail are pulled in below.
+  //    can come within R of an edge. First the candidate edges (below) are tried against
+  //    each chord; the sectors that fail are pulled in after that.
   std::array<Vec2d, kMaxPolygonVertices> chord_normal;  // the first n set below
   std::array<double, kMaxPolygonVertices> chord_offset;
-  std::array<double, kMaxPolygonVertices> chord_reach;
   // The edges each chord comes too close to. Every edge that can come within R of any
   // chord inside the sector's triangle comes within R of its first chord: its stadium
   // cannot lie inside the triangle (the only edge in the wedge lies beyond both vertices)
@@ -336,11 +352,8 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     const double len = detail::norm(c);
     chord_normal[k] = len > 0.0 ? Vec2d{c.y / len, -c.x / len} : Vec2d{0.0, 0.0};
     chord_offset[k] = detail::dot(chord_normal[k], a);
-    chord_reach[k] = std::max(detail::norm(a), detail::norm(b));
   }
   const double beyond = radius * (1.0 + 1e-6);
-  double reach_max = 0.0;
-  for (std::size_t k = 0; k < n; ++k) reach_max = std::max(reach_max, chord_reach[k]);
   // A chord on the R-neighbourhood touches it within rounding (on a circle every chord lies
   // on an edge's inner side): contacts up to kChordTolerance_m deep count as touching.
   const double chord_radius = radius - kChordTolerance_m;
@@ -384,7 +397,16 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     const auto jj = static_cast<std::ptrdiff_t>(j);
     const std::ptrdiff_t first = side_first[j];
     const std::ptrdiff_t last = side_last[j] - 1;
-    for (std::ptrdiff_t kk = first; kk <= last && kk - first < nn; ++kk) try_sector(kk, jj);
+    // A sector whose two rays both cross the sides is skipped: on each ray the R' side
+    // lies beyond the contact (the R side is one of the components the contact is the
+    // nearest of, and the R' side lies farther out), so it joins two points beyond the
+    // chord's ends, and the part of the wedge beyond the chord is convex.
+    const std::ptrdiff_t skip_first = side_cross_first[j];
+    const std::ptrdiff_t skip_last = side_cross_last[j] - 1;
+    for (std::ptrdiff_t kk = first; kk <= last && kk - first < nn; ++kk) {
+      if (kk >= skip_first && kk <= skip_last) continue;
+      try_sector(kk, jj);
+    }
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (reflex[i] == 0) continue;
@@ -479,43 +501,60 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
     // (d_min > R), and clearance only grows as a vertex moves in. Mostly the chord cuts the
     // round corner the disc makes about a reflex vertex: then the limit is where the chord,
     // turning about the fixed vertex, becomes tangent to the disc of one of those corners
-    // (tangent_limit), and one check confirms it against all near edges.
+    // (tangent_limit), and one check confirms it against all the sector's edges.
     // Otherwise (a straight side, or several edges at once) a bisection below that limit
     // finds it; it stops once the bracket is below kBisectionTolerance_m or the stored
     // float's resolution (2⁻²⁴ relative). The length kept is always one checked clear, so
     // the tolerance costs at most that much tightness, never safety.
-    auto limit = [&](bool move_k, double other) {
-      const auto clear_at = [&](double len) {
-        return move_k ? triangle_clear(verts, len * uk, other * uk1, near.data(), near_count,
-                                       chord_radius)
-                      : triangle_clear(verts, other * uk, len * uk1, near.data(), near_count,
-                                       chord_radius);
-      };
-      const Vec2d fixed = move_k ? other * uk1 : other * uk;
+    const auto clear_at = [&](bool move_k, double len) {
+      return move_k
+                 ? triangle_clear(verts, len * uk, rk1 * uk1, near.data(), near_count, chord_radius)
+                 : triangle_clear(verts, rk * uk, len * uk1, near.data(), near_count, chord_radius);
+    };
+    // The tangent limit of one vertex, the other staying where it is.
+    const auto tangent = [&](bool move_k) {
+      const Vec2d fixed = move_k ? rk1 * uk1 : rk * uk;
       const Vec2d moving = move_k ? uk : uk1;
       double hi = move_k ? rk : rk1;
       for (std::size_t i = 0; i < corner_count; ++i) {
         hi = tangent_limit(fixed, moving, verts.edge_start(corners[i]), radius, hi);
       }
-      if (clear_at(hi)) {
-        return hi;
-      }
+      return hi;
+    };
+    const auto bisect = [&](bool move_k, double hi) {
       double lo = 0.0;
       const double tolerance = std::max(hi * 0x1p-24, kBisectionTolerance_m);
       for (int it = 0; it < 60 && hi - lo > tolerance; ++it) {
         const double mid = 0.5 * (lo + hi);
-        (clear_at(mid) ? lo : hi) = mid;
+        (clear_at(move_k, mid) ? lo : hi) = mid;
       }
       return lo;
     };
-    // Pull in vertex k or vertex k+1, whichever keeps the larger triangle (area ∝ ρ_k ρ_k+1).
-    const double new_k = limit(true, rk1);
-    const double new_k1 = limit(false, rk);
-    if (new_k * rk1 >= rk * new_k1) {
-      rk = new_k;
+    // Pull in vertex k or vertex k+1, whichever keeps the larger triangle (area ∝ ρ_k ρ_k+1):
+    // the better tangent limit is checked first, and if it holds, the other (whose triangle
+    // is no larger even if it held) need not be.
+    const double tangent_k = tangent(true);
+    const double tangent_k1 = tangent(false);
+    const bool k_first = tangent_k * rk1 >= rk * tangent_k1;
+    double new_k = rk;
+    double new_k1 = rk1;
+    if (clear_at(k_first, k_first ? tangent_k : tangent_k1)) {
+      (k_first ? new_k : new_k1) = k_first ? tangent_k : tangent_k1;
     } else {
-      rk1 = new_k1;
+      const double other_tangent = k_first ? tangent_k1 : tangent_k;
+      const double a = bisect(k_first, k_first ? tangent_k : tangent_k1);
+      const double b =
+          clear_at(!k_first, other_tangent) ? other_tangent : bisect(!k_first, other_tangent);
+      const double cand_k = k_first ? a : b;
+      const double cand_k1 = k_first ? b : a;
+      if (cand_k * rk1 >= rk * cand_k1) {
+        new_k = cand_k;
+      } else {
+        new_k1 = cand_k1;
+      }
     }
+    rk = new_k;
+    rk1 = new_k1;
     out.set_rho_m(k, round_down(rk));
     out.set_rho_m(k1, round_down(rk1));
   }
