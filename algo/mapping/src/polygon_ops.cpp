@@ -171,7 +171,7 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   out.set_vertex_count(n);
   // A tiny slack keeps the float-stored result on the safe side of the double computation.
   const double radius = static_cast<double>(radius_m) * (1.0 + 1e-9) + 1e-9;
-  // About 23 KB of stack for the largest polygon; nothing on the heap.
+  // About 80 KB of stack (arrays sized for kMaxPolygonVertices); nothing on the heap.
   const Vertices verts(free_region);
   const double d_min = min_edge_distance_to_centre(verts, n);
   if (!(d_min > radius)) {
@@ -209,11 +209,11 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   //    and each disc or side is visited only for the rays that can meet it.
   std::array<double, kMaxPolygonVertices> t;  // the first n set below
   // Per edge: the rays between which its inner side lies (unwrapped indices).
-  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_first;
-  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_last;
+  std::array<std::int32_t, kMaxPolygonVertices> side_first;
+  std::array<std::int32_t, kMaxPolygonVertices> side_last;
   // Per edge: the rays that cross both its inner sides (empty if first > last).
-  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_cross_first;
-  std::array<std::ptrdiff_t, kMaxPolygonVertices> side_cross_last;
+  std::array<std::int32_t, kMaxPolygonVertices> side_cross_first;
+  std::array<std::int32_t, kMaxPolygonVertices> side_cross_last;
   // Per vertex: true if the boundary turns right there (a reflex corner of the free region).
   std::array<std::uint8_t, kMaxPolygonVertices> reflex;
   for (std::size_t k = 0; k < n; ++k) {
@@ -272,7 +272,7 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
         }
       }
     }
-    side_first[j] = jj - g;
+    side_first[j] = static_cast<std::int32_t>(jj - g);
     for (g = 0; g < nn; ++g) {  // rays j + 1, j + 2, ...: s rises
       const std::size_t k = wrap(jj + 1 + g);
       double tk = 0.0;
@@ -287,9 +287,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
         }
       }
     }
-    side_last[j] = jj + 1 + g;
-    side_cross_first[j] = cross_first;
-    side_cross_last[j] = cross_last;
+    side_last[j] = static_cast<std::int32_t>(jj + 1 + g);
+    side_cross_first[j] = static_cast<std::int32_t>(cross_first);
+    side_cross_last[j] = static_cast<std::int32_t>(cross_last);
   }
   //    (b) The disc of radius R about vertex i, at distance ρ_i from the centre: the ray
   //        g steps away meets it iff ρ_i sin(g·step) < R, at ρ_i cos(g·step) −

@@ -21,8 +21,9 @@ bool intersect_into(StarPolygon& into, const StarPolygon& other);
 // offset approximation: each ρ is the first contact of the ray with the radius-neighbourhood
 // of the boundary (stadiums around the edges), then each sector's triangle is checked
 // against the boundary and pulled in if the straight edge between two exact vertices would
-// cut a corner. Returns false (and all ρ = 0) if the disc at the centre already touches the
-// boundary: the robot cannot move safely at all.
+// cut a corner (docs/mapping.md, step 5). Exact to 1 µm (chords may touch the
+// neighbourhood that deep). Returns false (and all ρ = 0) if the disc at the centre already
+// touches the boundary: the robot cannot move safely at all. Uses about 80 KB of stack.
 bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygon& out);
 
 // Distance [m] from the centre to the polygon's boundary (the robot's present clearance).
