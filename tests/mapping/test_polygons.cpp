@@ -275,3 +275,28 @@ TEST(ExcludePoints, PointsAcrossTheSeamAndAtTheCentreAreHandled) {
   boticelli::mapping::exclude_points(std::span<const Point2>(&pts[1], 1), free);
   DOUBLES_EQUAL(0.0, free.max_rho_m(), 0.0);  // an obstacle at the centre closes it
 }
+
+TEST(Shrink, StraightWallsSeenHeadOnStopEveryRayIncludingThoseThroughTheJoints) {
+  // A square room 1 m from the centre on each side: along a wall the vertices are
+  // collinear, so neighbouring inner sides meet end to end, and the rays at 0°, 90°, ...
+  // pass exactly through such joints. No ray may slip through.
+  for (const std::size_t n : {std::size_t{360}, std::size_t{720}, std::size_t{8}}) {
+    StarPolygon square(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double a = 2.0 * 3.14159265358979 * static_cast<double>(k) / static_cast<double>(n);
+      square.set_rho_m(
+          k, static_cast<float>(1.0 / std::fmax(std::fabs(std::cos(a)), std::fabs(std::sin(a)))));
+    }
+    StarPolygon nav;
+    CHECK_TRUE(boticelli::mapping::shrink_by_radius(square, 0.3F, nav));
+    for (std::size_t k = 0; k < n; k += n / 4) {
+      DOUBLES_EQUAL(0.7, nav.rho_m(k), 1e-5);
+    }
+    float worst = 1e9F;
+    for (std::size_t k = 0; k < n; ++k) {
+      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(square, nav.vertex(k)));
+      CHECK_TRUE(nav.rho_m(k) <= square.rho_m(k) - 0.3F + 1e-5F);
+    }
+    CHECK_TRUE(worst >= 0.3F - 1e-5F);
+  }
+}

@@ -144,6 +144,8 @@ constexpr double kBisectionTolerance_m = 1e-5;
 // How far a chord may reach into the R-neighbourhood and still count as touching it
 // (1 µm: rounding, not geometry; the stored ρ are floats, 0.24 µm apart at 3 m).
 constexpr double kChordTolerance_m = 1e-6;
+// How much longer than its edge each inner side counts, at each end, relative to R (step 1).
+constexpr double kSideExtension = 1e-6;
 
 // Stored ρ never rounds outwards.
 float round_down(double v) {
@@ -252,8 +254,15 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       s_tol = s + kChordTolerance_m * ue * inv_facing * inv_len2;
       return true;
     };
+    // Each side counts kSideExtension R longer at both ends. Where the boundary runs
+    // straight, two neighbouring sides meet end to end, and a ray through the joint could
+    // otherwise slip between them in rounding; where it turns right by less than the
+    // reflex threshold (so its disc is skipped), their ends are less than 2R sin(1e-6 / 2)
+    // apart. The extension lies within R·1e-12 of the stadium, so it can only stop a
+    // ray a little early, never late.
     // Each walk ends at the first ray beyond both sides (or no longer facing their line),
     // so both lie within the sectors between the two rays where the walks end.
+    const double ext = kSideExtension * radius / len;
     // The rays that cross both sides (at R and at R') are [cross_first, cross_last].
     std::ptrdiff_t cross_first = jj + 1;
     std::ptrdiff_t cross_last = jj;
@@ -263,10 +272,10 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       double tk = 0.0;
       double s = 0.0;
       double s_tol = 0.0;
-      if (!meet(k, tk, s, s_tol) || (s < 0.0 && s_tol < 0.0)) break;
-      if (s >= 0.0 && s <= 1.0) {
+      if (!meet(k, tk, s, s_tol) || (s < -ext && s_tol < -ext)) break;
+      if (s >= -ext && s <= 1.0 + ext) {
         t[k] = std::min(t[k], tk);
-        if (s_tol >= 0.0 && s_tol <= 1.0) {
+        if (s_tol >= -ext && s_tol <= 1.0 + ext) {
           cross_first = jj - g;
           cross_last = std::max(cross_last, jj - g);
         }
@@ -278,10 +287,10 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
       double tk = 0.0;
       double s = 0.0;
       double s_tol = 0.0;
-      if (!meet(k, tk, s, s_tol) || (s > 1.0 && s_tol > 1.0)) break;
-      if (s >= 0.0 && s <= 1.0) {
+      if (!meet(k, tk, s, s_tol) || (s > 1.0 + ext && s_tol > 1.0 + ext)) break;
+      if (s >= -ext && s <= 1.0 + ext) {
         t[k] = std::min(t[k], tk);
-        if (s_tol >= 0.0 && s_tol <= 1.0) {
+        if (s_tol >= -ext && s_tol <= 1.0 + ext) {
           cross_first = std::min(cross_first, jj + 1 + g);
           cross_last = jj + 1 + g;
         }
@@ -301,8 +310,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   //        w·e_i−1 ≥ 0: w lies in the corner's polar cone, so w·v_i ≥ 0. But a ray from the
   //        centre enters the disc on its near half (w·v_i < 0), and any other point of the
   //        disc is inside a neighbouring stadium, which the ray entered earlier through
-  //        another disc or side. A turn within 1e-6 rad of straight counts as reflex (the
-  //        disc then lowers a contact by at most R·1e-12 if at all, and costs only time).
+  //        another disc or side. A right turn by less than 1e-6 rad counts as straight:
+  //        its disc reaches past the two sides' lines by only R(1 − cos(δ/2)) < R·1e-12,
+  //        and the extended sides (a) close the gap between their ends.
   for (std::size_t i = 0; i < n; ++i) {
     const auto ii = static_cast<std::ptrdiff_t>(i);
     const Vec2d e_in = verts.edge_end(ii - 1) - verts.edge_start(ii - 1);
