@@ -306,6 +306,24 @@ Vec3 SyntheticRoom::world_of(const evidence::Reading& reading) const {
           s.y + rho * std::sin(static_cast<double>(reading.alpha_rad)), s.z + h};
 }
 
+bool SyntheticRoom::add_feature(Vec3 d, double outlier_fraction, std::mt19937& rng,
+                                std::vector<evidence::Reading>& out) const {
+  const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+  d = {d.x / len, d.y / len, d.z / len};
+  const Hit hit = cast_from_sensor(d);
+  if (!hit.featured || !(hit.distance_m <= spec_.max_range_m)) {
+    return false;
+  }
+  double t = hit.distance_m;
+  if (std::uniform_real_distribution<double>(0.0, 1.0)(rng) < outlier_fraction) {
+    t *= 0.5;  // §4.8.2: outliers appear twice as close as they are
+  }
+  const Vec3 s = spec_.sensor;
+  out.push_back(reading_of({s.x + d.x * t, s.y + d.y * t, s.z + d.z * t},
+                           static_cast<float>(spec_.feature_m)));
+  return true;
+}
+
 std::vector<evidence::Reading> SyntheticRoom::generate_readings(
     std::size_t features, std::uint32_t seed, double outlier_fraction_override) const {
   const double outliers =
@@ -323,19 +341,7 @@ std::vector<evidence::Reading> SyntheticRoom::generate_readings(
     const double cy = std::sin(alpha);
     const double rho = wall_distance_xy(cx, cy);
     const double z = spec_.wall_height_m * unit(rng);
-    Vec3 d{rho * cx, rho * cy, z - s.z};
-    const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    d = {d.x / len, d.y / len, d.z / len};
-    const Hit hit = cast_from_sensor(d);
-    if (!hit.featured || !(hit.distance_m <= spec_.max_range_m)) {
-      continue;
-    }
-    double t = hit.distance_m;
-    if (unit(rng) < outliers) {
-      t *= 0.5;  // §4.8.2: outliers appear twice as close as they are
-    }
-    out.push_back(reading_of({s.x + d.x * t, s.y + d.y * t, s.z + d.z * t},
-                             static_cast<float>(spec_.feature_m)));
+    (void)add_feature({rho * cx, rho * cy, z - s.z}, outliers, rng, out);
   }
   return out;
 }
@@ -354,7 +360,6 @@ std::vector<evidence::Reading> SyntheticRoom::generate_camera_readings(
     return out;
   }
   out.reserve(features);
-  const Vec3 s = spec_.sensor;
   const double pan_offset = kTwoPi * unit(rng);
   for (std::size_t image = 0; image < images; ++image) {
     // Images share the features evenly; the first ones take the remainder.
@@ -377,20 +382,9 @@ std::vector<evidence::Reading> SyntheticRoom::generate_camera_readings(
       const double zc = -(v - 0.5 * scan.height_px) / scan.focal_px;
       const double xt = ct - zc * st;  // forward after tilting (tilt < 0 looks down)
       const double zt = st + zc * ct;
-      Vec3 d{xt * cp - yc * sp, xt * sp + yc * cp, zt};
-      const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-      d = {d.x / len, d.y / len, d.z / len};
-      const Hit hit = cast_from_sensor(d);
-      if (!hit.featured || !(hit.distance_m <= spec_.max_range_m)) {
-        continue;
+      if (add_feature({xt * cp - yc * sp, xt * sp + yc * cp, zt}, outliers, rng, out)) {
+        ++found;
       }
-      double t = hit.distance_m;
-      if (unit(rng) < outliers) {
-        t *= 0.5;  // §4.8.2: outliers appear twice as close as they are
-      }
-      out.push_back(reading_of({s.x + d.x * t, s.y + d.y * t, s.z + d.z * t},
-                               static_cast<float>(spec_.feature_m)));
-      ++found;
     }
   }
   return out;

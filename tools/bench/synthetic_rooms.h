@@ -4,6 +4,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <random>
 #include <span>
 #include <vector>
 
@@ -127,6 +128,11 @@ class SyntheticRoom {
   // Horizontal distance from the sensor to the walls in direction (cx, cy) (unit).
   [[nodiscard]] double wall_distance_xy(double cx, double cy) const;
   [[nodiscard]] double box_entry(const Vec3& origin, const Vec3& dir, double t_max) const;
+  // Casts along direction d (any length) and, if the first surface is featured and within
+  // range, appends its reading (moved to half its distance with probability
+  // outlier_fraction, one draw from rng). Returns whether it did.
+  bool add_feature(Vec3 d, double outlier_fraction, std::mt19937& rng,
+                   std::vector<evidence::Reading>& out) const;
   RoomSpec spec_;
 };
 
