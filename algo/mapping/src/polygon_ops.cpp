@@ -1,4 +1,4 @@
-// Intersection and exact shrink of star-shaped polygons (§5.4.2), with a windowed edge search.
+// Intersection, exact robot-radius shrink and point exclusion of star-shaped polygons (§5.4.2).
 #include "algo/mapping/polygon_ops.h"
 
 #include <algorithm>
@@ -70,7 +70,8 @@ double min_edge_distance_to_centre(const Vertices& v, std::size_t n) {
   return d;
 }
 
-// Edges farther (in angle) than `window` from a ray or sector are at least `radius` away:
+// Edges farther (in angle) than `window` from a ray or sector are at least `radius` away
+// (the fallback search of a sector with too many failing edges to list):
 // a boundary point at distance d ≥ d_min from the centre and angle δ ≥ asin(R/d_min) from
 // a wedge is at least d·sin δ ≥ R from it (δ ≤ 90°), or at least d > R (δ > 90°).
 std::ptrdiff_t edge_window(const StarPolygon& p, double radius, double d_min) {
@@ -80,7 +81,7 @@ std::ptrdiff_t edge_window(const StarPolygon& p, double radius, double d_min) {
   return std::min(w, static_cast<std::ptrdiff_t>(p.vertex_count() / 2 + 1));
 }
 
-// Clearance of the triangle (0, a, b) from the edges j ∈ [first, last] is at least R.
+// Clearance of the triangle (0, a, b) from the listed edges is at least R.
 // The sides 0–a and 0–b are clear already (each vertex is at most the first contact of its
 // ray), and no edge reaches inside the triangle (the only edge in the sector lies beyond
 // both vertices, the others outside the wedge), so only the chord a–b needs checking. An
@@ -187,9 +188,9 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   while (static_cast<double>(quarter) * step < 0.5 * core::kPi<double> - 1e-12) ++quarter;
   std::array<double, kMaxPolygonVertices / 4 + 2> sin_gap{};
   std::array<double, kMaxPolygonVertices / 4 + 2> cos_gap{};
-  for (std::ptrdiff_t g = 0; g < quarter; ++g) {
-    sin_gap[static_cast<std::size_t>(g)] = std::sin(static_cast<double>(g) * step);
-    cos_gap[static_cast<std::size_t>(g)] = std::cos(static_cast<double>(g) * step);
+  for (std::ptrdiff_t g = 0; g < quarter; ++g) {  // the unit vector of ray g
+    sin_gap[static_cast<std::size_t>(g)] = verts.unit_at(static_cast<std::size_t>(g)).y;
+    cos_gap[static_cast<std::size_t>(g)] = verts.unit_at(static_cast<std::size_t>(g)).x;
   }
   // Indices here stay within n of [0, n): one correction wraps them.
   const auto wrap = [nn](std::ptrdiff_t k) __attribute__((always_inline)) {
@@ -399,10 +400,10 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
   //    is star-shaped about the centre), below the chord, on an inner side or a reflex
   //    vertex's disc (step 1 (b): no other disc is ever met first). So the chord comes
   //    within R' of that side's edge, or of that vertex's edges (which end at its centre).
-  //    The candidates are thus: each edge against the sectors its inner side lies in
-  //    (from step 1 (a), one sector wider each way for the R' side lying 1 µm farther
-  //    out), and the two edges at each reflex vertex against every sector its disc
-  //    reaches (ρ_i sin(gap·step) < R, gap whole sectors away).
+  //    The candidates are thus: each edge against the sectors its inner sides (at R and
+  //    at R') lie in, as step 1 (a) found them, and the two edges at each reflex vertex
+  //    against every sector its disc reaches (ρ_i sin(gap·step) < R, gap whole sectors
+  //    away).
   for (std::size_t j = 0; j < n; ++j) {
     const auto jj = static_cast<std::ptrdiff_t>(j);
     const std::ptrdiff_t first = side_first[j];
