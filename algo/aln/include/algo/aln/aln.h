@@ -75,6 +75,12 @@ class Aln {
     std::uint16_t a = 0;
     std::uint16_t b = 0;
   };
+  // One step of evaluating the tree children before parents: push a piece's value, or
+  // replace the top two values by their MIN or MAX.
+  struct Op {
+    NodeKind kind = NodeKind::kPiece;
+    std::uint16_t piece = 0;  // for kPiece
+  };
 
   // One flat piece y = 0, inputs and output on [0, 1], weights unbounded.
   Aln() {
@@ -200,6 +206,9 @@ class Aln {
   [[nodiscard]] std::span<const std::uint16_t> post_order() const {
     return {post_order_.data(), node_count_};
   }
+  // The tree as evaluation steps in post order (what evaluate() runs), for evaluators that
+  // work on many inputs at once.
+  [[nodiscard]] std::span<const Op> ops() const { return {ops_.data(), node_count_}; }
   // Node index of the leaf holding piece p.
   [[nodiscard]] std::size_t node_of_piece(std::size_t p) const { return piece_node_[p]; }
 
@@ -384,11 +393,7 @@ class Aln {
   std::array<std::size_t, MaxPieces> piece_node_{};
   std::array<std::uint16_t, kMaxNodes> post_order_{};
   std::array<std::uint16_t, kMaxNodes> parent_{};  // parent_[0] = 0
-  struct Op {
-    NodeKind kind = NodeKind::kPiece;
-    std::uint16_t piece = 0;
-  };
-  std::array<Op, kMaxNodes> ops_{};  // post order, for evaluate()
+  std::array<Op, kMaxNodes> ops_{};                // post order, for evaluate()
   std::array<Range<Scalar>, static_cast<std::size_t>(N)> input_range_{};
   Range<Scalar> output_range_{};
   std::array<Scalar, static_cast<std::size_t>(N)> weight_lo_{};

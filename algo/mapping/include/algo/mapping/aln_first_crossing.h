@@ -28,18 +28,12 @@ class AlnFirstCrossing {
  public:
   using Model = aln::Aln<Scalar, 3, MaxPieces>;
 
-  // Keeps a copy of the model's tree. False (and nothing is free) if the range is not
+  // Keeps a copy of the model. False (and nothing is free) if the range is not
   // positive.
   bool set_model(const Model& occupancy, float safe_occupancy, float max_range_m) {
     model_ = occupancy;
     safe_ = static_cast<Scalar>(safe_occupancy);
     max_range_ = static_cast<Scalar>(max_range_m);
-    op_count_ = 0;
-    for (const std::uint16_t n : model_.post_order()) {
-      const auto& node = model_.node(n);
-      ops_[op_count_++] =
-          Op{node.kind, node.kind == aln::NodeKind::kPiece ? node.a : std::uint16_t{0}};
-    }
     valid_ = max_range_ > Scalar(0);
     return valid_;
   }
@@ -56,8 +50,7 @@ class AlnFirstCrossing {
     const auto h = static_cast<Scalar>(h_m);
     std::size_t top = 0;   // lists on the stack
     std::size_t used = 0;  // intervals in the pool
-    for (std::size_t o = 0; o < op_count_; ++o) {
-      const Op op = ops_[o];
+    for (const typename Model::Op op : model_.ops()) {
       if (op.kind == aln::NodeKind::kPiece) {
         const auto& piece = model_.piece(op.piece);
         // m(r) = c + w r ≥ m_safe on one interval of [0, r_max] (or none).
@@ -106,10 +99,6 @@ class AlnFirstCrossing {
     std::size_t first;
     std::size_t count;
   };
-  struct Op {
-    aln::NodeKind kind = aln::NodeKind::kPiece;
-    std::uint16_t piece = 0;
-  };
 
   // Union of two sorted disjoint lists into scratch_; returns its length.
   std::size_t unite(List a, List b) const {
@@ -150,8 +139,6 @@ class AlnFirstCrossing {
   Model model_{};
   Scalar safe_ = Scalar(0.6);
   Scalar max_range_ = Scalar(0);
-  std::array<Op, Model::kMaxNodes> ops_{};
-  std::size_t op_count_ = 0;
   // Evaluation memory: a stack of lists over one pool (the lists on the stack belong to
   // disjoint subtrees, so together they hold at most MaxPieces intervals).
   mutable std::array<Interval, MaxPieces> pool_{};

@@ -30,15 +30,6 @@ class AlnFreeRange {
       }
     }
     valid_ = aln::invert(occupancy, 2, inverse_);
-    // The inverse's tree in post order (children before parents), for the block evaluation.
-    op_count_ = 0;
-    if (valid_) {
-      for (const std::uint16_t n : inverse_.post_order()) {
-        const auto& node = inverse_.node(n);
-        ops_[op_count_++] =
-            Op{node.kind, node.kind == aln::NodeKind::kPiece ? node.a : std::uint16_t{0}};
-      }
-    }
     return valid_;
   }
   [[nodiscard]] bool valid() const { return valid_; }
@@ -86,8 +77,7 @@ class AlnFreeRange {
             static_cast<Scalar>(static_cast<float>(first_index + k0 + i) * step_rad + offset_rad);
       }
       std::size_t top = 0;
-      for (std::size_t o = 0; o < op_count_; ++o) {
-        const Op op = ops_[o];
+      for (const typename Model::Op op : inverse_.ops()) {
         if (op.kind == aln::NodeKind::kPiece) {
           const Scalar c = constant_[op.piece];
           const Scalar a = slope_[op.piece];
@@ -114,12 +104,6 @@ class AlnFreeRange {
   Scalar safe_occupancy_ = Scalar(0.6);
   static constexpr std::size_t kBlock = 16;
   using Block = std::array<Scalar, kBlock>;
-  struct Op {
-    aln::NodeKind kind = aln::NodeKind::kPiece;
-    std::uint16_t piece = 0;
-  };
-  std::array<Op, Model::kMaxNodes> ops_{};
-  std::size_t op_count_ = 0;
   // Working memory of ranges_at_height (the evaluation stack holds at most one block per
   // piece): part of the object, so nothing is allocated.
   mutable std::array<Scalar, MaxPieces> constant_{};
