@@ -12,6 +12,31 @@ bool on_circle(const StarPolygon& free, std::size_t k, float bounding_radius_m, 
   return free.rho_m(k) >= bounding_radius_m - tol_m;
 }
 
+// True if world point w lies at least margin_m inside both the free polygon (robot frame at
+// `pose`) and its bounding circle.
+bool well_inside(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
+                 core::Point2 w, float margin_m) {
+  const core::Point2 q = core::to_robot(pose, w);
+  const float d = std::hypot(q.x_m, q.y_m);
+  return d + margin_m <= bounding_radius_m &&
+         d + margin_m <= free.radius_at_m(std::atan2(q.y_m, q.x_m));
+}
+
+// Removes, in place and keeping the order of the rest, the points `pose`'s free polygon
+// covers by margin_m; returns how many went.
+std::size_t remove_well_inside(PointList& list, const core::Pose2& pose, const StarPolygon& free,
+                               float bounding_radius_m, float margin_m) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    if (!well_inside(pose, free, bounding_radius_m, list[i], margin_m)) {
+      list[kept++] = list[i];
+    }
+  }
+  const std::size_t removed = list.size() - kept;
+  list.resize(kept);
+  return removed;
+}
+
 bool near_any(const PointList& list, core::Point2 p, float radius_m) {
   return std::any_of(list.begin(), list.end(),
                      [&](const core::Point2& q) { return core::distance_m(p, q) < radius_m; });
@@ -157,12 +182,16 @@ void GlobalMap::clear() {
   obstacles_.clear();
   exploration_.clear();
   dropped_ = 0;
+  retired_ = 0;
 }
 
 bool GlobalMap::merge(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
                       const PointList& obstacles_robot, const PointList& exploration_robot,
                       const MapPointParams& params) {
   bool ok = true;
+  // Contradicted: the newer view sees free floor well inside where the point was.
+  retired_ += remove_well_inside(obstacles_, pose, free, bounding_radius_m,
+                                 params.obstacle_retire_margin_m);
   for (const core::Point2& p : obstacles_robot) {
     const core::Point2 w = core::to_world(pose, p);
     if (near_any(obstacles_, w, params.obstacle_merge_radius_m)) {
@@ -174,18 +203,7 @@ bool GlobalMap::merge(const core::Pose2& pose, const StarPolygon& free, float bo
     }
   }
   // Explored: well inside this cycle's free polygon (and the bounding circle).
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < exploration_.size(); ++i) {
-    const core::Point2 q = core::to_robot(pose, exploration_[i]);
-    const float d = std::hypot(q.x_m, q.y_m);
-    const bool explored =
-        d + params.explored_margin_m <= bounding_radius_m &&
-        d + params.explored_margin_m <= free.radius_at_m(std::atan2(q.y_m, q.x_m));
-    if (!explored) {
-      exploration_[kept++] = exploration_[i];
-    }
-  }
-  exploration_.resize(kept);
+  (void)remove_well_inside(exploration_, pose, free, bounding_radius_m, params.explored_margin_m);
   for (const core::Point2& p : exploration_robot) {
     const core::Point2 w = core::to_world(pose, p);
     if (near_any(exploration_, w, params.exploration_merge_radius_m)) {

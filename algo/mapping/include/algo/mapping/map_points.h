@@ -18,6 +18,13 @@ struct MapPointParams {
   float on_circle_tolerance_m = 0.02F;  // ρ within this of the bounding radius is "on it"
   // An incoming obstacle point this close to a known one is the same point [m].
   float obstacle_merge_radius_m = 0.1F;
+  // A known obstacle point this far inside a later free polygon, and this far inside its
+  // bounding circle, is contradicted by the newer view and retired [m]. It came from an
+  // earlier, coarser model or from a pose that odometry has since corrected. Larger than
+  // obstacle_spacing_m's half and than the polygon's per-ray error (about ρ·Δθ, 5 cm at
+  // 3 m with 360 rays), so a point on or near the new boundary, where the wall still is,
+  // is kept.
+  float obstacle_retire_margin_m = 0.15F;
   float exploration_merge_radius_m = 0.35F;  // likewise for exploration points [m]
   // An exploration point this far inside a later free polygon has been explored [m].
   float explored_margin_m = 0.1F;
@@ -58,10 +65,15 @@ inline constexpr std::size_t kMaxExplorationPoints = 512;
 // The global obstacle and exploration lists in the world frame, merged across cycles.
 class GlobalMap {
  public:
-  // Merges one cycle's points (robot frame, taken at `pose` from odometry): obstacle points
-  // closer than obstacle_merge_radius_m to a known one are dropped (deduplicated); known
-  // exploration points that this free polygon covers (explored_margin_m inside it) are
-  // removed as explored, then incoming ones are added unless one is already that close. Returns
+  // Merges one cycle's points (robot frame, taken at `pose` from odometry). First, known
+  // obstacle points that this free polygon contradicts (obstacle_retire_margin_m inside it
+  // and inside the bounding circle: the polygon speaks only about what it saw) are retired;
+  // then incoming obstacle points closer than obstacle_merge_radius_m to a known one are
+  // dropped (deduplicated). Known exploration points that this free polygon covers
+  // (explored_margin_m inside it) are removed as explored, then incoming ones are added
+  // unless one is already that close. Removal keeps the order of the points that stay.
+  // `free` should be the polygon after the feature guard's exclusions (extract_local_map's
+  // LocalMap::free), so an obstacle the model smooths away is not retired by it. Returns
   // false if a list overflowed (the points that did not fit are counted and dropped).
   bool merge(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
              const PointList& obstacles_robot, const PointList& exploration_robot,
@@ -74,11 +86,14 @@ class GlobalMap {
   PointList& obstacles() { return obstacles_; }
   PointList& exploration() { return exploration_; }
   [[nodiscard]] std::size_t dropped_points() const { return dropped_; }
+  // Obstacle points retired as contradicted by a newer polygon, since clear().
+  [[nodiscard]] std::size_t retired_points() const { return retired_; }
 
  private:
   core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles_;
   core::FixedVector<core::Point2, kMaxExplorationPoints> exploration_;
   std::size_t dropped_ = 0;
+  std::size_t retired_ = 0;
 };
 
 }  // namespace boticelli::mapping
