@@ -2,6 +2,7 @@
 // clear of them.
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include "algo/core/fixed_vector.h"
@@ -19,6 +20,9 @@ using boticelli::evidence::Reading;
 namespace mapping = boticelli::mapping;
 
 namespace {
+
+template <std::size_t N>
+using GuardCandidatesFor = FixedVector<mapping::GuardPoint, N>;
 
 // A room whose model sees a wall at 2.5 m in every direction and nothing closer: it calls
 // everything nearer than 2.5 m free (occupancy 0.9 beyond, 0 before).
@@ -55,26 +59,75 @@ void box_face(FixedVector<Reading, N>& out, std::size_t n) {
   }
 }
 
+// Deterministic uniform numbers in [-1, 1] (a 32-bit LCG).
+struct Uniform {
+  std::uint32_t state = 12345U;
+  float next() {
+    state = state * 1664525U + 1013904223U;
+    return static_cast<float>(state >> 8) / 8388608.0F - 1.0F;
+  }
+};
+
+// A model that sees only a wall 4 m away: everything nearer is free.
+float far_wall(float /*alpha*/, float h, float r) {
+  const float rho = std::sqrt(std::fmax(0.0F, r * r - h * h));
+  return rho >= 4.0F ? 0.9F : 0.0F;
+}
+
+// n readings of the front face of a 0.5 m box 2.5 m ahead (pan ±0.1 rad, heights
+// -0.54..-0.24 m), each with a range error uniform in ±error_m (median |error| error_m / 2).
+template <std::size_t N>
+void noisy_box(FixedVector<Reading, N>& out, std::size_t n, float error_m, Uniform& noise) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float u = static_cast<float>(i % 6) / 5.0F;
+    const float v = static_cast<float>(i / 6 % 4) / 3.0F;
+    const float alpha = -0.1F + 0.2F * u;
+    Reading rd =
+        at(alpha < 0.0F ? alpha + 6.2831853F : alpha, 2.5F / std::cos(alpha), -0.54F + 0.3F * v);
+    rd.r_m += error_m * noise.next();
+    (void)out.push_back(rd);
+  }
+}
+
+template <std::size_t N>
+std::size_t kept_by(const GuardCandidatesFor<N>& candidates, const mapping::FeatureGuardParams& g,
+                    FixedVector<Point2, N>& kept) {
+  kept.clear();
+  CHECK_TRUE(mapping::corroborated_points(candidates.span(), g, kept));
+  return kept.size();
+}
+
 }  // namespace
 
 TEST_GROUP(FeatureGuard){};
 
 TEST(FeatureGuard, OnlySurfacesTheModelCallsFreeInTheRobotsHeightBandAreCandidates) {
   FixedVector<Reading, 8> readings;
-  (void)readings.push_back(at(0.5F, 1.0F, -0.3F));        // in the band, model says free
-  (void)readings.push_back(at(0.5F, 2.6F, -0.3F));        // the model holds it (wall)
-  (void)readings.push_back(at(0.5F, 1.0F, 0.5F));         // above the robot
-  (void)readings.push_back(at(0.5F, 1.0F, -0.58F));       // below the lowest slice
-  (void)readings.push_back(at(0.5F, 1.0F, -0.3F, 0.4F));  // too little evidence
-  (void)readings.push_back(at(2.0F, 1.5F, 0.1F));         // in the band, model says free
+  (void)readings.push_back(at(0.5F, 1.0F, -0.3F));         // in the band, model says free
+  (void)readings.push_back(at(0.5F, 2.6F, -0.3F));         // the model holds it (wall)
+  (void)readings.push_back(at(0.5F, 1.0F, 0.5F));          // above the robot
+  (void)readings.push_back(at(0.5F, 1.0F, -0.58F));        // below the lowest slice
+  (void)readings.push_back(at(0.5F, 1.0F, -0.3F, 0.3F));   // too little evidence
+  (void)readings.push_back(at(2.0F, 1.5F, 0.1F));          // in the band, model says free
+  (void)readings.push_back(at(3.0F, 1.2F, -0.1F, 0.45F));  // weak, in the band, free
   FixedVector<mapping::GuardPoint, 8> candidates;
   LONGS_EQUAL(0, mapping::collect_unexplained_features(readings, wall_only, robot(),
                                                        mapping::FeatureGuardParams{}, candidates));
-  LONGS_EQUAL(2, candidates.size());
+  LONGS_EQUAL(3, candidates.size());
   DOUBLES_EQUAL(std::cos(0.5), candidates[0].x_m, 1e-5);
   DOUBLES_EQUAL(std::sin(0.5), candidates[0].y_m, 1e-5);
   DOUBLES_EQUAL(-0.3, candidates[0].h_m, 1e-6);
+  DOUBLES_EQUAL(std::hypot(1.0, 0.3), candidates[0].r_m, 1e-5);
+  DOUBLES_EQUAL(0.9, candidates[0].m, 1e-6);
   DOUBLES_EQUAL(1.5 * std::cos(2.0), candidates[1].x_m, 1e-5);
+  DOUBLES_EQUAL(0.45, candidates[2].m, 1e-6);
+  // With weak features turned off, only the two strong ones.
+  mapping::FeatureGuardParams strong_only;
+  strong_only.min_weak_evidence = strong_only.min_evidence;
+  candidates.clear();
+  (void)mapping::collect_unexplained_features(readings, wall_only, robot(), strong_only,
+                                              candidates);
+  LONGS_EQUAL(2, candidates.size());
 }
 
 TEST(FeatureGuard, AFullCandidateListCountsWhatItCouldNotKeep) {
@@ -107,6 +160,81 @@ TEST(FeatureGuard, AClusterIsKeptAndLoneOutliersAreDropped) {
   kept.clear();
   CHECK_TRUE(mapping::corroborated_points(candidates, strict, kept));
   LONGS_EQUAL(0, kept.size());
+}
+
+TEST(FeatureGuard, NoisyReadingsOfABoxAreKeptWhereAFixedRadiusKeepsFew) {
+  // 23 readings (as many as real stereo gives of a plain table) with a range error of up to
+  // 0.4 m at 2.5 m, median 0.2 m: more than twice the sensor model's δr = 0.1 r apart.
+  FixedVector<Reading, 64> readings;
+  Uniform noise;
+  noisy_box(readings, 23, 0.4F, noise);
+  GuardCandidatesFor<64> candidates;
+  (void)mapping::collect_unexplained_features(readings, far_wall, robot(),
+                                              mapping::FeatureGuardParams{}, candidates);
+  LONGS_EQUAL(23, candidates.size());
+  FixedVector<Point2, 64> kept;
+  CHECK_TRUE(kept_by(candidates, mapping::FeatureGuardParams{}, kept) >= 21);
+  for (const Point2& q : kept) {  // on the box, within the range error
+    CHECK_TRUE(q.x_m > 2.05F && q.x_m < 2.95F && std::fabs(q.y_m) < 0.35F);
+  }
+  mapping::FeatureGuardParams fixed;
+  fixed.neighbour_delta_r_factor = 0.0F;  // the old rule: 0.1 m whatever the range
+  CHECK_TRUE(kept_by(candidates, fixed, kept) <= 5);
+}
+
+TEST(FeatureGuard, IsolatedOutliersAreNotKeptThoughTheRadiusGrowsWithRange) {
+  FixedVector<Reading, 64> readings;
+  Uniform noise;
+  noisy_box(readings, 23, 0.4F, noise);
+  // Lone mismatches all round the room, 1-3.9 m away, at least 1 m apart.
+  for (int i = 0; i < 10; ++i) {
+    const float fi = static_cast<float>(i);
+    (void)readings.push_back(at(0.5F + 0.55F * fi, 1.0F + 0.3F * fi, -0.5F + 0.07F * fi));
+  }
+  GuardCandidatesFor<64> candidates;
+  (void)mapping::collect_unexplained_features(readings, far_wall, robot(),
+                                              mapping::FeatureGuardParams{}, candidates);
+  LONGS_EQUAL(33, candidates.size());
+  FixedVector<Point2, 64> kept;
+  CHECK_TRUE(kept_by(candidates, mapping::FeatureGuardParams{}, kept) >= 21);
+  for (const Point2& q : kept) {
+    CHECK_TRUE(q.x_m > 2.05F && std::fabs(q.y_m) < 0.35F);  // only the box
+  }
+}
+
+TEST(FeatureGuard, NeighboursAreFoundWithinTheSummedRangeErrorOfThePair) {
+  mapping::FeatureGuardParams g;  // δr = 0.1 r
+  // Two readings at 2 m and 3 m: 0.2 + 0.3 = 0.5 m.
+  const mapping::GuardPoint a{2.0F, 0.0F, 0.0F, 2.0F};
+  CHECK_TRUE(mapping::are_neighbours(a, {2.0F, 0.49F, 0.0F, 3.0F}, g));
+  CHECK_FALSE(mapping::are_neighbours(a, {2.0F, 0.51F, 0.0F, 3.0F}, g));
+  // Near the camera the fixed radius rules: 0.02 + 0.02 < 0.1 m.
+  const mapping::GuardPoint c{0.2F, 0.0F, 0.0F, 0.2F};
+  CHECK_TRUE(mapping::are_neighbours(c, {0.2F, 0.09F, 0.0F, 0.2F}, g));
+  CHECK_FALSE(mapping::are_neighbours(c, {0.2F, 0.11F, 0.0F, 0.2F}, g));
+  // Height counts (3-D distance), and the rule is symmetric.
+  CHECK_FALSE(mapping::are_neighbours(a, {2.0F, 0.4F, 0.4F, 3.0F}, g));
+  CHECK_TRUE(mapping::are_neighbours({2.0F, 0.49F, 0.0F, 3.0F}, a, g));
+}
+
+TEST(FeatureGuard, AWeakFeatureNeedsMoreCorroborationThanAStrongOne) {
+  GuardCandidatesFor<32> candidates;
+  for (int i = 0; i < 6; ++i) {  // six weak features within 5 cm: five neighbours each
+    (void)candidates.push_back({1.0F + 0.01F * static_cast<float>(i), 0.2F, -0.3F, 1.0F, 0.5F});
+  }
+  FixedVector<Point2, 32> kept;
+  LONGS_EQUAL(0, kept_by(candidates, mapping::FeatureGuardParams{}, kept));
+  for (mapping::GuardPoint& c : candidates) {
+    c.m = 0.9F;  // the same cluster with strong evidence
+  }
+  LONGS_EQUAL(6, kept_by(candidates, mapping::FeatureGuardParams{}, kept));
+  for (mapping::GuardPoint& c : candidates) {
+    c.m = 0.5F;
+  }
+  for (int i = 0; i < 4; ++i) {  // ten weak features: nine neighbours each
+    (void)candidates.push_back({1.0F, 0.21F + 0.01F * static_cast<float>(i), -0.3F, 1.0F, 0.5F});
+  }
+  LONGS_EQUAL(10, kept_by(candidates, mapping::FeatureGuardParams{}, kept));
 }
 
 TEST(FeatureGuard, TheNavigablePolygonKeepsTheRobotClearOfABoxTheModelMissed) {

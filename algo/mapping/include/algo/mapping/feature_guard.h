@@ -8,6 +8,7 @@
 
 #include "algo/core/fixed_vector.h"
 #include "algo/core/geometry.h"
+#include "algo/evidence/ray_samples.h"
 #include "algo/evidence/reading.h"
 #include "algo/mapping/extraction.h"
 #include "algo/mapping/star_polygon.h"
@@ -21,17 +22,44 @@ namespace boticelli::mapping {
 // evidence the robot must not drive into; a lone one is an outlier of the stereo (§4.8.2)
 // that the fit was right to ignore. So the guard keeps the corroborated ones and the
 // extraction pulls the polygon in front of them.
+//
+// Corroboration follows the stereo's range error. A reading lies about δr = delta_r_fraction · r
+// from its surface along its ray (the sensor model's δr, §3.7.3, Eq 3.7); real readings of a
+// plain table at 2–3 m scatter by a median 0.26 m, so a fixed 0.1 m radius finds no cluster
+// there. Two candidates are neighbours when their 3-D distance is at most
+//   max(neighbour_radius_m, neighbour_delta_r_factor · (δr_a + δr_b)).
+// The sum, not the larger δr: if each reading is within its δr of a surface point, two
+// readings of surface points d apart are at most d + δr_a + δr_b apart (triangle inequality),
+// so the sum is the smallest radius that still lets every pair of readings of a small patch
+// (d → 0) find each other; the larger δr alone misses the pairs whose errors are both near
+// their bound in opposite directions (up to 2δr apart). Near the camera δr is small and the
+// fixed radius rules.
 struct FeatureGuardParams {
   float min_evidence = 0.6F;        // features this occupied are surfaces (m_safe, §5.4)
   float neighbour_radius_m = 0.1F;  // corroboration: unexplained features this close (3-D)
   std::size_t min_neighbours = 4;   // at least this many others within the radius
+  // δr / r of the readings, the sensor model's (evidence::RaySampleParams, §3.7.3).
+  float delta_r_fraction = evidence::RaySampleParams{}.delta_r_fraction;
+  // Neighbour radius in units of the pair's summed range error δr_a + δr_b (0: fixed radius).
+  float neighbour_delta_r_factor = 1.0F;
+  // Weak features, min_weak_evidence ≤ m < min_evidence: their ray samples (§4.5) plateau at
+  // m, so the fit cannot raise F to m_safe (0.6) on them however many there are, and only
+  // the guard can keep such a surface. Being more likely mismatches (Eq 3.8: m = 0.4 is a
+  // match error of 0.77 E_max), they need min_weak_neighbours others within the radius.
+  // min_weak_evidence ≥ min_evidence turns this off.
+  float min_weak_evidence = 0.4F;
+  std::size_t min_weak_neighbours = 8;
 };
 
-// A feature in the robot frame: x, y [m] on the floor plane, h [m] relative to the PTU centre.
+// A feature in the robot frame: x, y [m] on the floor plane, h [m] relative to the PTU centre,
+// its range r [m] from the PTU centre (gives its range error δr; 0: unknown, then only the
+// fixed radius applies) and its evidence m (below min_evidence: a weak feature).
 struct GuardPoint {
   float x_m = 0.0F;
   float y_m = 0.0F;
   float h_m = 0.0F;
+  float r_m = 0.0F;
+  float m = 1.0F;
 };
 
 inline constexpr std::size_t kMaxGuardCandidates = 2048;
@@ -40,11 +68,15 @@ inline constexpr std::size_t kMaxGuardPoints = 1024;
 using GuardCandidates = core::FixedVectorBase<GuardPoint>;
 using GuardPoints = core::FixedVectorBase<core::Point2>;
 
-// Appends to `candidates` every reading with m ≥ min_evidence whose height lies in the
-// robot's band (slice_height_m(p, 0) .. slice_height_m(p, n − 1)) and where the model says
-// free: occupancy(α, h, r) < p.safe_occupancy. `occupancy` is any callable
+// Appends to `candidates` every reading with m ≥ min(min_evidence, min_weak_evidence) whose
+// height lies in the robot's band (slice_height_m(p, 0) .. slice_height_m(p, n − 1)) and where
+// the model says free: occupancy(α, h, r) < p.safe_occupancy. `occupancy` is any callable
 // (α [rad], h [m], r [m]) → m, e.g. the fitted ALN. Returns the number of readings that did
-// not fit (the list was full); those are not kept.
+// not fit (the list was full). Those are dropped, not kept: the list holds the first ones in
+// reading order, so with a full list a surface seen late in the readings may go unguarded.
+// kMaxGuardCandidates is sized so that this does not happen in a room the model explains
+// (only unexplained features get here); a caller that gets a non-zero count should report it
+// (the guard is then incomplete, not wrong).
 template <typename Occupancy>
 std::size_t collect_unexplained_features(std::span<const evidence::Reading> readings,
                                          const Occupancy& occupancy, const ExtractionParams& p,
@@ -53,8 +85,8 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
   const float h_hi = slice_height_m(p, p.height_count == 0 ? 0 : p.height_count - 1);
   std::size_t lost = 0;
   for (const evidence::Reading& rd : readings) {
-    if (!(rd.m >= g.min_evidence) || !(rd.h_m >= h_lo && rd.h_m <= h_hi) ||
-        !(rd.r_m > std::fabs(rd.h_m))) {
+    if (!(rd.m >= std::fmin(g.min_evidence, g.min_weak_evidence)) ||
+        !(rd.h_m >= h_lo && rd.h_m <= h_hi) || !(rd.r_m > std::fabs(rd.h_m))) {
       continue;
     }
     if (!(occupancy(rd.alpha_rad, rd.h_m, rd.r_m) < p.safe_occupancy)) {
@@ -62,7 +94,7 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
     }
     const float rho = std::sqrt(rd.r_m * rd.r_m - rd.h_m * rd.h_m);
     if (!candidates.push_back(
-            {rho * std::cos(rd.alpha_rad), rho * std::sin(rd.alpha_rad), rd.h_m})) {
+            {rho * std::cos(rd.alpha_rad), rho * std::sin(rd.alpha_rad), rd.h_m, rd.r_m, rd.m})) {
       ++lost;
     }
   }
@@ -70,9 +102,14 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
 }
 
 // Appends the candidates (robot frame, as x, y) with at least min_neighbours other
-// candidates within neighbour_radius_m. O(n²) over the candidates, which are few: the
-// features the model explains never get here. Returns false if `out` was full.
+// candidates (min_weak_neighbours for a weak one, m < min_evidence) within the pair's
+// neighbour radius (FeatureGuardParams). Neighbours of either kind count. O(n²) over the
+// candidates, which are few: the features the model explains never get here. Returns false
+// if `out` was full.
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
                          GuardPoints& out);
+
+// Whether candidates a and b corroborate each other (the rule above).
+bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuardParams& g);
 
 }  // namespace boticelli::mapping
