@@ -4,6 +4,9 @@
 #include <limits>
 #include <numbers>
 
+#include "algo/evidence/ray_samples.h"
+#include "algo/evidence/reading_limits.h"
+
 namespace boticelli::evidence {
 
 // How far the α = 0/2π seam copies reach beyond [0, 2π) (§4.9.1) [rad].
@@ -31,6 +34,17 @@ void configure_occupancy_model(Model& model, float lowest_h_m, float highest_h_m
   model.set_weight_bounds(0, -kMaxAlphaSlopePerRad, kMaxAlphaSlopePerRad);
   model.set_weight_bounds(1, -kMaxHeightSlopePerM, kMaxHeightSlopePerM);
   model.set_weight_bounds(2, kMinRangeSlopePerM, std::numeric_limits<float>::infinity());
+}
+
+// The same from the reading limits the stereo output was filtered with: the input box is
+// model_box(limits, ray_sample_reach(rays, bound)), which holds every ray sample of every
+// reading within the limits, so the model, the pads (pad_region) and the readings agree.
+template <typename Model>
+void configure_occupancy_model(Model& model, const ReadingLimits& limits,
+                               const RaySampleParams& rays = RaySampleParams{},
+                               OccupancyBound bound = OccupancyBound::kPlausibility) {
+  const ModelBox box = model_box(limits, ray_sample_reach(rays, bound));
+  configure_occupancy_model(model, box.lowest_h_m, box.highest_h_m, box.max_range_m);
 }
 
 }  // namespace boticelli::evidence
