@@ -281,3 +281,58 @@ TEST(WorldLoader, AStartInsideAnObstacleIsRejectedByTheSimulation) {
   CHECK_FALSE(g_sim.init(g_world, rig, SimParams{}, g_error, sizeof g_error));
   CHECK(std::strstr(g_error, "crate") != nullptr);
 }
+
+namespace {
+// A 0.2 m cube at (3 + 0.3 i, 3) with the given pattern and seed.
+std::string patterned_box(int i, const char* pattern, int seed) {
+  return "<model name=\"p" + std::to_string(i) + "\"><pose>" + std::to_string(3.0 + 0.3 * i) +
+         " 3 0.5 0 0 0</pose><link name=\"l\"><visual name=\"v\"><geometry><box><size>0.2 0.2 "
+         "0.2</size></box></geometry><boticelli:pattern seed=\"" +
+         std::to_string(seed) + "\">" + pattern + "</boticelli:pattern></visual></link></model>\n";
+}
+}  // namespace
+
+TEST(WorldLoader, AWorldWithSixtyFourDistinctPatternSeedsGetsSixtyFourTextures) {
+  // 56 camouflage seeds and the 8 leaves seeds a bank holds: 64 distinct pairs.
+  std::string models;
+  for (int i = 0; i < 56; ++i) models += patterned_box(i, "camouflage", 100 + i);
+  for (int i = 0; i < 8; ++i) models += patterned_box(56 + i, "leaves", 100 + i);
+  CHECK_TEXT(parse(small_world(models)), g_error);
+  CHECK_TEXT(g_bank.build(g_world, g_error, sizeof g_error), g_error);
+  CHECK_EQUAL(kMaxTextures, g_bank.size());
+  bool used[kMaxTextures] = {};
+  for (std::size_t i = 0; i < g_world.surface_count; ++i) {
+    const int t = g_world.surfaces[i].texture;
+    if (g_world.surfaces[i].pattern == Pattern::kPaper) continue;
+    CHECK(t >= 0 && t < static_cast<int>(kMaxTextures));
+    CHECK_FALSE(used[t]);
+    used[t] = true;
+  }
+  // Distinct seeds give distinct cloth: the first and last camouflage differ somewhere.
+  const int first = g_world.surfaces[1].texture;
+  const int last = g_world.surfaces[56].texture;
+  int differing = 0;
+  for (std::uint32_t x = 0; x < kTextureSize; ++x) {
+    differing += g_bank.texel(first, x, 7) != g_bank.texel(last, x, 7) ? 1 : 0;
+  }
+  CHECK(differing > 100);
+  // The bank stays a few MB: 2 bits a camouflage texel, a byte a leaves texel.
+  CHECK(sizeof(TextureBank) < (7U << 20U));
+}
+
+TEST(WorldLoader, MoreDistinctPatternSeedsThanTheBankHoldsAreRejected) {
+  std::string models;
+  for (int i = 0; i <= static_cast<int>(kMaxTextures); ++i) {
+    models += patterned_box(i, "camouflage", 100 + i);
+  }
+  CHECK_TEXT(parse(small_world(models)), g_error);
+  CHECK_FALSE(g_bank.build(g_world, g_error, sizeof g_error));
+  CHECK(std::strstr(g_error, "more than 64 distinct pattern seeds") != nullptr);
+  std::string trees;
+  for (int i = 0; i <= static_cast<int>(kMaxLeavesTextures); ++i) {
+    trees += patterned_box(i, "leaves", 100 + i);
+  }
+  CHECK_TEXT(parse(small_world(trees)), g_error);
+  CHECK_FALSE(g_bank.build(g_world, g_error, sizeof g_error));
+  CHECK(std::strstr(g_error, "distinct leaves seeds") != nullptr);
+}

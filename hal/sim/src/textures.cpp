@@ -65,10 +65,9 @@ class ValueNoise {
   std::vector<float> weight_y_;
 };
 
-void make_camouflage(std::uint32_t seed, std::uint8_t* out) {
+// Writes the tone indices (kCamouflageTones), 2 bits per texel, into `packed`.
+void make_camouflage(std::uint32_t seed, std::uint8_t* packed) {
   constexpr std::uint32_t kBlotchCells = kTextureSize / static_cast<std::uint32_t>(kTexelsPerScale);
-  // Four cloth tones (intensity factors x128): dark, mid, light, pale.
-  constexpr std::uint8_t kTones[4] = {38, 96, 150, 210};
   const ValueNoise coarse(seed, kBlotchCells, kBlotchCells);
   const ValueNoise medium(seed + 101U, 2 * kBlotchCells, 2 * kBlotchCells);
   const ValueNoise fine(seed + 202U, 4 * kBlotchCells, 4 * kBlotchCells);
@@ -78,10 +77,15 @@ void make_camouflage(std::uint32_t seed, std::uint8_t* out) {
     coarse.add_row(y, 0.62F, row.data());
     medium.add_row(y, 0.28F, row.data());
     fine.add_row(y, 0.10F, row.data());
-    for (std::uint32_t x = 0; x < kTextureSize; ++x) {
-      const float n = row[x];
-      const int tone = n < 0.40F ? 0 : (n < 0.50F ? 1 : (n < 0.60F ? 2 : 3));
-      out[y * kTextureSize + x] = kTones[tone];
+    std::uint8_t* out = packed + y * (kTextureSize / 4U);
+    for (std::uint32_t x = 0; x < kTextureSize; x += 4U) {
+      std::uint32_t byte = 0;
+      for (std::uint32_t k = 0; k < 4U; ++k) {
+        const float n = row[x + k];
+        const std::uint32_t tone = n < 0.40F ? 0U : (n < 0.50F ? 1U : (n < 0.60F ? 2U : 3U));
+        byte |= tone << (2U * k);
+      }
+      out[x / 4U] = static_cast<std::uint8_t>(byte);
     }
   }
 }
@@ -108,6 +112,7 @@ void make_leaves(std::uint32_t seed, std::uint8_t* out) {
 
 bool TextureBank::build(World& world, char* error, std::size_t error_size) {
   count_ = 0;
+  leaves_count_ = 0;
   for (std::size_t i = 0; i < world.surface_count; ++i) {
     Surface& s = world.surfaces[i];
     if (s.pattern != Pattern::kCamouflage && s.pattern != Pattern::kLeaves) continue;
@@ -120,11 +125,19 @@ bool TextureBank::build(World& world, char* error, std::size_t error_size) {
                       kMaxTextures);
         return false;
       }
-      keys_[k] = {s.pattern, s.pattern_seed};
+      if (s.pattern == Pattern::kLeaves && leaves_count_ == kMaxLeavesTextures) {
+        std::snprintf(error, error_size,
+                      "line %d: more than %zu distinct leaves seeds (reuse seeds)", s.line,
+                      kMaxLeavesTextures);
+        return false;
+      }
       if (s.pattern == Pattern::kCamouflage) {
-        make_camouflage(s.pattern_seed, texels_[k]);
+        keys_[k] = {s.pattern, s.pattern_seed, k};
+        make_camouflage(s.pattern_seed, camouflage_[k]);
       } else {
-        make_leaves(s.pattern_seed, texels_[k]);
+        keys_[k] = {s.pattern, s.pattern_seed, leaves_count_};
+        make_leaves(s.pattern_seed, leaves_[leaves_count_]);
+        ++leaves_count_;
       }
       ++count_;
     }
@@ -134,7 +147,7 @@ bool TextureBank::build(World& world, char* error, std::size_t error_size) {
 }
 
 float TextureBank::sample(int texture, float u, float v) const {
-  const std::uint8_t* t = texels_[static_cast<std::size_t>(texture)];
+  const Key& key = keys_[static_cast<std::size_t>(texture)];
   // floor() through a 32-bit int (u, v are bounded: the world is within 1000 m and a texel
   // is at least 0.6 mm, so |u|, |v| < 2e6); then wrap into the period.
   std::int32_t iu = static_cast<std::int32_t>(u);
@@ -148,16 +161,31 @@ float TextureBank::sample(int texture, float u, float v) const {
   const std::uint32_t y0 = static_cast<std::uint32_t>(iv) & kMask;
   const std::uint32_t x1 = (x0 + 1U) & kMask;
   const std::uint32_t y1 = (y0 + 1U) & kMask;
+  const std::size_t i00 = std::size_t{y0} * kTextureSize + x0;
+  const std::size_t i01 = std::size_t{y0} * kTextureSize + x1;
+  const std::size_t i10 = std::size_t{y1} * kTextureSize + x0;
+  const std::size_t i11 = std::size_t{y1} * kTextureSize + x1;
+  float t00 = 0.0F;
+  float t01 = 0.0F;
+  float t10 = 0.0F;
+  float t11 = 0.0F;
+  if (key.pattern == Pattern::kLeaves) {
+    const std::uint8_t* t = leaves_[key.slot];
+    t00 = static_cast<float>(t[i00]);
+    t01 = static_cast<float>(t[i01]);
+    t10 = static_cast<float>(t[i10]);
+    t11 = static_cast<float>(t[i11]);
+  } else {
+    const std::uint8_t* t = camouflage_[key.slot];
+    t00 = static_cast<float>(camouflage_tone(t, i00));
+    t01 = static_cast<float>(camouflage_tone(t, i01));
+    t10 = static_cast<float>(camouflage_tone(t, i10));
+    t11 = static_cast<float>(camouflage_tone(t, i11));
+  }
   const float tx = u - fu;
   const float ty = v - fv;
-  const float a = static_cast<float>(t[y0 * kTextureSize + x0]) +
-                  (static_cast<float>(t[y0 * kTextureSize + x1]) -
-                   static_cast<float>(t[y0 * kTextureSize + x0])) *
-                      tx;
-  const float b = static_cast<float>(t[y1 * kTextureSize + x0]) +
-                  (static_cast<float>(t[y1 * kTextureSize + x1]) -
-                   static_cast<float>(t[y1 * kTextureSize + x0])) *
-                      tx;
+  const float a = t00 + (t01 - t00) * tx;
+  const float b = t10 + (t11 - t10) * tx;
   return (a + (b - a) * ty) * (1.0F / 128.0F);
 }
 

@@ -13,7 +13,7 @@ namespace boticelli::hal::sim {
 // Capacities: a world file with more elements than these is rejected, not truncated.
 inline constexpr std::size_t kMaxSurfaces = 256;
 inline constexpr std::size_t kMaxColliders = 256;
-inline constexpr std::size_t kMaxTextures = 12;    // distinct (pattern, seed) pairs
+inline constexpr std::size_t kMaxTextures = 64;    // distinct (pattern, seed) pairs (textures.h)
 inline constexpr std::size_t kMaxNameLength = 63;  // model names, longer ones are cut
 inline constexpr std::size_t kMaxWorldFileBytes = 4U << 20U;
 inline constexpr std::size_t kMaxHullVertices = 8;
