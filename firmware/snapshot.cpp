@@ -619,12 +619,12 @@ void draw_value(Canvas& c, const PanelMap& m, const SnapshotFrame& f, float* fie
   legend.item(kStep, "STEP");
 }
 
+#ifdef BOTICELLI_HAVE_PNG
 const char* errno_text(int e) {
   const char* s = strerrordesc_np(e);  // a constant string: no locale, no buffer, no heap
   return s != nullptr ? s : "unknown error";
 }
 
-#ifdef BOTICELLI_HAVE_PNG
 // libpng callbacks. The memory functions receive the png_struct being built (even the temporary
 // one inside png_create_write_struct_2), whose mem_ptr is the writer.
 png_voidp arena_malloc(png_structp png, png_alloc_size_t size) {

@@ -30,7 +30,7 @@ using boticelli::firmware::SnapshotWriter;
 
 namespace {
 
-SnapshotWriter g_writer;  // ~4 MB: static storage, as on the robot
+SnapshotWriter g_writer;  // ~3.1 MB: static storage, as on the robot
 
 // A synthetic room: walls from (-1.5,-1.5) to (2.5,2.5), a cylinder at (1.5,1.5), the robot at the
 // origin. Panels are laid out in a 5 m square view, 80 px/m.
@@ -213,16 +213,24 @@ TEST(SnapshotWriter, WritingASnapshotMakesNoHeapAllocationAndFitsTheArena) {
   CHECK(g_writer.file_bytes_last() > 1000U);
 }
 
-TEST(SnapshotWriter, AnExhaustedArenaFailsCleanlyAndLeavesNoFileBehind) {
+TEST(SnapshotWriter, AnExhaustedArenaFailsCleanlyAndKeepsThePreviousFileWhole) {
   CHECK_TRUE_TEXT(g_writer.open(dir.c_str(), error, sizeof error), error);
   CHECK_TRUE_TEXT(g_writer.write(synthetic_frame(1), error, sizeof error), error);
+  Image before;
+  CHECK_TRUE(read_png(dir + "/cycle-000001.png", before));
   // Room for libpng's own structures and rows, not for zlib's deflate state: zlib's memory
-  // comes through libpng's callbacks too.
+  // comes through libpng's callbacks too. The same cycle again (a resumed mission) must not
+  // damage the file already there.
   g_writer.limit_arena(64U * 1024U);
-  CHECK_FALSE(g_writer.write(synthetic_frame(2), error, sizeof error));
+  SnapshotFrame moved = synthetic_frame(1);
+  moved.robot.x_m = 1.0F;
+  CHECK_FALSE(g_writer.write(moved, error, sizeof error));
   CHECK_TEXT(std::strstr(error, "arena") != nullptr, error);
   const std::vector<std::string> only_first{"cycle-000001.png"};
   CHECK(only_first == list_dir(dir));
+  Image after;
+  CHECK_TRUE(read_png(dir + "/cycle-000001.png", after));
+  CHECK(before.rgb == after.rgb);
   g_writer.limit_arena(0);
   CHECK_TRUE_TEXT(g_writer.write(synthetic_frame(2), error, sizeof error), error);
   const std::vector<std::string> both{"cycle-000001.png", "cycle-000002.png"};
