@@ -9,6 +9,7 @@
 
 #include "algo/core/fixed_vector.h"
 #include "algo/core/geometry.h"
+#include "algo/mapping/map_points.h"
 
 namespace boticelli::firmware {
 
@@ -21,8 +22,10 @@ struct MissionLogEntry {
 };
 
 struct MissionState {
-  static constexpr std::size_t kMaxObstaclePoints = 2048;
-  static constexpr std::size_t kMaxExplorationPoints = 512;
+  // The global map's capacities (mapping::GlobalMap), so a saved state holds what the map
+  // holds and a restored one fits back into it.
+  static constexpr std::size_t kMaxObstaclePoints = mapping::kMaxObstaclePoints;
+  static constexpr std::size_t kMaxExplorationPoints = mapping::kMaxExplorationPoints;
   static constexpr std::size_t kMaxModelBytes = 64 * 1024;
   static constexpr std::size_t kMaxLogEntries = 128;
 
