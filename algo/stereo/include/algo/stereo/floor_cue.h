@@ -1,0 +1,156 @@
+// Floor-appearance cue: obstacle bases and seen-free floor from one frame and the ground plane.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/reading.h"
+#include "algo/image/low_res_frame.h"
+#include "algo/stereo/rig.h"
+
+namespace boticelli::stereo {
+
+// Appearance-based obstacle detection (Ulrich & Nourbakhsh 2000; Horswill's Polly): what
+// looks like the floor close in front of the robot is floor; walking up an image column
+// from the bottom, the floor appearance stops at the base of the first obstacle, and the
+// floor plane (h = −ptu_height) says how far away that base is. Stereo (§3.4) sees only
+// strong vertical intensity changes; this cue sees plain boxes and featureless walls, and
+// says which floor was actually seen free (unknown is not free).
+//
+// Appearance: each pixel's (Y, Cb, Cr) after undoing the camera's radial vignetting,
+// compared per channel with the floor model's median; a pixel looks like floor when every
+// channel is within the channel's tolerance max(spread_factor · σ, min tolerance), σ the
+// robust spread (1.4826 · median absolute deviation) of the reference pixels.
+struct FloorCueParams {
+  float max_range_m = 3.0F;  // the floor is looked at up to this horizontal distance ρ [m]
+  // Reference region: pixels of the bottom rows whose rays meet the floor at a horizontal
+  // distance ρ from the PTU centre in [reference_min_m, reference_max_m] [m].
+  float reference_min_m = 0.4F;
+  float reference_max_m = 1.0F;
+  std::uint32_t reference_rows_max = 40;     // bottom rows searched for the region [px]
+  std::uint32_t reference_min_pixels = 150;  // fewer: nothing is learned
+  float vignetting = 0.25F;                  // camera's brightness loss at the image corners [0, 1)
+  float spread_factor = 4.0F;                // tolerance in robust standard deviations
+  float min_tolerance_luma = 10.0F;          // smallest luma tolerance [grey levels]
+  float min_tolerance_chroma = 5.0F;         // smallest chroma tolerance [chroma levels]
+  // Learning accepts a region only if at least this fraction of its pixels look like floor,
+  // both to the region's own model and to the model already known (if any).
+  float consistency_min = 0.9F;
+  float learn_rate = 0.5F;         // weight of a new region when updating a model, (0, 1]
+  std::uint32_t column_step = 2;   // every column_step-th column is walked [px]
+  std::uint32_t boundary_run = 3;  // k: non-floor pixels in a row that end the floor [px]
+  // Obstacle readings at the base's ρ, at these heights above the floor [m] (the robot must
+  // not assume a plain object is lower than itself).
+  std::array<float, 4> obstacle_heights_m{0.05F, 0.2F, 0.4F, 0.0F};
+  std::uint32_t obstacle_height_count = 3;
+  // Evidence m of a boundary from its contrast c (how many tolerances the k pixels above
+  // the base are from the floor model, median): evidence_weak at c = 1, rising linearly to
+  // evidence_clear at c ≥ clear_contrast.
+  float evidence_weak = 0.4F;
+  float evidence_clear = 0.9F;
+  float clear_contrast = 2.5F;
+};
+
+// What the floor looks like: per channel (0 Y, 1 Cb, 2 Cr; vignetting undone) [grey levels].
+struct FloorModel {
+  bool valid = false;
+  std::array<float, 3> median{};     // Y in 0..255, Cb and Cr as offsets from 128
+  std::array<float, 3> tolerance{};  // the floor test's half width per channel
+};
+
+enum class FloorLearn : std::uint8_t {
+  kLearned,       // first model, from a self-consistent region
+  kUpdated,       // region agreed with the known model; model blended towards it
+  kNoRegion,      // the geometry gives too few reference pixels at this tilt
+  kNotUniform,    // the region does not agree with itself (something else in it)
+  kInconsistent,  // the region does not look like the known floor (obstacle in front)
+};
+
+// One walk of the last process() call: up the image of the vertical plane through the
+// optical centre and one bottom-row pixel (the floor along it is one line of sight).
+struct FloorColumn {
+  enum class End : std::uint8_t {
+    kBoundary,         // the floor stopped at an obstacle's base
+    kMaxRange,         // the floor reached max_range_m (or the horizon)
+    kImageEdge,        // the walk left the image (top or side) still closer than max_range_m
+    kBlockedAtBottom,  // the bottom row already does not look like floor: nothing said
+  };
+  std::uint32_t u_px = 0;  // the walk's bottom-row pixel column [px]
+  End end = End::kBlockedAtBottom;
+  float azimuth_rad = 0.0F;  // direction of the walk's vertical plane, PTU frame, [0, 2π)
+  float near_rho_m = 0.0F;   // horizontal distance (PTU centre) of its bottom-row floor point [m]
+  float base_rho_m = 0.0F;   // kBoundary: horizontal distance of the obstacle base [m]
+  float free_rho_m = 0.0F;   // horizontal distance of the free reading, 0 if none [m]
+  float evidence = 0.0F;     // kBoundary: m of the obstacle readings
+};
+
+struct FloorCueResult {
+  std::size_t obstacle_readings = 0;  // appended to `obstacles`
+  std::size_t free_readings = 0;      // appended to `free`
+  std::size_t columns = 0;            // columns walked
+  std::size_t boundaries = 0;         // columns ending at an obstacle base
+  bool truncated = false;             // an output was full: some readings were dropped
+  bool model_valid = false;           // false: nothing was done (no floor model yet)
+};
+
+class FloorCue {
+ public:
+  static constexpr std::size_t kMaxColumns = image::LowResFrame::kMaxWidth;
+
+  explicit FloorCue(const RigModel& rig, const FloorCueParams& params = {});
+  [[nodiscard]] const FloorCueParams& params() const { return params_; }
+  [[nodiscard]] const FloorModel& model() const { return model_; }
+  void reset() { model_ = FloorModel{}; }
+
+  // Learns (or, if one is known, updates) the floor model from the frame's reference
+  // region for the PTU at pan/tilt [rad]. Nothing changes unless kLearned or kUpdated.
+  FloorLearn learn(const image::LowResFrame& frame, float pan_rad, float tilt_rad);
+
+  // Walks the columns of one frame (the rig's low resolution) seen at pan/tilt [rad] with
+  // the current model. APPENDS to `obstacles` readings at the base of each boundary (one
+  // per configured height, m from the contrast) and to `free` one reading per column with
+  // m = 0 at the farthest floor point connected to the bottom of the image (the line of
+  // sight to it is free). Never writes past either capacity. Nothing is allocated.
+  FloorCueResult process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
+                         core::FixedVectorBase<evidence::Reading>& obstacles,
+                         core::FixedVectorBase<evidence::Reading>& free);
+
+  // Columns of the last process() call.
+  [[nodiscard]] std::size_t column_count() const { return column_count_; }
+  [[nodiscard]] const FloorColumn& column(std::size_t i) const { return columns_[i]; }
+
+  // Is the pixel floor to the current model? `contrast` gets the largest channel distance
+  // in tolerances (≤ 1 for floor). False without a model.
+  bool looks_like_floor(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
+                        float& contrast) const;
+
+  // Horizontal distances from the PTU centre [m] at which the image's centre column meets
+  // the floor at tilt [rad]: bottom row (near) and top row (far, +inf if the top row is at
+  // or above the horizon). False if no row of the centre column sees the floor.
+  bool floor_coverage(float tilt_rad, float& near_m, float& far_m) const;
+
+ private:
+  // The line of sight from the optical centre at azimuth/elevation [rad] (PTU frame) meets
+  // the floor: the floor point (PTU frame) and its ρ [m].
+  bool sight_floor_point(const CameraPose& pose, float azimuth_rad, float elevation_rad,
+                         Eigen::Vector3f& point, float& rho_m) const;
+  // Ray of pixel (u, v) meets the floor: the floor point (PTU frame) and its ρ [m].
+  bool floor_point(const CameraPose& pose, float u, float v, Eigen::Vector3f& point,
+                   float& rho_m) const;
+  void pixel_values(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
+                    std::array<float, 3>& values) const;
+  float contrast_to(const FloorModel& model, const std::array<float, 3>& values) const;
+
+  RigModel rig_;
+  FloorCueParams params_;
+  FloorModel model_;
+  std::array<FloorColumn, kMaxColumns> columns_{};
+  std::size_t column_count_ = 0;
+  // Reference pixels of the region being learned (compensated values), for the robust stats.
+  static constexpr std::size_t kMaxReference = std::size_t{kMaxColumns} * 64;
+  std::array<std::array<std::uint8_t, 3>, kMaxReference> reference_{};
+};
+
+}  // namespace boticelli::stereo

@@ -1,0 +1,348 @@
+// Floor-appearance cue (Ulrich & Nourbakhsh 2000): floor model, column walk, ground-plane ranging.
+#include "algo/stereo/floor_cue.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "algo/core/angles.h"
+#include "algo/stereo/triangulation.h"
+
+namespace boticelli::stereo {
+
+namespace {
+
+constexpr float kLumaBlack = 16.0F;   // BT.601 limited range: Y = 16 + 219·luminance
+constexpr std::uint32_t kMaxRun = 8;  // cap of boundary_run [px]
+constexpr std::uint32_t kMaxReferenceRows = 64;
+
+// Median and robust spread (1.4826 · MAD) of one channel's histogram of `count` samples.
+void robust_stats(const std::array<std::uint32_t, 256>& histogram, std::size_t count, float& median,
+                  float& sigma) {
+  const std::size_t half = (count + 1) / 2;
+  std::size_t seen = 0;
+  int mid = 0;
+  for (int b = 0; b < 256; ++b) {
+    seen += histogram[static_cast<std::size_t>(b)];
+    if (seen >= half) {
+      mid = b;
+      break;
+    }
+  }
+  // Median absolute deviation: grow a window around the median until it holds half.
+  std::size_t inside = histogram[static_cast<std::size_t>(mid)];
+  int d = 0;
+  while (inside < half && d < 255) {
+    ++d;
+    if (mid - d >= 0) {
+      inside += histogram[static_cast<std::size_t>(mid - d)];
+    }
+    if (mid + d <= 255) {
+      inside += histogram[static_cast<std::size_t>(mid + d)];
+    }
+  }
+  median = static_cast<float>(mid);
+  sigma = 1.4826F * static_cast<float>(d);
+}
+
+// Median of the first n (≤ kMaxRun) values (insertion sort in place).
+float median_of(std::array<float, kMaxRun>& values, std::uint32_t n) {
+  for (std::uint32_t i = 1; i < n && i < kMaxRun; ++i) {
+    const float x = values[i];
+    std::uint32_t j = i;
+    for (; j > 0 && values[j - 1] > x; --j) {
+      values[j] = values[j - 1];
+    }
+    values[j] = x;
+  }
+  return values[std::min(n, kMaxRun) / 2];
+}
+
+std::uint8_t to_byte(float x) {
+  return static_cast<std::uint8_t>(std::clamp(std::lround(x), 0L, 255L));
+}
+
+}  // namespace
+
+FloorCue::FloorCue(const RigModel& rig, const FloorCueParams& params) : rig_(rig), params_(params) {
+  params_.boundary_run = std::clamp<std::uint32_t>(params_.boundary_run, 1, kMaxRun);
+  params_.column_step = std::max<std::uint32_t>(params_.column_step, 1);
+  params_.obstacle_height_count = std::min<std::uint32_t>(
+      params_.obstacle_height_count, static_cast<std::uint32_t>(params_.obstacle_heights_m.size()));
+  params_.reference_rows_max = std::min(params_.reference_rows_max, kMaxReferenceRows);
+  params_.learn_rate = std::clamp(params_.learn_rate, 0.0F, 1.0F);
+}
+
+bool FloorCue::floor_point(const CameraPose& pose, float u, float v, Eigen::Vector3f& point,
+                           float& rho_m) const {
+  const Eigen::Vector3f ray = RigModel::ray_ptu(pose, rig_.low_res_camera(), Eigen::Vector2f(u, v));
+  if (!(ray.z() < -1e-6F)) {
+    return false;  // at or above the horizon
+  }
+  const float floor_z = -rig_.params().ptu_height_m;  // the floor in the PTU frame [m]
+  const float t = (floor_z - pose.centre_m.z()) / ray.z();
+  if (!(t > 0.0F)) {
+    return false;
+  }
+  point = pose.centre_m + t * ray;
+  rho_m = std::hypot(point.x(), point.y());
+  return true;
+}
+
+void FloorCue::pixel_values(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
+                            std::array<float, 3>& values) const {
+  // Vignetting as a radial quadratic fall-off to (1 − vignetting) in the corners; undone so
+  // the floor looks the same everywhere in the image.
+  const float cx = 0.5F * static_cast<float>(frame.width - 1);
+  const float cy = 0.5F * static_cast<float>(frame.height - 1);
+  const float dx = static_cast<float>(u) - cx;
+  const float dy = static_cast<float>(v) - cy;
+  const float gain = 1.0F / (1.0F - params_.vignetting * (dx * dx + dy * dy) / (cx * cx + cy * cy));
+  values[0] = kLumaBlack + (frame.y(u, v) - kLumaBlack) * gain;
+  values[1] = static_cast<float>(frame.cb(u, v)) * gain;
+  values[2] = static_cast<float>(frame.cr(u, v)) * gain;
+}
+
+float FloorCue::contrast_to(const FloorModel& model, const std::array<float, 3>& values) const {
+  float worst = 0.0F;
+  for (std::size_t c = 0; c < 3; ++c) {
+    worst = std::max(worst, std::fabs(values[c] - model.median[c]) / model.tolerance[c]);
+  }
+  return worst;
+}
+
+bool FloorCue::looks_like_floor(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
+                                float& contrast) const {
+  contrast = std::numeric_limits<float>::infinity();
+  if (!model_.valid || u >= frame.width || v >= frame.height) {
+    return false;
+  }
+  std::array<float, 3> values{};
+  pixel_values(frame, u, v, values);
+  contrast = contrast_to(model_, values);
+  return contrast <= 1.0F;
+}
+
+FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float tilt_rad) {
+  if (frame.width < 2 || frame.height < 2) {
+    return FloorLearn::kNoRegion;
+  }
+  const CameraPose pose = rig_.camera_pose(pan_rad, tilt_rad);
+  std::array<std::array<std::uint32_t, 256>, 3> histogram{};
+  std::size_t count = 0;
+  const std::uint32_t rows = std::min(params_.reference_rows_max, frame.height);
+  for (std::uint32_t k = 0; k < rows; ++k) {
+    const std::uint32_t v = frame.height - 1 - k;
+    for (std::uint32_t u = 0; u < frame.width && count < kMaxReference; ++u) {
+      Eigen::Vector3f point;
+      float rho = 0.0F;
+      if (!floor_point(pose, static_cast<float>(u), static_cast<float>(v), point, rho) ||
+          rho < params_.reference_min_m || rho > params_.reference_max_m) {
+        continue;
+      }
+      std::array<float, 3> values{};
+      pixel_values(frame, u, v, values);
+      auto& stored = reference_[count++];
+      stored = {to_byte(values[0]), to_byte(values[1] + 128.0F), to_byte(values[2] + 128.0F)};
+      for (std::size_t c = 0; c < 3; ++c) {
+        ++histogram[c][stored[c]];
+      }
+    }
+  }
+  if (count < params_.reference_min_pixels || count == 0) {
+    return FloorLearn::kNoRegion;
+  }
+  FloorModel candidate;
+  candidate.valid = true;
+  const std::array<float, 3> min_tolerance{params_.min_tolerance_luma, params_.min_tolerance_chroma,
+                                           params_.min_tolerance_chroma};
+  for (std::size_t c = 0; c < 3; ++c) {
+    float median = 0.0F;
+    float sigma = 0.0F;
+    robust_stats(histogram[c], count, median, sigma);
+    candidate.median[c] = c == 0 ? median : median - 128.0F;
+    candidate.tolerance[c] = std::max(params_.spread_factor * sigma, min_tolerance[c]);
+  }
+  // Consistency: the region must look like floor to its own model (an obstacle covering
+  // part of it fails here) and to the model already known (one covering all of it).
+  std::size_t own = 0;
+  std::size_t known = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
+                                      static_cast<float>(reference_[i][1]) - 128.0F,
+                                      static_cast<float>(reference_[i][2]) - 128.0F};
+    own += contrast_to(candidate, values) <= 1.0F ? 1U : 0U;
+    known += model_.valid && contrast_to(model_, values) <= 1.0F ? 1U : 0U;
+  }
+  const auto needed =
+      static_cast<std::size_t>(std::ceil(params_.consistency_min * static_cast<float>(count)));
+  if (model_.valid && known < needed) {
+    return FloorLearn::kInconsistent;
+  }
+  if (own < needed) {
+    return FloorLearn::kNotUniform;
+  }
+  if (!model_.valid) {
+    model_ = candidate;
+    return FloorLearn::kLearned;
+  }
+  const float w = params_.learn_rate;
+  for (std::size_t c = 0; c < 3; ++c) {
+    model_.median[c] += w * (candidate.median[c] - model_.median[c]);
+    model_.tolerance[c] += w * (candidate.tolerance[c] - model_.tolerance[c]);
+  }
+  return FloorLearn::kUpdated;
+}
+
+bool FloorCue::sight_floor_point(const CameraPose& pose, float azimuth_rad, float elevation_rad,
+                                 Eigen::Vector3f& point, float& rho_m) const {
+  if (!(elevation_rad < -1e-4F)) {
+    return false;  // at or above the horizon
+  }
+  const float floor_z = -rig_.params().ptu_height_m;  // the floor in the PTU frame [m]
+  const float s = (pose.centre_m.z() - floor_z) / std::tan(-elevation_rad);  // along the floor
+  point = Eigen::Vector3f(pose.centre_m.x() + s * std::cos(azimuth_rad),
+                          pose.centre_m.y() + s * std::sin(azimuth_rad), floor_z);
+  rho_m = std::hypot(point.x(), point.y());
+  return true;
+}
+
+FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
+                                 core::FixedVectorBase<evidence::Reading>& obstacles,
+                                 core::FixedVectorBase<evidence::Reading>& free) {
+  FloorCueResult result;
+  column_count_ = 0;
+  result.model_valid = model_.valid;
+  if (!model_.valid || frame.width == 0 || frame.height == 0) {
+    return result;
+  }
+  const CameraPose pose = rig_.camera_pose(pan_rad, tilt_rad);
+  const CameraIntrinsics& camera = rig_.low_res_camera();
+  const float floor_h = -rig_.params().ptu_height_m;
+  const std::uint32_t k = params_.boundary_run;
+  // One image row per step near the image centre [rad]; the walk needs at most ~2 per row.
+  const float step_rad = 1.0F / camera.focal_px;
+  const auto max_steps = 2U * frame.height;
+  const float bottom_v = static_cast<float>(frame.height - 1);
+  for (std::uint32_t u = 0; u < frame.width && column_count_ < kMaxColumns;
+       u += params_.column_step) {
+    FloorColumn& col = columns_[column_count_++];
+    col = FloorColumn{};
+    col.u_px = u;
+    // The walk: up the vertical plane through the optical centre and this bottom pixel,
+    // so a vertical obstacle edge stays on one side of it (image columns are not vertical
+    // planes once the camera is tilted).
+    const Eigen::Vector3f bottom_ray =
+        RigModel::ray_ptu(pose, camera, Eigen::Vector2f(static_cast<float>(u), bottom_v));
+    const float azimuth = std::atan2(bottom_ray.y(), bottom_ray.x());
+    const float elevation0 = std::atan2(bottom_ray.z(), std::hypot(bottom_ray.x(), bottom_ray.y()));
+    col.azimuth_rad = core::wrap_two_pi(azimuth);
+    bool have_floor = false;  // a floor pixel connected to the bottom
+    Eigen::Vector3f free_point = Eigen::Vector3f::Zero();
+    std::uint32_t run = 0;
+    std::uint32_t run_start = 0;  // step of the first non-floor pixel of the run
+    std::array<float, kMaxRun> run_contrast{};
+    col.end = FloorColumn::End::kImageEdge;
+    for (std::uint32_t step = 0; step < max_steps; ++step) {
+      const float elevation = elevation0 + static_cast<float>(step) * step_rad;
+      Eigen::Vector3f point;
+      float rho = 0.0F;
+      if (!sight_floor_point(pose, azimuth, elevation, point, rho) || rho > params_.max_range_m) {
+        col.end = FloorColumn::End::kMaxRange;
+        break;
+      }
+      if (step == 0) {
+        col.near_rho_m = rho;
+      }
+      Eigen::Vector2f pixel;
+      if (!RigModel::project_ptu(pose, camera, point, pixel)) {
+        break;
+      }
+      const long pu = std::lround(pixel.x());
+      const long pv = std::lround(pixel.y());
+      if (pu < 0 || pv < 0 || pu >= static_cast<long>(frame.width) ||
+          pv >= static_cast<long>(frame.height)) {
+        break;  // left the image: at its top or side
+      }
+      float contrast = 0.0F;
+      if (looks_like_floor(frame, static_cast<std::uint32_t>(pu), static_cast<std::uint32_t>(pv),
+                           contrast)) {
+        run = 0;
+        have_floor = true;
+        free_point = point;
+        continue;
+      }
+      if (run == 0) {
+        run_start = step;
+      }
+      run_contrast[run++] = contrast;
+      if (run >= k) {
+        col.end = FloorColumn::End::kBoundary;
+        break;
+      }
+    }
+    if (col.end == FloorColumn::End::kBoundary && run_start == 0) {
+      // Not floor from the first row: the obstacle may be anywhere nearer; say nothing.
+      col.end = FloorColumn::End::kBlockedAtBottom;
+    }
+    if (col.end == FloorColumn::End::kBoundary) {
+      // The base: between the last floor sample and the first obstacle sample.
+      const float elevation = elevation0 + (static_cast<float>(run_start) - 0.5F) * step_rad;
+      Eigen::Vector3f base;
+      float rho = 0.0F;
+      if (sight_floor_point(pose, azimuth, elevation, base, rho)) {
+        const float c = median_of(run_contrast, k);
+        const float ramp =
+            std::clamp((c - 1.0F) / std::max(params_.clear_contrast - 1.0F, 1e-3F), 0.0F, 1.0F);
+        const float m =
+            params_.evidence_weak + ramp * (params_.evidence_clear - params_.evidence_weak);
+        col.base_rho_m = rho;
+        col.evidence = m;
+        ++result.boundaries;
+        for (std::uint32_t i = 0; i < params_.obstacle_height_count; ++i) {
+          const Eigen::Vector3f p(base.x(), base.y(), floor_h + params_.obstacle_heights_m[i]);
+          if (obstacles.push_back(reading_from_point(p, m))) {
+            ++result.obstacle_readings;
+          } else {
+            result.truncated = true;
+          }
+        }
+      } else {
+        col.end = FloorColumn::End::kBlockedAtBottom;
+      }
+    }
+    if (have_floor) {
+      col.free_rho_m = std::hypot(free_point.x(), free_point.y());
+      if (free.push_back(reading_from_point(free_point, 0.0F))) {
+        ++result.free_readings;
+      } else {
+        result.truncated = true;
+      }
+    }
+  }
+  result.columns = column_count_;
+  return result;
+}
+
+bool FloorCue::floor_coverage(float tilt_rad, float& near_m, float& far_m) const {
+  const CameraPose pose = rig_.camera_pose(0.0F, tilt_rad);
+  const CameraIntrinsics& camera = rig_.low_res_camera();
+  const auto u = static_cast<float>(camera.width_px / 2);
+  near_m = std::numeric_limits<float>::infinity();
+  far_m = 0.0F;
+  bool any = false;
+  for (std::uint32_t v = 0; v < camera.height_px; ++v) {
+    Eigen::Vector3f point;
+    float rho = 0.0F;
+    if (floor_point(pose, u, static_cast<float>(v), point, rho)) {
+      any = true;
+      near_m = std::min(near_m, rho);
+      far_m = std::max(far_m, rho);
+    } else {
+      far_m = std::numeric_limits<float>::infinity();
+    }
+  }
+  return any;
+}
+
+}  // namespace boticelli::stereo
