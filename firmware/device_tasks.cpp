@@ -7,7 +7,14 @@ void CameraTask::run(std::uint64_t now_us) {
   if (!seen_time_) {
     seen_time_ = true;
     last_frame_us_ = now_us;
+    last_poll_us_ = now_us - idle_poll_us_;
   }
+  // Nobody wants a frame: poll seldom (a stalled camera is still noticed).
+  if (consumer_ != nullptr && !consumer_->wants_frames() &&
+      now_us - last_poll_us_ < idle_poll_us_) {
+    return;
+  }
+  last_poll_us_ = now_us;
   hal::Frame frame;
   switch (camera_.poll(frame)) {
     case hal::CameraPoll::kFrame:

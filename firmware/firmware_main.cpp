@@ -10,7 +10,8 @@
 #include "firmware/console.h"
 #include "firmware/device_tasks.h"
 #include "firmware/executive.h"
-#include "firmware/idle_mission.h"
+#include "firmware/mission/mission.h"
+#include "firmware/mission/trace_writer.h"
 #include "firmware/mission_state.h"
 #include "firmware/options.h"
 #include "firmware/parameters.h"
@@ -18,6 +19,7 @@
 #include "firmware/realtime.h"
 #include "firmware/safety.h"
 #include "firmware/service_notify.h"
+#include "firmware/snapshot.h"
 #include "firmware/state_saver.h"
 #include "firmware/task_table.h"
 
@@ -41,34 +43,41 @@ double wall_seconds() {
 MissionState g_state;
 StateStore g_store;
 ParameterTable g_parameters;
+mission::TraceWriter g_trace;
+SnapshotWriter g_snapshots;
 
 // Everything that is bound to the board's devices, rebuilt in place for each run (static
 // storage, no heap; firmware_main may be called again, e.g. by tests).
 struct Runtime {
-  Runtime(hal::Hal& hal, const BoardConfig& config, StateStore* store)
+  Runtime(hal::Hal& hal, const BoardConfig& config, StateStore* store, const TruthSource* truth,
+          mission::TraceWriter* trace, SnapshotWriter* snapshots)
       : saver(g_store),
         executive(hal.clock),
         safety(hal.estop, hal.bumper, hal.base),
-        mission(hal.base, hal.pan_tilt, hal.clock, g_state, store != nullptr ? &saver : nullptr,
-                config.checkpoint_period_ms * 1000U),
+        mission({hal, config, safety, executive, g_state, store != nullptr ? &saver : nullptr,
+                 truth, trace, snapshots}),
         console(hal.console, executive, safety, mission, g_parameters),
         estop_task(safety),
         base_task(hal.base, safety),
         ptu_task(hal.pan_tilt),
         camera_task(hal.camera),
+        mission_task(mission),
         console_task(console),
-        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {}
+        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {
+    camera_task.set_consumer(&mission);
+  }
 
   ServiceNotifier notifier;
   StateSaver saver;
   Executive executive;
   Safety safety;
-  IdleMission mission;
+  mission::Mission mission;
   Console console;
   EstopTask estop_task;
   BaseTask base_task;
   PanTiltTask ptu_task;
   CameraTask camera_task;
+  mission::MissionTask mission_task;
   ConsoleTask console_task;
   WatchdogTask watchdog_task;
 };
@@ -139,8 +148,17 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
       std::fprintf(stderr, "boticelli: watchdog not armed (%s)\n", hal.watchdog.error());
     }
   }
+  if (options.trace_file != nullptr && !g_trace.open(options.trace_file, error, sizeof error)) {
+    return fail(error, "");
+  }
+  if (options.snapshots_dir != nullptr &&
+      !g_snapshots.open(options.snapshots_dir, error, sizeof error)) {
+    return fail(error, "");
+  }
   g_parameters = ParameterTable{};
-  g_runtime.emplace(hal, config, store);
+  g_runtime.emplace(hal, config, store, board.truth(),
+                    options.trace_file != nullptr ? &g_trace : nullptr,
+                    options.snapshots_dir != nullptr ? &g_snapshots : nullptr);
   Runtime& rt = *g_runtime;
   // On a real-time board the state is written by a thread of its own (fsync can take tens
   // of milliseconds on an SD card); on the simulation it is written in the background slot.
@@ -149,12 +167,13 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   if (!notifier.open()) std::fprintf(stderr, "boticelli: %s\n", notifier.error());
   Executive& executive = rt.executive;
   Safety& safety = rt.safety;
-  IdleMission& mission = rt.mission;
+  mission::Mission& mission = rt.mission;
   Console& console = rt.console;
 
   // The executive and its tasks.
-  Task* const tasks[kTaskCount] = {&rt.estop_task,  &rt.base_task,    &rt.ptu_task,
-                                   &rt.camera_task, &rt.console_task, &rt.watchdog_task};
+  Task* const tasks[kTaskCount] = {&rt.estop_task,   &rt.base_task,    &rt.ptu_task,
+                                   &rt.camera_task,  &rt.mission_task, &rt.console_task,
+                                   &rt.watchdog_task};
   const char* why = "";
   for (std::size_t i = 0; i < kTaskCount; ++i) {
     if (!executive.add_task(kTaskTable[i], *tasks[i], &why)) return fail("executive", why);
@@ -207,6 +226,18 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
       stop_reason = "max cycles";
       break;
     }
+    if (mission.finished()) {
+      stop_reason = mission.end_reason();
+      break;
+    }
+  }
+  if (!mission.finished()) {
+    // Stopped from outside: --max-cycles is the end of the search, anything else an abort.
+    if (options.max_cycles != 0 && mission.cycles_this_run() >= options.max_cycles) {
+      mission.finish_not_found("max cycles");
+    } else {
+      mission.abort(stop_reason);
+    }
   }
 
   // Orderly stop: base and PTU halted, watchdog disarmed, console drained (bounded).
@@ -215,6 +246,8 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   hal.pan_tilt.halt();
   if (watchdog_armed) hal.watchdog.stop();
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
+  console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
+              mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
   for (int i = 0; i < 50 && console.pending_output() > 0 && console.healthy(); ++i) {
     console.drain();
     hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);
@@ -225,18 +258,21 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
     std::fprintf(stderr, "boticelli: %llu state saves failed, last: %s\n",
                  static_cast<unsigned long long>(rt.saver.failures()), error);
   }
+  if (g_trace.is_open() && !g_trace.close(error, sizeof error)) {
+    std::fprintf(stderr, "boticelli: %s\n", error);
+  }
   const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
-  // No mission yet: the run ends aborted (never found), with no target estimate.
+  const mission::Result result = mission.result();
   std::printf(
-      "MISSION result=aborted cycles=%llu collisions=%llu sim_time_s=%.3f wall_time_s=%.3f "
-      "target_error_m=nan\n",
-      static_cast<unsigned long long>(g_state.cycle),
+      "MISSION result=%s cycles=%llu collisions=%llu sim_time_s=%.3f wall_time_s=%.3f "
+      "target_error_m=%.3f\n",
+      mission::result_name(result), static_cast<unsigned long long>(g_state.cycle),
       static_cast<unsigned long long>(safety.collisions()), sim_time_s,
-      wall_seconds() - wall_start_s);
+      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()));
   std::fflush(stdout);
   g_runtime.reset();
   g_signal = 0;
-  return kExitNotFound;
+  return result == mission::Result::kFound ? kExitFound : kExitNotFound;
 }
 
 }  // namespace boticelli::firmware

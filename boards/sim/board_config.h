@@ -6,6 +6,7 @@
 
 #include "algo/stereo/rig.h"
 #include "firmware/board.h"
+#include "firmware/mission/mission_params.h"
 #include "hal/sim/renderer.h"
 #include "hal/sim/sim_world.h"
 
@@ -64,18 +65,7 @@ inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t s
 
 // The rig the renderer uses: built from the same config the firmware's stereo code reads.
 inline stereo::RigParams make_rig_params(const firmware::BoardConfig& c) {
-  stereo::RigParams p;
-  p.camera.width_px = c.camera_width_px;
-  p.camera.height_px = c.camera_height_px;
-  p.camera.focal_px = c.focal_px;
-  p.camera.principal_x_px = c.principal_x_px;
-  p.camera.principal_y_px = c.principal_y_px;
-  p.camera.radial_k1 = c.radial_k1;
-  p.lever_m = c.lever_m;
-  p.support_angle_rad = c.support_angle_rad;
-  p.ptu_height_m = c.ptu_height_m;
-  p.tilt_step_rad = c.tilt_step_rad;
-  return p;
+  return firmware::mission::make_rig_params(c);
 }
 
 }  // namespace boticelli::boards::sim

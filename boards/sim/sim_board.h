@@ -1,8 +1,10 @@
 // SimBoard: the host simulation board — sim HAL devices on one SimWorld loaded from --world.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <optional>
+#include <span>
 
 #include "board_config.h"
 #include "firmware/board.h"
@@ -25,13 +27,24 @@ namespace boticelli::boards::sim {
 // test's. init() loads the world (--world, else the shipped thesis room), builds textures,
 // rig, physics and renderer; the firmware then calls init()/open() of each device. The
 // sim-only accessors give tests the ground truth the firmware never sees.
-class SimBoard final : public firmware::Board {
+class SimBoard final : public firmware::Board, public firmware::TruthSource {
  public:
   SimBoard();
   const firmware::BoardInfo& info() const override { return kInfo; }
   const firmware::BoardConfig& config() const override { return config_; }
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
   hal::Hal& hal() override { return hal_; }
+  const firmware::TruthSource* truth() const override { return this; }
+  // TruthSource: the simulator's own pose and target (trace, target error).
+  core::Pose2 robot_pose() const override { return sim_.true_pose(); }
+  core::Pose2 odometry_origin() const override { return sim_.odometry_origin(); }
+  Eigen::Vector3f target_m() const override { return sim_.target_point_m(); }
+  std::span<const std::span<const core::Point2>> outlines() const override {
+    return {outlines_.data(), outline_count_};
+  }
+  std::span<const firmware::SnapshotCircle> circles() const override {
+    return {circles_.data(), circle_count_};
+  }
 
   // ---- sim-only: ground truth and scripting (valid after a successful init) ----
   hal::sim::SimWorld& sim() { return sim_; }  // true pose, collisions, target, e-stop script
@@ -62,6 +75,10 @@ class SimBoard final : public firmware::Board {
   hal::sim::WatchdogSim watchdog_;
   hal_linux::ConsolePort console_;
   hal::Hal hal_;
+  std::array<std::span<const core::Point2>, hal::sim::kMaxColliders> outlines_{};
+  std::size_t outline_count_ = 0;
+  std::array<firmware::SnapshotCircle, hal::sim::kMaxColliders> circles_{};
+  std::size_t circle_count_ = 0;
 };
 
 }  // namespace boticelli::boards::sim

@@ -1,10 +1,16 @@
 // Board: what a board folder hands the firmware — its description, its config and its HAL bag.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
+#include <Eigen/Core>
+
+#include "algo/core/geometry.h"
 #include "firmware/options.h"
+#include "firmware/snapshot.h"
 #include "hal/hal.h"
 
 namespace boticelli::firmware {
@@ -51,7 +57,40 @@ struct BoardConfig {
   // Background units per frame (0 = limited by time only); a simulated board may set it so
   // the work done per frame does not depend on the host's speed.
   std::uint32_t background_units_per_slice = 0;
-  std::uint32_t checkpoint_period_ms = 1000;  // idle cycle length until the mission lands
+  std::uint32_t checkpoint_period_ms = 1000;  // state checkpoint period while no cycle ends
+  // The mission's look (§6.2.1, §6.3): pan positions spread over the PTU's pan range (the
+  // camera's 56° field of view closes the circle beyond it), and tilt rows; each row is a
+  // stereo pair (tilt, tilt − Φ) or a single frame for the floor cue only.
+  std::uint32_t look_pan_positions = 15;
+  static constexpr std::size_t kMaxTiltRows = 4;
+  std::array<float, kMaxTiltRows> look_tilt_rad = {0.0F, -0.5F, -0.8F, 0.0F};
+  std::array<bool, kMaxTiltRows> look_tilt_is_pair = {true, true, false, false};
+  std::uint32_t look_tilt_rows = 3;
+  std::uint32_t camera_settle_ms = 60;  // after the PTU stops, before a frame counts [ms]
+  // What the camera can be trusted for (thesis §3.4: about 0.1 m to 4.5 m).
+  float max_range_m = 4.5F;
+  float ceiling_height_m = 2.5F;     // readings above this height are errors [m]
+  float clearance_margin_m = 0.05F;  // kept beyond the robot radius from every obstacle [m]
+  float ground_clearance_m = 0.03F;  // lowest obstacle height the base cannot drive over [m]
+  float goal_standoff_m = 0.55F;     // the mission ends this far from the target [m]
+};
+
+// Ground truth a simulated board can report (never used to decide anything): the trace and
+// the MISSION line's target error. Hardware boards have none.
+class TruthSource {
+ public:
+  virtual ~TruthSource() = default;
+  virtual core::Pose2 robot_pose() const = 0;       // true pose in the world [m, rad]
+  virtual core::Pose2 odometry_origin() const = 0;  // world pose of the odometry frame's origin
+  virtual Eigen::Vector3f target_m() const = 0;     // the true target point in the world [m]
+  // The obstacles seen from above, for pictures: convex outlines and circles (world frame).
+  virtual std::span<const std::span<const core::Point2>> outlines() const { return {}; }
+  virtual std::span<const SnapshotCircle> circles() const { return {}; }
+
+ protected:
+  TruthSource() = default;
+  TruthSource(const TruthSource&) = default;
+  TruthSource& operator=(const TruthSource&) = default;
 };
 
 class Board {
@@ -65,6 +104,8 @@ class Board {
   virtual bool init(const Options& options, char* error, std::size_t error_size) = 0;
   // The devices; valid after a successful init().
   virtual hal::Hal& hal() = 0;
+  // Ground truth, or nullptr (hardware).
+  virtual const TruthSource* truth() const { return nullptr; }
 };
 
 }  // namespace boticelli::firmware

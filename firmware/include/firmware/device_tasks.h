@@ -51,6 +51,9 @@ class FrameConsumer {
  public:
   virtual ~FrameConsumer() = default;
   virtual void on_frame(const hal::Frame& frame) = 0;
+  // False while the consumer has no use for frames: the camera task then polls only every
+  // idle_poll_us (enough to keep its health), so a simulated camera renders only what is used.
+  virtual bool wants_frames() const { return true; }
 
  protected:
   FrameConsumer() = default;
@@ -62,8 +65,9 @@ class FrameConsumer {
 // from quickly, e.g. a re-opened device, does not count against the watchdog).
 class CameraTask final : public Task {
  public:
-  explicit CameraTask(hal::Camera& camera, std::uint64_t stall_us = 2000000)
-      : camera_(camera), stall_us_(stall_us) {}
+  explicit CameraTask(hal::Camera& camera, std::uint64_t stall_us = 2000000,
+                      std::uint64_t idle_poll_us = 1500000)
+      : camera_(camera), stall_us_(stall_us), idle_poll_us_(idle_poll_us) {}
   void set_consumer(FrameConsumer* consumer) { consumer_ = consumer; }
   void run(std::uint64_t now_us) override;
   bool healthy() const override { return healthy_; }
@@ -73,6 +77,8 @@ class CameraTask final : public Task {
  private:
   hal::Camera& camera_;
   std::uint64_t stall_us_;
+  std::uint64_t idle_poll_us_;
+  std::uint64_t last_poll_us_ = 0;
   FrameConsumer* consumer_ = nullptr;
   std::uint64_t last_frame_us_ = 0;
   bool seen_time_ = false;

@@ -12,7 +12,16 @@ namespace boticelli::firmware {
 inline constexpr std::uint32_t kDefaultMinorFrameUs = 10000;  // 10 ms minor frame
 
 // Index of each task in kTaskTable (table order is run order within a frame).
-enum class TaskId : std::uint8_t { kEstop, kBase, kPanTilt, kCamera, kConsole, kWatchdog, kCount };
+enum class TaskId : std::uint8_t {
+  kEstop,
+  kBase,
+  kPanTilt,
+  kCamera,
+  kMission,
+  kConsole,
+  kWatchdog,
+  kCount
+};
 
 inline constexpr std::size_t kTaskCount = static_cast<std::size_t>(TaskId::kCount);
 
@@ -24,6 +33,7 @@ inline constexpr std::array<TaskSpec, kTaskCount> kTaskTable{{
     {"base", 10000, 1000},      // ODrive setpoint re-send, encoder feedback, heartbeats
     {"ptu", 20000, 500},        // PTU-D46 command queue and replies
     {"camera", 10000, 2000},    // V4L2 dequeue / requeue (image work runs in the background)
+    {"mission", 10000, 500},    // mission control: PTU scan, frames, the driven step, holds
     {"console", 10000, 1500},   // serial console: input, commands, telemetry, output
     {"watchdog", 100000, 200},  // /dev/watchdog and systemd WATCHDOG=1 while all healthy
 }};

@@ -261,6 +261,7 @@ void SimWorld::base_start() {
   base_health_ = BaseHealth::kStarting;
   base_error_ = "starting";
   base_ready_at_us_ = now_us_ + params_.base.startup_us;
+  odometry_origin_ = true_pose();
   odometry_ = Odometry{};
   odometry_.timestamp_us = now_us_;
 }

@@ -90,6 +90,8 @@ class SimWorld {
   BaseHealth base_health() const { return base_health_; }
   const char* base_error() const { return base_error_; }
   Odometry odometry() const { return odometry_; }
+  // The true pose at which the odometry frame was fixed (the last base start).
+  core::Pose2 odometry_origin() const { return odometry_origin_; }
 
   // ---- PTU (driven through PanTiltSim) ----
   PtuAxis& pan() { return pan_; }
@@ -134,6 +136,7 @@ class SimWorld {
   std::uint64_t base_ready_at_us_ = 0;
   bool base_started_ = false;
   Odometry odometry_{};
+  core::Pose2 odometry_origin_{};
   std::uint32_t collisions_ = 0;
   const char* last_collision_model_ = "";
   char collision_error_[96] = {};

@@ -1,0 +1,127 @@
+// Think stage of one look: readings → ray samples → ALN fit → feature guard → navigation polygon,
+// resumable in small units of work.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "algo/aln/aln.h"
+#include "algo/aln/samples.h"
+#include "algo/aln/trainer.h"
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/ray_samples.h"
+#include "algo/evidence/reading.h"
+#include "algo/mapping/aln_free_range.h"
+#include "algo/mapping/extraction.h"
+#include "algo/mapping/feature_guard.h"
+#include "algo/mapping/star_polygon.h"
+
+namespace boticelli::mapping {
+
+inline constexpr std::size_t kLookMaxPieces = 256;
+// Ray samples of one look: 5 per reading for up to ~24k readings and floor rays, plus the
+// seam copies (§4.9.1).
+inline constexpr std::size_t kLookMaxSamples = 196608;
+
+using OccupancyModel = aln::Aln<float, 3, kLookMaxPieces>;
+using OccupancyTrainer = aln::Trainer<float, 3, kLookMaxPieces>;
+using OccupancySample = aln::Sample<float, 3>;
+
+// Everything the Think stage of one look needs, in one place (the mission derives it from the
+// board config once).
+struct LocalModelParams {
+  ExtractionParams extraction;     // slices, m_safe, bounding circle, robot radius
+  evidence::RaySampleParams rays;  // Fig 4.2b samples per reading
+  aln::TrainerConfig trainer;      // ε, piece cap, rounds (§4.7.3)
+  FeatureGuardParams guard;        // features the fit misses
+  float model_lowest_h_m = -0.7F;  // the model's input box: heights relative to the PTU
+  float model_highest_h_m = 1.9F;  //   centre [m] and ranges [m] (ReadingLimits)
+  float model_max_range_m = 5.4F;
+  float seam_margin_rad = 0.5F;  // α copies beyond [0, 2π) (§4.9.1)
+  // Free samples (occupancy 0) on the line of sight to each floor point seen free, at these
+  // fractions of its range: the floor cue's positive evidence of free space.
+  std::size_t free_samples_per_ray = 4;
+  // Only space something showed free counts as free (§4.9.1: unknown is not free): the free
+  // polygon is cut to the farthest floor seen in each vertex direction.
+  bool clamp_to_seen_free = true;
+  std::size_t readings_per_unit = 64;  // work per unit while building samples
+  std::size_t visits_per_unit = 1024;  // trainer sample visits per unit
+};
+
+struct LocalModelStats {
+  std::size_t samples = 0;
+  std::size_t pieces = 0;
+  double rms = 0.0;
+  std::size_t guard_candidates = 0;
+  std::size_t guard_points = 0;
+  std::size_t units = 0;
+  bool model_valid = false;  // the fit was invertible (monotone in r)
+};
+
+// One look's local model. start() takes the look's readings (robot/PTU frame, §4.5.2):
+// stereo features, the floor cue's obstacle bases (occupied) and its farthest free floor
+// points (m = 0: the line of sight to them is free). The spans must stay valid until done().
+// step() does one bounded unit of work; nothing allocates. Make the object static (MBs).
+class LocalModelBuilder {
+ public:
+  LocalModelBuilder() = default;
+  LocalModelBuilder(const LocalModelBuilder&) = delete;
+  LocalModelBuilder& operator=(const LocalModelBuilder&) = delete;
+
+  void start(const LocalModelParams& params, std::span<const evidence::Reading> features,
+             std::span<const evidence::Reading> floor_obstacles,
+             std::span<const evidence::Reading> floor_free);
+  // One unit of work; true when the local map is ready.
+  bool step();
+  // Runs to the end (tests, benchmarks).
+  void run() {
+    while (!step()) {
+    }
+  }
+  [[nodiscard]] bool done() const { return phase_ == Phase::kDone; }
+
+  [[nodiscard]] const LocalMap& map() const { return map_; }
+  // The fit's polygon cut in front of the guard points, before the seen-free cut: where the
+  // model and the guard put obstacles (the belief side of §7.2.3's gap).
+  [[nodiscard]] const StarPolygon& obstacle_polygon() const { return obstacle_polygon_; }
+  // The farthest free floor seen along each vertex ray [m] (robot frame).
+  [[nodiscard]] const StarPolygon& seen_free() const { return seen_free_; }
+  [[nodiscard]] const OccupancyModel& model() const { return model_; }
+  [[nodiscard]] std::span<const core::Point2> guard_points() const {
+    return {guard_.data(), guard_.size()};
+  }
+  [[nodiscard]] const LocalModelStats& stats() const { return stats_; }
+  [[nodiscard]] const LocalModelParams& params() const { return params_; }
+  // Occupancy of the fitted model at (α, h, r) (0 before a fit).
+  [[nodiscard]] float occupancy(float alpha_rad, float h_m, float r_m) const;
+
+ private:
+  enum class Phase : std::uint8_t { kIdle, kSamples, kSeam, kTrain, kGuard, kExtract, kDone };
+
+  void add_reading_samples(const evidence::Reading& reading);
+  void add_free_samples(const evidence::Reading& reading);
+  void build_seen_free();
+  void extract();
+
+  LocalModelParams params_{};
+  Phase phase_ = Phase::kIdle;
+  std::span<const evidence::Reading> features_{};
+  std::span<const evidence::Reading> obstacles_{};
+  std::span<const evidence::Reading> free_{};
+  std::size_t cursor_ = 0;
+  core::FixedVector<evidence::RaySample, kLookMaxSamples> ray_samples_;
+  core::FixedVector<OccupancySample, kLookMaxSamples> samples_;
+  OccupancyModel model_{};
+  OccupancyTrainer trainer_{};
+  AlnFreeRange<float, kLookMaxPieces> free_range_{};
+  core::FixedVector<GuardPoint, kMaxGuardCandidates> candidates_;
+  core::FixedVector<core::Point2, kMaxGuardPoints> guard_;
+  StarPolygon obstacle_polygon_{};
+  StarPolygon seen_free_{};
+  StarPolygon scratch_{};
+  LocalMap map_{};
+  LocalModelStats stats_{};
+};
+
+}  // namespace boticelli::mapping

@@ -1,0 +1,203 @@
+// Think stage of one look (see local_model_builder.h): samples, resumable fit, guard, polygon.
+#include "algo/mapping/local_model_builder.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "algo/core/angles.h"
+#include "algo/evidence/occupancy_model.h"
+#include "algo/mapping/polygon_ops.h"
+
+namespace boticelli::mapping {
+namespace {
+
+float horizontal_m(const evidence::Reading& r) {
+  const float d = r.r_m * r.r_m - r.h_m * r.h_m;
+  return d > 0.0F ? std::sqrt(d) : 0.0F;
+}
+
+// Vertex index whose sector (centred on the vertex ray) holds pan angle α.
+std::size_t vertex_of(const StarPolygon& p, float alpha_rad) {
+  const float a = core::wrap_two_pi(alpha_rad);
+  const auto n = p.vertex_count();
+  auto k = static_cast<std::size_t>(std::lround(a / p.angle_step_rad()));
+  return k % n;
+}
+
+}  // namespace
+
+void LocalModelBuilder::start(const LocalModelParams& params,
+                              std::span<const evidence::Reading> features,
+                              std::span<const evidence::Reading> floor_obstacles,
+                              std::span<const evidence::Reading> floor_free) {
+  params_ = params;
+  features_ = features;
+  obstacles_ = floor_obstacles;
+  free_ = floor_free;
+  cursor_ = 0;
+  ray_samples_.clear();
+  samples_.clear();
+  candidates_.clear();
+  guard_.clear();
+  stats_ = LocalModelStats{};
+  map_.can_move = false;
+  evidence::configure_occupancy_model(model_, params.model_lowest_h_m, params.model_highest_h_m,
+                                      params.model_max_range_m);
+  phase_ = Phase::kSamples;
+}
+
+void LocalModelBuilder::add_reading_samples(const evidence::Reading& reading) {
+  if (!(reading.r_m > 0.0F) || !(reading.r_m <= params_.model_max_range_m) ||
+      !(reading.h_m >= params_.model_lowest_h_m && reading.h_m <= params_.model_highest_h_m)) {
+    return;  // outside the model's box: the limits filter such readings before
+  }
+  (void)evidence::append_plausibility_samples(reading, params_.rays, ray_samples_);
+}
+
+void LocalModelBuilder::add_free_samples(const evidence::Reading& reading) {
+  if (!(reading.r_m > 0.0F)) return;
+  const std::size_t n = std::max<std::size_t>(params_.free_samples_per_ray, 1);
+  const float r_end = std::min(reading.r_m, params_.model_max_range_m);
+  for (std::size_t j = 1; j <= n; ++j) {
+    // Evenly along the line of sight, the last a little short of the floor point.
+    const float s = r_end * (0.95F * static_cast<float>(j) / static_cast<float>(n));
+    const float h = reading.h_m * (s / reading.r_m);
+    if (!ray_samples_.push_back({reading.alpha_rad, h, s, 0.0F})) return;
+  }
+}
+
+bool LocalModelBuilder::step() {
+  ++stats_.units;
+  switch (phase_) {
+    case Phase::kIdle:
+    case Phase::kDone:
+      return phase_ == Phase::kDone;
+    case Phase::kSamples: {
+      // Features, then floor obstacles, then free floor rays, a few per unit.
+      const std::size_t total = features_.size() + obstacles_.size() + free_.size();
+      const std::size_t end = std::min(total, cursor_ + params_.readings_per_unit);
+      for (; cursor_ < end; ++cursor_) {
+        if (cursor_ < features_.size()) {
+          add_reading_samples(features_[cursor_]);
+        } else if (cursor_ < features_.size() + obstacles_.size()) {
+          add_reading_samples(obstacles_[cursor_ - features_.size()]);
+        } else {
+          add_free_samples(free_[cursor_ - features_.size() - obstacles_.size()]);
+        }
+      }
+      if (cursor_ == total) {
+        phase_ = Phase::kSeam;
+      }
+      return false;
+    }
+    case Phase::kSeam: {
+      (void)evidence::append_seam_copies(ray_samples_, params_.seam_margin_rad);
+      for (const evidence::RaySample& s : ray_samples_) {
+        OccupancySample a;
+        a.x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
+        a.y = s.occupancy;
+        if (!samples_.push_back(a)) break;
+      }
+      stats_.samples = samples_.size();
+      trainer_.configure(params_.trainer);
+      if (!trainer_.start(aln::SampleSet<float, 3>(samples_.data(), samples_.size()), model_)) {
+        phase_ = Phase::kGuard;  // nothing seen: no model; nothing is free
+        return false;
+      }
+      phase_ = Phase::kTrain;
+      return false;
+    }
+    case Phase::kTrain:
+      if (trainer_.step(params_.visits_per_unit)) {
+        stats_.pieces = model_.piece_count();
+        stats_.rms = trainer_.stats().rms;
+        phase_ = Phase::kGuard;
+      }
+      return false;
+    case Phase::kGuard: {
+      stats_.model_valid =
+          samples_.size() > 0 && free_range_.set_model(model_, params_.extraction.safe_occupancy);
+      const auto occupancy = [this](float a, float h, float r) { return this->occupancy(a, h, r); };
+      (void)collect_unexplained_features(features_, occupancy, params_.extraction, params_.guard,
+                                         candidates_);
+      (void)collect_unexplained_features(obstacles_, occupancy, params_.extraction, params_.guard,
+                                         candidates_);
+      stats_.guard_candidates = candidates_.size();
+      (void)corroborated_points(candidates_.span(), params_.guard, guard_);
+      stats_.guard_points = guard_.size();
+      phase_ = Phase::kExtract;
+      return false;
+    }
+    case Phase::kExtract:
+      extract();
+      phase_ = Phase::kDone;
+      return true;
+  }
+  return false;
+}
+
+float LocalModelBuilder::occupancy(float alpha_rad, float h_m, float r_m) const {
+  if (samples_.size() == 0) return 0.0F;
+  return static_cast<float>(model_(OccupancyModel::Vec(alpha_rad, h_m, r_m)));
+}
+
+void LocalModelBuilder::build_seen_free() {
+  const ExtractionParams& p = params_.extraction;
+  seen_free_.set_vertex_count(p.vertex_count);
+  // The line of sight to a free floor point is free; so is the floor up to an obstacle's
+  // base (less its range error) and the body band up to a feature seen inside it.
+  auto see = [&](float alpha, float rho) {
+    const std::size_t k = vertex_of(seen_free_, alpha);
+    seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), std::min(rho, p.bounding_radius_m)));
+  };
+  const float dr = params_.rays.delta_r_fraction;
+  for (const evidence::Reading& r : free_) see(r.alpha_rad, horizontal_m(r));
+  for (const evidence::Reading& r : obstacles_) see(r.alpha_rad, horizontal_m(r) * (1.0F - dr));
+  const float h_lo = slice_height_m(p, 0);
+  const float h_hi = slice_height_m(p, p.height_count == 0 ? 0 : p.height_count - 1);
+  for (const evidence::Reading& r : features_) {
+    if (r.h_m >= h_lo && r.h_m <= h_hi && r.m >= p.safe_occupancy) {
+      see(r.alpha_rad, horizontal_m(r) * (1.0F - 2.0F * dr));
+    }
+  }
+  // A vertex no reading fell on (a gap between image columns) takes the smaller of its
+  // nearest seen neighbours when they are close; a wider gap stays unknown (0).
+  constexpr std::size_t kMaxGap = 3;
+  const std::size_t n = seen_free_.vertex_count();
+  scratch_.set_vertex_count(n);
+  for (std::size_t k = 0; k < n; ++k) scratch_.set_rho_m(k, seen_free_.rho_m(k));
+  for (std::size_t k = 0; k < n; ++k) {
+    if (scratch_.rho_m(k) > 0.0F) continue;
+    float left = 0.0F;
+    float right = 0.0F;
+    std::size_t dl = 1;
+    for (; dl <= kMaxGap && left <= 0.0F; ++dl) left = scratch_.rho_m((k + n - dl) % n);
+    std::size_t dr_i = 1;
+    for (; dr_i <= kMaxGap && right <= 0.0F; ++dr_i) right = scratch_.rho_m((k + dr_i) % n);
+    if (left > 0.0F && right > 0.0F) seen_free_.set_rho_m(k, std::min(left, right));
+  }
+}
+
+void LocalModelBuilder::extract() {
+  const ExtractionParams& p = params_.extraction;
+  const std::size_t heights = std::clamp<std::size_t>(p.height_count, 1, kMaxHeights);
+  if (stats_.model_valid) {
+    extract_slice(free_range_, slice_height_m(p, 0), p, obstacle_polygon_);
+    for (std::size_t i = 1; i < heights; ++i) {
+      extract_slice(free_range_, slice_height_m(p, i), p, scratch_);
+      (void)intersect_into(obstacle_polygon_, scratch_);
+    }
+  } else {
+    obstacle_polygon_.set_vertex_count(p.vertex_count);  // nothing known: nothing free
+  }
+  exclude_points(guard_.span(), obstacle_polygon_);
+  build_seen_free();
+  map_.free = obstacle_polygon_;
+  if (params_.clamp_to_seen_free) {
+    (void)intersect_into(map_.free, seen_free_);
+  }
+  map_.can_move =
+      shrink_for_robot(map_.free, p.robot_radius_m, p.clearance_margin_m, map_.navigable);
+}
+
+}  // namespace boticelli::mapping

@@ -1,0 +1,219 @@
+// Mission: Look–Think–Drive (thesis ch. 6) — the PTU scan and frames, the local model and global
+// map, value iteration and the driven step, behind MissionView and BackgroundWork.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/reading.h"
+#include "algo/image/low_res_frame.h"
+#include "algo/mapping/local_model_builder.h"
+#include "algo/mapping/map_points.h"
+#include "algo/planning/planner.h"
+#include "algo/planning/value_iteration.h"
+#include "algo/stereo/floor_cue.h"
+#include "algo/stereo/rig.h"
+#include "algo/stereo/stereo_processor.h"
+#include "firmware/board.h"
+#include "firmware/device_tasks.h"
+#include "firmware/executive.h"
+#include "firmware/mission/drive_controller.h"
+#include "firmware/mission/mission_params.h"
+#include "firmware/mission/target_tracker.h"
+#include "firmware/mission_state.h"
+#include "firmware/mission_view.h"
+#include "firmware/safety.h"
+#include "firmware/state_saver.h"
+#include "hal/hal.h"
+
+namespace boticelli::firmware {
+class SnapshotWriter;
+}
+
+namespace boticelli::firmware::mission {
+
+enum class Result : std::uint8_t { kRunning, kFound, kNotFound, kAborted };
+const char* result_name(Result result);
+
+class TraceWriter;
+
+// The stages' phases, as the console and the trace name them.
+enum class Phase : std::uint8_t {
+  kStart,  // waiting for the base and the PTU
+  kLook,   // PTU scan: move, settle, grab; the background runs the stereo per view
+  kThink,  // background: samples, fit, guard, polygon, map points
+  kPlan,   // background: value iteration and the step
+  kDrive,  // turn in place, then straight, on odometry
+  kHold,   // e-stop / bumper / pause: base stopped, waiting
+  kDone,   // found, not found or aborted
+};
+const char* phase_name(Phase phase);
+
+// Readings of one look (robot frame): stereo features and the floor cue's output.
+inline constexpr std::size_t kMaxLookFeatures = 16384;
+inline constexpr std::size_t kMaxLookFloorObstacles = 12288;
+inline constexpr std::size_t kMaxLookFloorFree = 8192;
+
+// What the mission needs from around it (references valid for its lifetime).
+struct MissionContext {
+  hal::Hal& hal;
+  const BoardConfig& config;
+  Safety& safety;
+  const Executive& executive;  // background pause flag
+  MissionState& state;
+  StateSaver* saver = nullptr;          // --state
+  const TruthSource* truth = nullptr;   // sim ground truth (trace, target error)
+  TraceWriter* trace = nullptr;         // --trace
+  SnapshotWriter* snapshots = nullptr;  // --snapshots
+};
+
+class Mission final : public MissionView, public BackgroundWork, public FrameConsumer {
+ public:
+  explicit Mission(const MissionContext& context);
+  Mission(const Mission&) = delete;
+  Mission& operator=(const Mission&) = delete;
+
+  // Anchors the mission at now (a resumed state keeps its cycle count, lists and goal).
+  void start(std::uint64_t now_us);
+  // The mission task's body, every minor frame: PTU scan, frames, driving, holds, trace.
+  void control(std::uint64_t now_us);
+  // Background slices: stereo per view, Think, Plan.
+  StepResult step(SliceBudget& budget) override;
+  // Camera task: keeps a settled frame when the look wants one.
+  void on_frame(const hal::Frame& frame) override;
+  bool wants_frames() const override { return want_frame_; }
+
+  // MissionView.
+  const char* state_name() const override { return phase_name(phase_); }
+  core::Pose2 pose() const override;
+  float pan_rad() const override;
+  std::uint32_t features() const override { return last_features_; }
+  std::uint32_t pieces() const override { return last_pieces_; }
+  std::uint64_t cycles() const override { return state_.cycle; }
+  std::string_view model_text() const override { return state_.model_text(); }
+  MapCounts map_counts() const override;
+
+  [[nodiscard]] Result result() const { return result_; }
+  [[nodiscard]] bool finished() const { return result_ != Result::kRunning; }
+  [[nodiscard]] const char* end_reason() const { return end_reason_; }
+  [[nodiscard]] std::uint64_t cycles_this_run() const { return cycles_this_run_; }
+  [[nodiscard]] bool has_target() const { return tracker_.confirmed(); }
+  [[nodiscard]] const Eigen::Vector3f& target_estimate_m() const { return tracker_.estimate_m(); }
+  // Distance between the target estimate and the true target (NaN without either).
+  [[nodiscard]] float target_error_m() const;
+  [[nodiscard]] Phase phase() const { return phase_; }
+  [[nodiscard]] const MissionParams& params() const { return params_; }
+  [[nodiscard]] const mapping::GlobalMap& global_map() const { return map_; }
+  // Ends the mission from outside: shutdown (aborted) or --max-cycles (not found).
+  void abort(const char* why);
+  void finish_not_found(const char* why) { finish(Result::kNotFound, why); }
+  // Shutdown: hands over a state still waiting for the writer and waits until it is saved.
+  void finish_saving();
+  // Per-stage host CPU time so far [s] (the benchmark's split).
+  [[nodiscard]] double look_cpu_s() const { return cpu_s_[0]; }
+  [[nodiscard]] double think_cpu_s() const { return cpu_s_[1]; }
+  [[nodiscard]] double plan_cpu_s() const { return cpu_s_[2]; }
+
+ private:
+  enum class LookStep : std::uint8_t { kMove, kSettle, kGrab, kProcess };
+
+  void begin_look(std::uint64_t now_us);
+  void control_look(std::uint64_t now_us);
+  void control_drive(std::uint64_t now_us);
+  bool hold_needed();
+  void control_hold(std::uint64_t now_us);
+  void finish(Result result, const char* why);
+  void end_cycle(const char* what);
+  void process_view();
+  void begin_think();
+  void after_think();
+  void begin_plan();
+  void after_plan();
+  void write_trace(std::uint64_t now_us);
+  void write_snapshot();
+  [[nodiscard]] core::Pose2 odometry_pose() const;
+  [[nodiscard]] std::size_t view_count() const { return params_.pan_positions * params_.row_count; }
+  void view_angles(std::size_t view, float& pan_rad, float& tilt_rad, bool& pair) const;
+
+  hal::Hal& hal_;
+  const BoardConfig& config_;
+  Safety& safety_;
+  const Executive& executive_;
+  MissionState& state_;
+  StateSaver* saver_;
+  const TruthSource* truth_;
+  TraceWriter* trace_;
+  SnapshotWriter* snapshots_;
+  MissionParams params_;
+
+  Phase phase_ = Phase::kStart;
+  Phase held_phase_ = Phase::kStart;
+  Result result_ = Result::kRunning;
+  const char* end_reason_ = "";
+  std::uint64_t now_us_ = 0;
+  std::uint64_t cycles_this_run_ = 0;
+  std::uint64_t next_trace_us_ = 0;
+  std::uint64_t released_since_us_ = 0;
+  bool released_ = false;
+  bool submit_pending_ = false;
+  std::size_t failed_cycles_ = 0;
+
+  // Look.
+  stereo::RigModel rig_;
+  stereo::StereoProcessor stereo_;
+  stereo::FloorCue floor_cue_;
+  std::size_t view_ = 0;
+  LookStep look_step_ = LookStep::kMove;
+  bool second_frame_ = false;  // grabbing the pair's second frame
+  float view_pan_rad_ = 0.0F;
+  float view_tilt_rad_ = 0.0F;
+  bool view_pair_ = false;
+  stereo::PairPose pair_pose_{};
+  std::uint64_t step_deadline_us_ = 0;
+  std::uint64_t settle_until_us_ = 0;
+  bool want_frame_ = false;
+  bool frame_ready_ = false;
+  bool view_ready_ = false;  // both frames in; the background's turn
+  image::LowResFrame first_{};
+  image::LowResFrame second_{};
+  core::Pose2 look_pose_{};
+  core::FixedVector<evidence::Reading, kMaxLookFeatures> features_;
+  core::FixedVector<evidence::Reading, kMaxLookFloorObstacles> floor_obstacles_;
+  core::FixedVector<evidence::Reading, kMaxLookFloorFree> floor_free_;
+  TargetTracker tracker_;
+  std::uint32_t last_features_ = 0;
+  std::uint32_t last_pieces_ = 0;
+
+  // Think and plan.
+  mapping::LocalModelBuilder builder_;
+  mapping::GlobalMap map_;
+  core::FixedVector<core::Point2, mapping::kMaxObstaclePoints> cycle_obstacles_;
+  core::FixedVector<core::Point2, mapping::kMaxExplorationPoints> cycle_exploration_;
+  planning::ValueIteration value_;
+  planning::Trail trail_;
+  planning::StepDecision decision_{};
+  bool think_started_ = false;
+  bool plan_started_ = false;
+
+  // Drive.
+  DriveController driver_;
+  bool drive_pending_ = false;                  // a step was chosen; control starts it
+  core::FixedVector<core::Point2, 1024> path_;  // where the robot has been (snapshots)
+
+  double cpu_s_[3] = {0.0, 0.0, 0.0};
+};
+
+// The executive's mission task: calls Mission::control every frame; unhealthy when the
+// mission ended aborted by a device fault.
+class MissionTask final : public Task {
+ public:
+  explicit MissionTask(Mission& mission) : mission_(mission) {}
+  void run(std::uint64_t now_us) override { mission_.control(now_us); }
+
+ private:
+  Mission& mission_;
+};
+
+}  // namespace boticelli::firmware::mission

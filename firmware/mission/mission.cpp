@@ -1,0 +1,696 @@
+// Mission: the Look–Think–Drive state machine (see mission.h).
+#include "firmware/mission/mission.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <limits>
+
+#include "algo/aln/text_format.h"
+#include "algo/core/angles.h"
+#include "algo/image/low_res_frame.h"
+#include "firmware/mission/trace_writer.h"
+#include "firmware/snapshot.h"
+#include "firmware/text_buffer.h"
+
+namespace boticelli::firmware::mission {
+namespace {
+
+double thread_cpu_s() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+// Adds the CPU time of a scope to one of the mission's stage counters.
+class CpuScope {
+ public:
+  explicit CpuScope(double& total) : total_(total), start_(thread_cpu_s()) {}
+  ~CpuScope() { total_ += thread_cpu_s() - start_; }
+  CpuScope(const CpuScope&) = delete;
+  CpuScope& operator=(const CpuScope&) = delete;
+
+ private:
+  double& total_;
+  double start_;
+};
+
+// Model text buffer: the text format of the last fitted model (console `model`, state file).
+char g_model_text[MissionState::kMaxModelBytes];
+
+}  // namespace
+
+const char* result_name(Result result) {
+  switch (result) {
+    case Result::kRunning:
+      return "running";
+    case Result::kFound:
+      return "found";
+    case Result::kNotFound:
+      return "not_found";
+    case Result::kAborted:
+      return "aborted";
+  }
+  return "unknown";
+}
+
+const char* phase_name(Phase phase) {
+  switch (phase) {
+    case Phase::kStart:
+      return "start";
+    case Phase::kLook:
+      return "look";
+    case Phase::kThink:
+      return "think";
+    case Phase::kPlan:
+      return "plan";
+    case Phase::kDrive:
+      return "drive";
+    case Phase::kHold:
+      return "hold";
+    case Phase::kDone:
+      return "done";
+  }
+  return "unknown";
+}
+
+Mission::Mission(const MissionContext& c)
+    : hal_(c.hal),
+      config_(c.config),
+      safety_(c.safety),
+      executive_(c.executive),
+      state_(c.state),
+      saver_(c.saver),
+      truth_(c.truth),
+      trace_(c.trace),
+      snapshots_(c.snapshots),
+      params_(make_mission_params(c.config)),
+      rig_(params_.rig),
+      stereo_(rig_, params_.stereo),
+      floor_cue_(rig_) {
+  tracker_.configure(params_.target);
+  driver_.configure(params_.drive);
+  // The lowest row first: it teaches the floor cue what the floor looks like before the
+  // higher rows, which see less floor, are walked.
+  std::sort(params_.rows, params_.rows + params_.row_count,
+            [](const LookRow& a, const LookRow& b) { return a.tilt_rad < b.tilt_rad; });
+}
+
+void Mission::start(std::uint64_t now_us) {
+  now_us_ = now_us;
+  next_trace_us_ = now_us;
+  phase_ = Phase::kStart;
+  result_ = Result::kRunning;
+  end_reason_ = "";
+  cycles_this_run_ = 0;
+  failed_cycles_ = 0;
+  map_.clear();
+  for (const core::Point2& p : state_.obstacles) (void)map_.obstacles().push_back(p);
+  for (const core::Point2& p : state_.exploration) (void)map_.exploration().push_back(p);
+  tracker_.clear();
+  if (state_.has_goal) {
+    // A resumed goal was confirmed before the restart: it stands as two agreeing views.
+    const Eigen::Vector3f g(state_.goal.x_m, state_.goal.y_m, 0.0F);
+    tracker_.add(g, 1.0F, 0xFFFFFFF0U);
+    tracker_.add(g, 1.0F, 0xFFFFFFF1U);
+  }
+  trail_.clear();
+  path_.clear();
+}
+
+core::Pose2 Mission::odometry_pose() const {
+  const hal::Odometry o = hal_.base.odometry();
+  return {static_cast<float>(o.x_m), static_cast<float>(o.y_m), static_cast<float>(o.yaw_rad)};
+}
+
+core::Pose2 Mission::pose() const {
+  return odometry_pose();
+}
+
+float Mission::pan_rad() const {
+  return hal_.pan_tilt.state().pan_rad;
+}
+
+MapCounts Mission::map_counts() const {
+  MapCounts m;
+  m.polygon_vertices = static_cast<std::uint32_t>(builder_.map().free.vertex_count());
+  m.obstacle_points = static_cast<std::uint32_t>(map_.obstacles().size());
+  m.exploration_points = static_cast<std::uint32_t>(map_.exploration().size());
+  return m;
+}
+
+float Mission::target_error_m() const {
+  if (truth_ == nullptr || !tracker_.confirmed()) return std::numeric_limits<float>::quiet_NaN();
+  // The estimate is in the odometry frame; the truth knows where that frame lies.
+  const core::Pose2 o = truth_->odometry_origin();
+  const Eigen::Vector3f& e = tracker_.estimate_m();
+  const core::Point2 w = core::to_world(o, {e.x(), e.y()});
+  const Eigen::Vector3f world(w.x_m, w.y_m, e.z());
+  return (world - truth_->target_m()).norm();
+}
+
+void Mission::view_angles(std::size_t view, float& pan_rad, float& tilt_rad, bool& pair) const {
+  const std::size_t row = view / params_.pan_positions;
+  std::size_t i = view % params_.pan_positions;
+  if (row % 2 == 1) i = params_.pan_positions - 1 - i;  // sweep back on odd rows
+  const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
+  const float t = params_.pan_positions == 1
+                      ? 0.5F
+                      : static_cast<float>(i) / static_cast<float>(params_.pan_positions - 1);
+  pan_rad = lim.pan_min_rad + t * (lim.pan_max_rad - lim.pan_min_rad);
+  tilt_rad = std::clamp(params_.rows[row].tilt_rad, lim.tilt_min_rad, lim.tilt_max_rad);
+  pair = params_.rows[row].pair;
+  if (pair && tilt_rad - params_.rig.tilt_step_rad < lim.tilt_min_rad) {
+    tilt_rad = lim.tilt_min_rad + params_.rig.tilt_step_rad;  // room for the second frame
+  }
+}
+
+void Mission::finish(Result result, const char* why) {
+  if (result_ != Result::kRunning) return;
+  result_ = result;
+  end_reason_ = why;
+  phase_ = Phase::kDone;
+  want_frame_ = false;
+  driver_.reset();
+  hal_.base.set_velocity(0.0F, 0.0F);
+  TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
+  line.appendf("mission %s: %s", result_name(result), why);
+  state_.add_log(state_.cycle, line.view());
+  if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
+}
+
+void Mission::abort(const char* why) {
+  finish(Result::kAborted, why);
+}
+
+// ---------------------------------------------------------------- control (mission task)
+
+bool Mission::hold_needed() {
+  return safety_.engaged() || executive_.background_paused();
+}
+
+void Mission::control(std::uint64_t now_us) {
+  now_us_ = now_us;
+  write_trace(now_us);
+  if (submit_pending_ && saver_ != nullptr && saver_->submit(state_)) submit_pending_ = false;
+  if (phase_ == Phase::kDone) {
+    hal_.base.set_velocity(0.0F, 0.0F);
+    return;
+  }
+  if (safety_.engaged() && safety_.cause() == StopCause::kBumper) {
+    abort("bumper contact");
+    return;
+  }
+  if (hold_needed() && phase_ != Phase::kHold) {
+    held_phase_ = phase_;
+    phase_ = Phase::kHold;
+    want_frame_ = false;
+    released_ = false;
+    if (driver_.busy()) driver_.abort("held");
+  }
+  switch (phase_) {
+    case Phase::kStart: {
+      const hal::PanTiltState ptu = hal_.pan_tilt.state();
+      if (ptu.fault) return abort("pan-tilt unit fault");
+      if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) begin_look(now_us);
+      return;
+    }
+    case Phase::kLook:
+      control_look(now_us);
+      return;
+    case Phase::kThink:
+    case Phase::kPlan:
+      hal_.base.set_velocity(0.0F, 0.0F);
+      return;
+    case Phase::kDrive:
+      control_drive(now_us);
+      return;
+    case Phase::kHold:
+      control_hold(now_us);
+      return;
+    case Phase::kDone:
+      return;
+  }
+}
+
+void Mission::control_hold(std::uint64_t now_us) {
+  hal_.base.set_velocity(0.0F, 0.0F);
+  if (driver_.busy()) {
+    const hal::Odometry o = hal_.base.odometry();
+    (void)driver_.update(odometry_pose(), o.v_m_s, o.omega_rad_s, now_us);
+  }
+  if (safety_.engaged()) {
+    // A button stop is cleared once the button has been released for a while; a console
+    // stop waits for the console's `clear`.
+    if (safety_.cause() == StopCause::kButton && !hal_.estop.read()) {
+      if (!released_) {
+        released_ = true;
+        released_since_us_ = now_us;
+      } else if (now_us - released_since_us_ >= params_.release_hold_us) {
+        (void)safety_.clear();
+      }
+    } else {
+      released_ = false;
+    }
+    return;
+  }
+  if (executive_.background_paused()) return;
+  if (hal_.base.health() != hal::BaseHealth::kReady) return;
+  // Carry on. An interrupted step is not resumed blind: the robot looks again first.
+  if (held_phase_ == Phase::kDrive) {
+    end_cycle("step interrupted");
+    if (phase_ != Phase::kDone) begin_look(now_us);
+    return;
+  }
+  phase_ = held_phase_;
+  if (phase_ == Phase::kLook && look_step_ != LookStep::kProcess) {
+    look_step_ = LookStep::kMove;  // re-issue the interrupted move and wait again
+  }
+}
+
+void Mission::begin_look(std::uint64_t now_us) {
+  phase_ = Phase::kLook;
+  view_ = 0;
+  second_frame_ = false;
+  look_step_ = LookStep::kMove;
+  features_.clear();
+  floor_obstacles_.clear();
+  floor_free_.clear();
+  look_pose_ = odometry_pose();
+  step_deadline_us_ = now_us + params_.ptu_timeout_us;
+  think_started_ = false;
+  plan_started_ = false;
+}
+
+void Mission::control_look(std::uint64_t now_us) {
+  hal_.base.set_velocity(0.0F, 0.0F);
+  const hal::PanTiltState ptu = hal_.pan_tilt.state();
+  if (ptu.fault) return abort("pan-tilt unit fault");
+  switch (look_step_) {
+    case LookStep::kMove: {
+      view_angles(view_, view_pan_rad_, view_tilt_rad_, view_pair_);
+      const float tilt =
+          second_frame_ ? view_tilt_rad_ - params_.rig.tilt_step_rad : view_tilt_rad_;
+      if (!hal_.pan_tilt.move_to(view_pan_rad_, tilt)) return abort("pan-tilt unit refused a move");
+      step_deadline_us_ = now_us + params_.ptu_timeout_us;
+      look_step_ = LookStep::kSettle;
+      settle_until_us_ = 0;
+      return;
+    }
+    case LookStep::kSettle:
+      if (ptu.moving) {
+        if (now_us > step_deadline_us_) abort("pan-tilt move did not complete");
+        return;
+      }
+      if (settle_until_us_ == 0) settle_until_us_ = now_us + params_.settle_us;
+      if (now_us < settle_until_us_) return;
+      frame_ready_ = false;
+      want_frame_ = true;
+      step_deadline_us_ = now_us + params_.frame_timeout_us;
+      look_step_ = LookStep::kGrab;
+      return;
+    case LookStep::kGrab:
+      if (!frame_ready_) {
+        if (now_us > step_deadline_us_) abort("no camera frame");
+        return;
+      }
+      want_frame_ = false;
+      if (!second_frame_) {
+        pair_pose_.pan_rad = ptu.pan_rad;
+        pair_pose_.first_tilt_rad = ptu.tilt_rad;
+      } else {
+        pair_pose_.second_tilt_rad = ptu.tilt_rad;
+      }
+      if (view_pair_ && !second_frame_) {
+        second_frame_ = true;
+        look_step_ = LookStep::kMove;
+        return;
+      }
+      view_ready_ = true;
+      look_step_ = LookStep::kProcess;
+      return;
+    case LookStep::kProcess:
+      if (view_ready_) return;  // the background has not taken the view yet
+      second_frame_ = false;
+      if (++view_ < view_count()) {
+        look_step_ = LookStep::kMove;
+        return;
+      }
+      // Look complete: park the camera level and think.
+      (void)hal_.pan_tilt.move_to(0.0F, 0.0F);
+      phase_ = Phase::kThink;
+      return;
+  }
+}
+
+void Mission::on_frame(const hal::Frame& frame) {
+  if (!want_frame_ || frame_ready_ || frame.timestamp_us < settle_until_us_) return;
+  image::LowResFrame& into = second_frame_ ? second_ : first_;
+  if (!image::downsample_yuyv(frame.data, frame.width_px, frame.height_px, frame.stride_bytes,
+                              params_.rig.downsample_factor, into)) {
+    return;
+  }
+  frame_ready_ = true;
+}
+
+void Mission::control_drive(std::uint64_t now_us) {
+  if (drive_pending_) {
+    drive_pending_ = false;
+    driver_.start(odometry_pose(), decision_.target, now_us);
+  }
+  const hal::Odometry o = hal_.base.odometry();
+  const DriveCommand cmd = driver_.update(odometry_pose(), o.v_m_s, o.omega_rad_s, now_us);
+  hal_.base.set_velocity(cmd.v_m_s, cmd.omega_rad_s);
+  if (hal_.base.health() == hal::BaseHealth::kStopped && !safety_.engaged()) {
+    return abort("base stopped by itself");
+  }
+  if (driver_.busy()) return;
+  const bool ok = driver_.status() == DriveStatus::kDone;
+  const core::Pose2 here = odometry_pose();
+  trail_.add({here.x_m, here.y_m});
+  if (tracker_.confirmed()) {
+    const Eigen::Vector3f& g = tracker_.estimate_m();
+    if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
+        params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m) {
+      end_cycle("at the target");
+      return finish(Result::kFound, "within the stand-off of the target");
+    }
+  }
+  end_cycle(ok ? "step done" : driver_.failure());
+  if (phase_ != Phase::kDone) begin_look(now_us);
+}
+
+void Mission::end_cycle(const char* what) {
+  ++state_.cycle;
+  ++cycles_this_run_;
+  state_.pose = odometry_pose();
+  state_.obstacles.clear();
+  for (const core::Point2& p : map_.obstacles()) {
+    if (!state_.obstacles.push_back(p)) break;
+  }
+  state_.exploration.clear();
+  for (const core::Point2& p : map_.exploration()) {
+    if (!state_.exploration.push_back(p)) break;
+  }
+  state_.has_goal = tracker_.confirmed();
+  if (state_.has_goal) {
+    state_.goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
+  }
+  TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
+  line.appendf("cycle %s x_m=%.2f y_m=%.2f pieces=%u features=%u obst=%u expl=%u", what,
+               static_cast<double>(state_.pose.x_m), static_cast<double>(state_.pose.y_m),
+               last_pieces_, last_features_, static_cast<unsigned>(map_.obstacles().size()),
+               static_cast<unsigned>(map_.exploration().size()));
+  state_.add_log(state_.cycle, line.view());
+  if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
+  write_snapshot();
+  if (path_.size() == path_.capacity()) {
+    // Keep every other point: the path stays whole at half the resolution.
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < path_.size(); i += 2) path_[kept++] = path_[i];
+    path_.resize(kept);
+  }
+  (void)path_.push_back({state_.pose.x_m, state_.pose.y_m});
+}
+
+void Mission::write_trace(std::uint64_t now_us) {
+  if (trace_ == nullptr || now_us < next_trace_us_) return;
+  next_trace_us_ += params_.trace_period_us;
+  if (next_trace_us_ <= now_us) next_trace_us_ = now_us + params_.trace_period_us;
+  const core::Pose2 odo = odometry_pose();
+  const core::Pose2 truth = truth_ != nullptr ? truth_->robot_pose() : odo;
+  const hal::PanTiltState ptu = hal_.pan_tilt.state();
+  trace_->row(static_cast<double>(now_us) * 1e-6, truth, ptu.pan_rad, ptu.tilt_rad,
+              phase_name(phase_), odo);
+}
+
+// ---------------------------------------------------------------- background
+
+StepResult Mission::step(SliceBudget& budget) {
+  if (phase_ == Phase::kDone) return StepResult::kMore;
+  // The view just grabbed: stereo, target, floor cue (one unit).
+  if (phase_ == Phase::kLook && view_ready_) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    process_view();
+    view_ready_ = false;
+    return StepResult::kMore;
+  }
+  if (phase_ == Phase::kThink) {
+    if (!think_started_) {
+      if (!budget.next_unit()) return StepResult::kMore;
+      begin_think();
+    }
+    CpuScope cpu(cpu_s_[1]);
+    while (!builder_.done()) {
+      if (!budget.next_unit()) return StepResult::kMore;
+      (void)builder_.step();
+    }
+    after_think();
+    return StepResult::kMore;
+  }
+  if (phase_ == Phase::kPlan) {
+    CpuScope cpu(cpu_s_[2]);
+    if (!plan_started_) {
+      if (!budget.next_unit()) return StepResult::kMore;
+      begin_plan();
+    }
+    while (!value_.done()) {
+      if (!budget.next_unit()) return StepResult::kMore;
+      (void)value_.step(params_.vi_work_per_unit);
+    }
+    if (!budget.next_unit()) return StepResult::kMore;
+    after_plan();
+    return StepResult::kDone;
+  }
+  return StepResult::kMore;
+}
+
+void Mission::process_view() {
+  CpuScope cpu(cpu_s_[0]);
+  if (view_pair_) {
+    (void)stereo_.process(first_, second_, pair_pose_, features_);
+    last_features_ = static_cast<std::uint32_t>(stereo_.points().size());
+    const stereo::TargetFix fix = stereo_.locate_target(first_, second_, pair_pose_);
+    if (fix.found) {
+      // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
+      const core::Point2 w = core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
+      const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
+      tracker_.add(world, fix.confidence, static_cast<std::uint32_t>(state_.cycle * 256U + view_));
+    }
+  }
+  // The floor cue: learn from the lowest rows, then walk the columns of the first frame.
+  if (view_pair_ == false || pair_pose_.first_tilt_rad < -0.3F) {
+    (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
+  }
+  (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad, floor_obstacles_,
+                           floor_free_);
+}
+
+void Mission::begin_think() {
+  think_started_ = true;
+  const std::size_t removed = evidence::filter_readings(features_, params_.limits);
+  (void)removed;
+  builder_.start(params_.model, features_.span(), floor_obstacles_.span(), floor_free_.span());
+}
+
+void Mission::after_think() {
+  const mapping::LocalMap& local = builder_.map();
+  last_pieces_ = static_cast<std::uint32_t>(builder_.stats().pieces);
+  // Map points (§5.4.4): obstacles where the fit and the guard put them; exploration points
+  // on the bounding circle and where only the lack of seen floor cuts the polygon (§7.2.3).
+  cycle_obstacles_.clear();
+  cycle_exploration_.clear();
+  const float radius = params_.model.extraction.bounding_radius_m;
+  (void)mapping::extract_map_points(builder_.obstacle_polygon(), radius, params_.points,
+                                    cycle_obstacles_, cycle_exploration_);
+  (void)mapping::extract_gap_exploration_points(builder_.obstacle_polygon(), local.free, radius,
+                                                params_.points, cycle_exploration_);
+  // Guard points are obstacles too.
+  for (const core::Point2& g : builder_.guard_points()) {
+    if (!cycle_obstacles_.push_back(g)) break;
+  }
+  (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
+                   params_.points);
+  // The model in the text format, for the console and the state file.
+  const std::size_t n = aln::write_text(builder_.model(), g_model_text, sizeof g_model_text);
+  if (n > 0) (void)state_.set_model({g_model_text, n});
+  phase_ = Phase::kPlan;
+}
+
+void Mission::begin_plan() {
+  plan_started_ = true;
+  planning::RewardSources sources;
+  sources.obstacles = map_.obstacles().span();
+  sources.exploration = map_.exploration().span();
+  sources.visited = trail_.points();
+  sources.has_goal = tracker_.confirmed();
+  if (sources.has_goal) sources.goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
+  planning::ValueIterationParams vp = params_.value;
+  vp.seed = static_cast<std::uint32_t>(state_.seed * 7919U + state_.cycle);
+  value_.start(vp, params_.rewards, sources, {look_pose_.x_m, look_pose_.y_m});
+}
+
+void Mission::after_plan() {
+  const core::Pose2 here = odometry_pose();
+  if (map_.exploration().size() == 0 && !tracker_.confirmed()) {
+    end_cycle("nothing left to explore");
+    return finish(Result::kNotFound, "nothing left to explore");
+  }
+  decision_ = planning::choose_step(value_, builder_.map().navigable, here, params_.step);
+  if (decision_.kind == planning::StepKind::kAtGoal) {
+    end_cycle("at the target");
+    return finish(Result::kFound, "within the stand-off of the target");
+  }
+  if (decision_.kind == planning::StepKind::kMove) {
+    // The thesis's consistency check: the whole step must lie in this look's polygon.
+    const mapping::StarPolygon& nav = builder_.map().navigable;
+    bool inside = true;
+    for (int i = 1; i <= 20 && inside; ++i) {
+      const float t = static_cast<float>(i) / 20.0F;
+      const core::Point2 p{here.x_m + t * (decision_.target.x_m - here.x_m),
+                           here.y_m + t * (decision_.target.y_m - here.y_m)};
+      inside = nav.contains(core::to_robot(look_pose_, p));
+    }
+    if (inside) {
+      failed_cycles_ = 0;
+      drive_pending_ = true;
+      phase_ = Phase::kDrive;
+      return;
+    }
+  }
+  // No safe step: look again (new readings, a new fit), and give up after a few cycles in a
+  // row.
+  ++failed_cycles_;
+  end_cycle("no safe step");
+  if (failed_cycles_ >= params_.max_failed_cycles) {
+    return finish(Result::kNotFound, "no safe step in several looks");
+  }
+  begin_look(now_us_);
+}
+
+namespace {
+
+// Working storage of the pictures (static: they are large).
+core::FixedVector<SnapshotReading, kMaxLookFeatures + kMaxLookFloorObstacles> g_snap_readings;
+std::array<core::Point2, mapping::kMaxPolygonVertices> g_snap_free;
+std::array<core::Point2, mapping::kMaxPolygonVertices> g_snap_navigable;
+std::array<core::Point2, 2048> g_snap_outline_points;
+std::array<std::span<const core::Point2>, 256> g_snap_outlines;
+std::array<SnapshotCircle, 256> g_snap_circles;
+
+struct OccupancyView {
+  const mapping::LocalModelBuilder* builder;
+  core::Pose2 pose;
+};
+
+// The occupancy model sliced at the robot's heights: the highest occupancy over the slices.
+float occupancy_at(const void* context, float x_m, float y_m) {
+  const auto& v = *static_cast<const OccupancyView*>(context);
+  const core::Point2 q = core::to_robot(v.pose, {x_m, y_m});
+  const float rho = std::hypot(q.x_m, q.y_m);
+  const float alpha = core::wrap_two_pi(std::atan2(q.y_m, q.x_m));
+  const mapping::ExtractionParams& p = v.builder->params().extraction;
+  float m = 0.0F;
+  for (std::size_t i = 0; i < p.height_count; ++i) {
+    const float h = mapping::slice_height_m(p, i);
+    m = std::max(m, v.builder->occupancy(alpha, h, std::sqrt(rho * rho + h * h)));
+  }
+  return std::clamp(m, 0.0F, 1.0F);
+}
+
+float value_at(const void* context, float x_m, float y_m) {
+  return static_cast<const planning::ValueIteration*>(context)->value({x_m, y_m});
+}
+
+void to_world(const mapping::StarPolygon& poly, const core::Pose2& pose,
+              std::array<core::Point2, mapping::kMaxPolygonVertices>& out) {
+  for (std::size_t k = 0; k < poly.vertex_count(); ++k)
+    out[k] = core::to_world(pose, poly.vertex(k));
+}
+
+}  // namespace
+
+void Mission::write_snapshot() {
+  if (snapshots_ == nullptr) return;
+  g_snap_readings.clear();
+  auto add = [&](const evidence::Reading& r) {
+    const float d = r.r_m * r.r_m - r.h_m * r.h_m;
+    const float rho = d > 0.0F ? std::sqrt(d) : 0.0F;
+    const core::Point2 w =
+        core::to_world(look_pose_, {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)});
+    (void)g_snap_readings.push_back({w.x_m, w.y_m, r.m});
+  };
+  for (const evidence::Reading& r : features_) add(r);
+  for (const evidence::Reading& r : floor_obstacles_) add(r);
+  const mapping::LocalMap& local = builder_.map();
+  to_world(local.free, look_pose_, g_snap_free);
+  to_world(local.navigable, look_pose_, g_snap_navigable);
+  SnapshotFrame f;
+  f.cycle = static_cast<std::uint32_t>(state_.cycle);
+  f.state = phase_name(phase_);
+  f.robot = odometry_pose();
+  f.robot_radius_m = config_.robot_radius_m;
+  // The view: the room so far (path, points) and 3.5 m around the robot.
+  float x0 = f.robot.x_m - 3.5F, x1 = f.robot.x_m + 3.5F;
+  float y0 = f.robot.y_m - 3.5F, y1 = f.robot.y_m + 3.5F;
+  for (const core::Point2& p : path_) {
+    x0 = std::min(x0, p.x_m - 1.0F);
+    x1 = std::max(x1, p.x_m + 1.0F);
+    y0 = std::min(y0, p.y_m - 1.0F);
+    y1 = std::max(y1, p.y_m + 1.0F);
+  }
+  f.view = {x0, y0, x1, y1};
+  f.readings = g_snap_readings.span();
+  const OccupancyView occupancy{&builder_, look_pose_};
+  f.occupancy = &occupancy_at;
+  f.occupancy_context = &occupancy;
+  f.occupancy_threshold = params_.model.extraction.safe_occupancy;
+  f.free_polygon = {g_snap_free.data(), local.free.vertex_count()};
+  f.navigable_polygon = {g_snap_navigable.data(), local.navigable.vertex_count()};
+  f.obstacle_points = map_.obstacles().span();
+  f.exploration_points = map_.exploration().span();
+  if (tracker_.confirmed())
+    f.goal = core::Point2{tracker_.estimate_m().x(), tracker_.estimate_m().y()};
+  f.path = path_.span();
+  f.value = &value_at;
+  f.value_context = &value_;
+  if (decision_.kind == planning::StepKind::kMove) f.step_end = decision_.target;
+  if (truth_ != nullptr) {
+    // The truth is in the world frame; the pictures are in the odometry frame.
+    const core::Pose2 origin = truth_->odometry_origin();
+    std::size_t used = 0;
+    std::size_t count = 0;
+    for (const std::span<const core::Point2> outline : truth_->outlines()) {
+      if (count == g_snap_outlines.size() || used + outline.size() > g_snap_outline_points.size()) {
+        break;
+      }
+      for (std::size_t i = 0; i < outline.size(); ++i) {
+        g_snap_outline_points[used + i] = core::to_robot(origin, outline[i]);
+      }
+      g_snap_outlines[count++] = {g_snap_outline_points.data() + used, outline.size()};
+      used += outline.size();
+    }
+    std::size_t circles = 0;
+    for (const SnapshotCircle& c : truth_->circles()) {
+      if (circles == g_snap_circles.size()) break;
+      g_snap_circles[circles++] = {core::to_robot(origin, c.centre), c.radius_m};
+    }
+    f.truth_polygons = {g_snap_outlines.data(), count};
+    f.truth_circles = {g_snap_circles.data(), circles};
+  }
+  char error[160] = "";
+  if (!snapshots_->write(f, error, sizeof error)) {
+    TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
+    line.appendf("snapshot: %s", error);
+    state_.add_log(state_.cycle, line.view());
+  }
+}
+
+void Mission::finish_saving() {
+  if (saver_ == nullptr) return;
+  while (submit_pending_) submit_pending_ = !saver_->submit(state_);
+  saver_->flush();
+}
+
+}  // namespace boticelli::firmware::mission

@@ -1,0 +1,67 @@
+// Mission parameters from the board config (see mission_params.h).
+#include "firmware/mission/mission_params.h"
+
+#include <algorithm>
+
+#include "algo/evidence/occupancy_model.h"
+
+namespace boticelli::firmware::mission {
+
+stereo::RigParams make_rig_params(const BoardConfig& c) {
+  stereo::RigParams p;
+  p.camera.width_px = c.camera_width_px;
+  p.camera.height_px = c.camera_height_px;
+  p.camera.focal_px = c.focal_px;
+  p.camera.principal_x_px = c.principal_x_px;
+  p.camera.principal_y_px = c.principal_y_px;
+  p.camera.radial_k1 = c.radial_k1;
+  p.lever_m = c.lever_m;
+  p.support_angle_rad = c.support_angle_rad;
+  p.ptu_height_m = c.ptu_height_m;
+  p.tilt_step_rad = c.tilt_step_rad;
+  return p;
+}
+
+MissionParams make_mission_params(const BoardConfig& c) {
+  MissionParams p;
+  p.rig = make_rig_params(c);
+  p.limits = evidence::make_reading_limits(c.ptu_height_m, c.ceiling_height_m, c.max_range_m);
+
+  // Think: the model's box is the readings' box (so nothing the stereo keeps falls outside).
+  mapping::LocalModelParams& m = p.model;
+  const evidence::ModelBox box = evidence::model_box(p.limits, evidence::ray_sample_reach(m.rays));
+  m.model_lowest_h_m = box.lowest_h_m;
+  m.model_highest_h_m = box.highest_h_m;
+  m.model_max_range_m = box.max_range_m;
+  m.seam_margin_rad = evidence::kSeamMarginRad;
+  mapping::ExtractionParams& e = m.extraction;
+  e.ptu_height_m = c.ptu_height_m;
+  e.lowest_height_m = c.ground_clearance_m;
+  e.robot_height_m = c.robot_height_m;
+  e.robot_radius_m = c.robot_radius_m;
+  e.clearance_margin_m = c.clearance_margin_m;
+  e.height_count = 5;
+  e.bounding_radius_m = 3.0F;  // §5.4.4: the model is trusted to about 3 m
+  m.trainer.epsilon = 0.15;    // §4.8.2
+  m.trainer.max_iterations = 10;
+  m.trainer.max_pieces = mapping::kLookMaxPieces;
+
+  // Drive: value iteration keeps the robot radius plus the polygon's margin from obstacles.
+  p.value.robot_radius_m = c.robot_radius_m + c.clearance_margin_m;
+  p.value.step_m = 0.4F;
+  p.value.window_half_size_m = 4.0F;
+  p.rewards.goal_standoff_m = c.goal_standoff_m;
+  p.drive.max_speed_m_s = c.max_speed_m_s;
+  p.drive.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
+
+  // Look.
+  p.pan_positions = std::max<std::uint32_t>(c.look_pan_positions, 1);
+  p.row_count = std::min<std::size_t>(c.look_tilt_rows, BoardConfig::kMaxTiltRows);
+  for (std::size_t i = 0; i < p.row_count; ++i) {
+    p.rows[i] = {c.look_tilt_rad[i], c.look_tilt_is_pair[i]};
+  }
+  p.settle_us = c.camera_settle_ms * 1000U;
+  return p;
+}
+
+}  // namespace boticelli::firmware::mission
