@@ -9,7 +9,7 @@
 namespace boticelli::stereo {
 
 StereoProcessor::StereoProcessor(const RigModel& rig, const StereoParams& params)
-    : rig_(rig), params_(params), selector_(params.features) {}
+    : rig_(rig), params_(params), selector_(params.features), target_detector_(params.target) {}
 
 std::size_t StereoProcessor::process_yuyv(const std::uint8_t* first_yuyv,
                                           const std::uint8_t* second_yuyv,

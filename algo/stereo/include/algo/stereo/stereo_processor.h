@@ -19,6 +19,7 @@ namespace boticelli::stereo {
 struct StereoParams {
   image::FeatureParams features;    // cap 500, central band, min strength
   image::TrackParams tracking;      // 3 px band, E_thresh, distinctiveness
+  image::TargetParams target;       // green triangle on white paper (§3.4.2)
   float match_error_max = 1500.0F;  // E_max of Eq 3.8 [grey levels²], in agreement with E_thresh
   float min_range_m = 0.2F;         // nearest depth searched, from the first optical centre [m]
   bool fast_triangulation = false;  // Eq 3.4 instead of the exact Eq 3.2
