@@ -85,7 +85,7 @@ bool FloorCue::floor_point(const CameraPose& pose, float u, float v, Eigen::Vect
     return false;
   }
   point = pose.centre_m + t * ray;
-  rho_m = std::hypot(point.x(), point.y());
+  rho_m = std::sqrt(point.x() * point.x() + point.y() * point.y());
   return true;
 }
 
@@ -133,11 +133,16 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   const std::uint32_t rows = std::min(params_.reference_rows_max, frame.height);
   for (std::uint32_t k = 0; k < rows; ++k) {
     const std::uint32_t v = frame.height - 1 - k;
+    // Rows further up see the floor farther away: stop once a whole row is beyond the region.
+    bool row_beyond = true;
     for (std::uint32_t u = 0; u < frame.width && count < kMaxReference; ++u) {
       Eigen::Vector3f point;
       float rho = 0.0F;
-      if (!floor_point(pose, static_cast<float>(u), static_cast<float>(v), point, rho) ||
-          rho < params_.reference_min_m || rho > params_.reference_max_m) {
+      if (!floor_point(pose, static_cast<float>(u), static_cast<float>(v), point, rho)) {
+        continue;
+      }
+      row_beyond = row_beyond && rho > params_.reference_max_m;
+      if (rho < params_.reference_min_m || rho > params_.reference_max_m) {
         continue;
       }
       std::array<float, 3> values{};
@@ -147,6 +152,9 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
       for (std::size_t c = 0; c < 3; ++c) {
         ++histogram[c][stored[c]];
       }
+    }
+    if (row_beyond) {
+      break;
     }
   }
   if (count < params_.reference_min_pixels || count == 0) {
@@ -203,7 +211,7 @@ bool FloorCue::sight_floor_point(const CameraPose& pose, float azimuth_rad, floa
   const float s = (pose.centre_m.z() - floor_z) / std::tan(-elevation_rad);  // along the floor
   point = Eigen::Vector3f(pose.centre_m.x() + s * std::cos(azimuth_rad),
                           pose.centre_m.y() + s * std::sin(azimuth_rad), floor_z);
-  rho_m = std::hypot(point.x(), point.y());
+  rho_m = std::sqrt(point.x() * point.x() + point.y() * point.y());
   return true;
 }
 
@@ -223,19 +231,52 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
   // One image row per step near the image centre [rad]; the walk needs at most ~2 per row.
   const float step_rad = 1.0F / camera.focal_px;
   const auto max_steps = 2U * frame.height;
-  const float bottom_v = static_cast<float>(frame.height - 1);
+  // The walks' azimuths: spread along the highest image row whose centre still sees the
+  // floor within max range (vertical planes fan out upwards in a tilted-down image, so
+  // walks taken from the bottom row would leave the image at its sides early).
+  std::uint32_t azimuth_row = frame.height - 1;
+  for (std::uint32_t v = 0; v < frame.height; ++v) {
+    Eigen::Vector3f point;
+    float rho = 0.0F;
+    if (floor_point(pose, 0.5F * static_cast<float>(frame.width - 1), static_cast<float>(v), point,
+                    rho) &&
+        rho <= params_.max_range_m) {
+      azimuth_row = v;
+      break;
+    }
+  }
+  // Pixel positions the walk samples: those that round to a pixel of the frame.
+  const auto in_frame = [&](const Eigen::Vector2f& pixel) {
+    return pixel.x() >= -0.49F && pixel.y() >= -0.49F &&
+           pixel.x() <= static_cast<float>(frame.width) - 0.51F &&
+           pixel.y() <= static_cast<float>(frame.height) - 0.51F;
+  };
+  const auto inside = [&](float azimuth, float elevation) {
+    const Eigen::Vector3f dir(std::cos(elevation) * std::cos(azimuth),
+                              std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    Eigen::Vector2f pixel;
+    return RigModel::project_ptu(pose, camera, pose.centre_m + dir, pixel) && in_frame(pixel);
+  };
   for (std::uint32_t u = 0; u < frame.width && column_count_ < kMaxColumns;
        u += params_.column_step) {
     FloorColumn& col = columns_[column_count_++];
     col = FloorColumn{};
     col.u_px = u;
-    // The walk: up the vertical plane through the optical centre and this bottom pixel,
+    // The walk: up the vertical plane through the optical centre and pixel (u, azimuth_row),
     // so a vertical obstacle edge stays on one side of it (image columns are not vertical
-    // planes once the camera is tilted).
-    const Eigen::Vector3f bottom_ray =
-        RigModel::ray_ptu(pose, camera, Eigen::Vector2f(static_cast<float>(u), bottom_v));
-    const float azimuth = std::atan2(bottom_ray.y(), bottom_ray.x());
-    const float elevation0 = std::atan2(bottom_ray.z(), std::hypot(bottom_ray.x(), bottom_ray.y()));
+    // planes once the camera is tilted), from where that plane leaves the image below.
+    const Eigen::Vector3f ray = RigModel::ray_ptu(
+        pose, camera, Eigen::Vector2f(static_cast<float>(u), static_cast<float>(azimuth_row)));
+    const float azimuth = std::atan2(ray.y(), ray.x());
+    float elevation0 = std::atan2(ray.z(), std::hypot(ray.x(), ray.y()));
+    // The plane's image is one segment of the image: bisect for its lower end.
+    float outside = -1.55F;  // [rad], nearly straight down: below every image of this rig
+    if (inside(azimuth, elevation0)) {
+      for (int i = 0; i < 14; ++i) {
+        const float mid = 0.5F * (outside + elevation0);
+        (inside(azimuth, mid) ? elevation0 : outside) = mid;
+      }
+    }
     col.azimuth_rad = core::wrap_two_pi(azimuth);
     bool have_floor = false;  // a floor pixel connected to the bottom
     Eigen::Vector3f free_point = Eigen::Vector3f::Zero();
@@ -258,15 +299,23 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
       if (!RigModel::project_ptu(pose, camera, point, pixel)) {
         break;
       }
-      const long pu = std::lround(pixel.x());
-      const long pv = std::lround(pixel.y());
-      if (pu < 0 || pv < 0 || pu >= static_cast<long>(frame.width) ||
-          pv >= static_cast<long>(frame.height)) {
+      // The two pixels either side of the walk on its row: floor only if both are, so an
+      // obstacle edge within a pixel of the walk stops it (errs towards the obstacle).
+      if (!in_frame(pixel)) {
         break;  // left the image: at its top or side
       }
+      const long pv = std::lround(pixel.y());
+      const long left =
+          std::clamp(std::lround(std::floor(pixel.x())), 0L, static_cast<long>(frame.width) - 2);
       float contrast = 0.0F;
-      if (looks_like_floor(frame, static_cast<std::uint32_t>(pu), static_cast<std::uint32_t>(pv),
-                           contrast)) {
+      float contrast_right = 0.0F;
+      const auto row = static_cast<std::uint32_t>(pv);
+      const bool floor_left =
+          looks_like_floor(frame, static_cast<std::uint32_t>(left), row, contrast);
+      const bool floor_right =
+          looks_like_floor(frame, static_cast<std::uint32_t>(left + 1), row, contrast_right);
+      contrast = std::max(contrast, contrast_right);
+      if (floor_left && floor_right) {
         run = 0;
         have_floor = true;
         free_point = point;

@@ -108,11 +108,14 @@ class FloorCue {
   // region for the PTU at pan/tilt [rad]. Nothing changes unless kLearned or kUpdated.
   FloorLearn learn(const image::LowResFrame& frame, float pan_rad, float tilt_rad);
 
-  // Walks the columns of one frame (the rig's low resolution) seen at pan/tilt [rad] with
-  // the current model. APPENDS to `obstacles` readings at the base of each boundary (one
-  // per configured height, m from the contrast) and to `free` one reading per column with
-  // m = 0 at the farthest floor point connected to the bottom of the image (the line of
-  // sight to it is free). Never writes past either capacity. Nothing is allocated.
+  // Walks one frame (the rig's low resolution) seen at pan/tilt [rad] with the current
+  // model: every column_step-th pixel of the highest row that sees the floor within max
+  // range gives one walk up its vertical plane from where that plane enters the image.
+  // A sample is floor only if both pixels either side of the walk look like floor. APPENDS to
+  // `obstacles` readings at the base of each boundary (one per configured height, m from the
+  // contrast) and to `free` one reading per column with m = 0 at the farthest floor point connected
+  // to the bottom of the image (the line of sight to it is free). Never writes past either
+  // capacity. Nothing is allocated.
   FloorCueResult process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                          core::FixedVectorBase<evidence::Reading>& obstacles,
                          core::FixedVectorBase<evidence::Reading>& free);

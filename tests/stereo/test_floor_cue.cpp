@@ -1,0 +1,397 @@
+// Floor-appearance cue on frames of the sim renderer: obstacle bases where the geometry puts them.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/evidence/reading.h"
+#include "algo/image/low_res_frame.h"
+#include "algo/stereo/floor_cue.h"
+#include "algo/stereo/rig.h"
+#include "board_config.h"
+#include "hal/sim/renderer.h"
+#include "hal/sim/sim_world.h"
+#include "hal/sim/textures.h"
+#include "hal/sim/world.h"
+
+#include "CppUTest/TestHarness.h"
+#include "alloc_guard.h"
+
+using boticelli::core::FixedVector;
+using boticelli::evidence::Reading;
+using boticelli::image::LowResFrame;
+using boticelli::stereo::FloorColumn;
+using boticelli::stereo::FloorCue;
+using boticelli::stereo::FloorCueResult;
+using boticelli::stereo::FloorLearn;
+using boticelli::stereo::RigModel;
+namespace sim = boticelli::hal::sim;
+namespace board = boticelli::boards::sim;
+
+namespace {
+
+constexpr float kLookTilt = -0.5F;  // the look's lower tilt row [rad]
+constexpr float kBaseTol = 0.1F;    // base distance tolerance [m] (with 10 % of the distance)
+
+// The world files' common part: a plain floor (the example colour of WORLDS.md), the
+// example's directional light, the robot at the origin facing +x, the target behind it.
+std::string world_with(const std::string& models) {
+  return "<sdf version=\"1.6\" xmlns:boticelli=\"urn:boticelli:sdf\">\n<world name=\"t\">\n"
+         "<scene><ambient>0.45 0.45 0.45 1</ambient></scene>\n"
+         "<light name=\"sun\" type=\"directional\"><direction>-0.3 0.2 -1</direction>"
+         "<diffuse>0.6 0.6 0.6 1</diffuse></light>\n"
+         "<include><uri>model://boticelli</uri><pose>0 0 0 0 0 0</pose></include>\n"
+         "<model name=\"floor\"><link name=\"l\"><visual name=\"v\"><geometry><plane>"
+         "<normal>0 0 1</normal><size>20 20</size></plane></geometry>"
+         "<material><diffuse>0.55 0.5 0.45 1</diffuse></material></visual></link></model>\n"
+         "<model name=\"target\"><pose>-6 0 1 0 0 0</pose><link name=\"l\"><visual name=\"v\">"
+         "<geometry><box><size>0.01 0.3 0.3</size></box></geometry>"
+         "<boticelli:pattern>paper</boticelli:pattern>"
+         "<boticelli:target face=\"+x\" size=\"0.2\"/></visual></link></model>\n" +
+         models + "</world>\n</sdf>\n";
+}
+
+// A plain box: centre x y z and size sx sy sz [m], colour "r g b".
+std::string plain_box(const char* name, const char* pose, const char* size,
+                      const char* colour = "0.7 0.7 0.7") {
+  return std::string("<model name=\"") + name + "\"><pose>" + pose +
+         " 0 0 0</pose><link name=\"l\"><visual name=\"v\"><geometry><box><size>" + size +
+         "</size></box></geometry><material><diffuse>" + colour +
+         " 1</diffuse></material></visual></link></model>\n";
+}
+
+std::string table_at(float x, float y) {
+  std::string s;
+  char pose[64];
+  std::snprintf(pose, sizeof pose, "%.3f %.3f 0.69", static_cast<double>(x),
+                static_cast<double>(y));
+  s += plain_box("table_top", pose, "1.0 0.8 0.02", "0.6 0.45 0.3");
+  const float dx[4] = {-0.45F, 0.45F, -0.45F, 0.45F};
+  const float dy[4] = {-0.35F, -0.35F, 0.35F, 0.35F};
+  for (int i = 0; i < 4; ++i) {
+    std::snprintf(pose, sizeof pose, "%.3f %.3f 0.34", static_cast<double>(x + dx[i]),
+                  static_cast<double>(y + dy[i]));
+    char name[16];
+    std::snprintf(name, sizeof name, "leg%d", i);
+    s += plain_box(name, pose, "0.05 0.05 0.68", "0.6 0.45 0.3");
+  }
+  return s;
+}
+
+// One world with its renderer, as the sim board builds them.
+struct Scene {
+  sim::World world;
+  sim::TextureBank textures;
+  sim::SimWorld sim;
+  std::optional<sim::Renderer> renderer;  // allocates: built per test, dropped in teardown
+};
+
+Scene g_scene;  // large (textures): static
+RigModel g_rig(board::make_rig_params(board::make_config()));
+std::vector<std::uint8_t> g_yuyv(640U * 480U * 2U);
+LowResFrame g_frame;
+LowResFrame g_frame2;
+char g_error[256];
+
+void load(const std::string& models) {
+  const std::string xml = world_with(models);
+  CHECK_TEXT(sim::parse_world(xml.c_str(), xml.size(), "floor_cue.sdf", g_scene.world, g_error,
+                              sizeof g_error),
+             g_error);
+  CHECK_TEXT(g_scene.textures.build(g_scene.world, g_error, sizeof g_error), g_error);
+  const board::SimSettings settings = board::make_settings(board::make_config(), 3);
+  CHECK_TEXT(g_scene.sim.init(g_scene.world, g_rig, settings.physics, g_error, sizeof g_error),
+             g_error);
+  g_scene.renderer.emplace();
+  CHECK_TEXT(g_scene.renderer->init(g_scene.world, g_scene.textures, g_rig.camera(),
+                                    settings.render, g_error, sizeof g_error),
+             g_error);
+}
+
+sim::RigidTransform camera_in_world(float pan, float tilt) {
+  return g_scene.sim.camera_pose(boticelli::core::Pose2{0.0F, 0.0F, 0.0F}, pan, tilt);
+}
+
+void render(float pan, float tilt, std::uint32_t frame_index, LowResFrame& out) {
+  g_scene.renderer->render(camera_in_world(pan, tilt), frame_index, g_yuyv.data(), 640U * 2U,
+                           nullptr);
+  CHECK(boticelli::image::downsample_yuyv(g_yuyv.data(), 640, 480, 640 * 2, 4, out));
+}
+
+Eigen::Vector3f floor_point_of(const Reading& r) {
+  const float rho = std::sqrt(r.r_m * r.r_m - r.h_m * r.h_m);
+  return {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad), 0.0F};  // world, on the floor
+}
+
+// Distance along the floor from below the camera to the nearest obstacle within one
+// low-resolution pixel (1/F rad; the cue stops at an edge that near) either side of the direction
+// of `floor_target`, for horizontal rays `height` above the floor (+inf if none) [m].
+float first_obstacle_m(float pan, float tilt, const Eigen::Vector3f& floor_target, float height,
+                       float spread_rad = 1.0F / 150.0F) {
+  const Eigen::Vector3f c = camera_in_world(pan, tilt).translation_m;
+  const Eigen::Vector3f origin(c.x(), c.y(), height);
+  const float heading = std::atan2(floor_target.y() - c.y(), floor_target.x() - c.x());
+  float nearest = std::numeric_limits<float>::infinity();
+  for (const float offset : {-spread_rad, 0.0F, spread_rad}) {
+    const Eigen::Vector3f d(std::cos(heading + offset), std::sin(heading + offset), 0.0F);
+    std::size_t surface = 0;
+    float t = 0.0F;
+    if (sim::cast_ray(g_scene.world, origin, d, surface, t)) {
+      nearest = std::min(nearest, t);
+    }
+  }
+  return nearest;
+}
+
+float along_floor_m(float pan, float tilt, const Eigen::Vector3f& floor_point) {
+  const Eigen::Vector3f c = camera_in_world(pan, tilt).translation_m;
+  return std::hypot(floor_point.x() - c.x(), floor_point.y() - c.y());
+}
+
+struct Outputs {
+  FixedVector<Reading, 1024> obstacles;
+  FixedVector<Reading, 256> free;
+  FloorCueResult result;
+};
+
+// Every obstacle base within tolerance of the truth along its line of sight; returns how
+// many bases were checked. Every free reading short of the first obstacle, and visible.
+std::size_t check_against_truth(const FloorCue& cue, const Outputs& out, float pan, float tilt) {
+  const std::size_t per_base = cue.params().obstacle_height_count;
+  CHECK_EQUAL(out.result.boundaries * per_base, out.obstacles.size());
+  float worst_far = -1.0F;
+  float worst_near = -1.0F;
+  for (std::size_t i = 0; i < out.obstacles.size(); i += per_base) {
+    const Eigen::Vector3f base = floor_point_of(out.obstacles[i]);
+    const float estimate = along_floor_m(pan, tilt, base);
+    // Nothing within half a pixel of the walk may be nearer than its base; something
+    // within one and a half pixels (the cue stops beside an edge) must be there.
+    const float truth = first_obstacle_m(pan, tilt, base, 0.02F, 0.5F / 150.0F);
+    const float wide = first_obstacle_m(pan, tilt, base, 0.02F, 1.5F / 150.0F);
+    // Farther than the truth: at most the smaller of 0.1 m and 10 %; nearer: the larger.
+    const float far_tol = std::min(kBaseTol, 0.1F * truth);
+    const float near_tol = std::max(kBaseTol, 0.1F * wide);
+    if (std::getenv("FLOOR_DEBUG") != nullptr) {
+      std::printf("\n   base %zu u=%u est %.3f truth %.3f m=%.2f", i / per_base,
+                  static_cast<unsigned>(i / per_base), static_cast<double>(estimate),
+                  static_cast<double>(truth), static_cast<double>(out.obstacles[i].m));
+    }
+    worst_far = std::max(worst_far, estimate - truth);
+    worst_near = std::max(worst_near, wide - estimate);
+    if (!(estimate <= truth + far_tol && estimate >= wide - near_tol)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "base %zu at %.3f m along the floor, truth %.3f m (%.3f m within 1.5 px)",
+                    i / per_base, static_cast<double>(estimate), static_cast<double>(truth),
+                    static_cast<double>(wide));
+      FAIL(text);
+    }
+    // A clear boundary (the walk's own line meets the obstacle, not only a pixel beside
+    // it) is strong evidence.
+    if (first_obstacle_m(pan, tilt, base, 0.02F, 0.0F) < wide + 0.05F) {
+      CHECK(out.obstacles[i].m >= 0.6F);
+    }
+  }
+  const Eigen::Vector3f eye = camera_in_world(pan, tilt).translation_m;
+  for (const Reading& f : out.free) {
+    CHECK_EQUAL(0.0F, f.m);
+    DOUBLES_EQUAL(-g_rig.params().ptu_height_m, f.h_m, 1e-4);
+    const Eigen::Vector3f p = floor_point_of(f);
+    const float along = along_floor_m(pan, tilt, p);
+    CHECK(along <= first_obstacle_m(pan, tilt, p, 0.02F, 0.0F) + 0.01F);
+    CHECK(along <= first_obstacle_m(pan, tilt, p, 0.3F, 0.0F) + 0.01F);
+    // The line of sight from the camera to the free point reaches it.
+    std::size_t surface = 0;
+    float t = 0.0F;
+    const Eigen::Vector3f d = p - eye;
+    CHECK(sim::cast_ray(g_scene.world, eye, d, surface, t));
+    CHECK(t >= 0.99F);
+  }
+  if (out.obstacles.size() > 0) {
+    std::printf("\n  tilt %+.3f: %zu bases, worst farther %+.3f m, worst nearer %+.3f m\n",
+                static_cast<double>(tilt), out.obstacles.size() / per_base,
+                static_cast<double>(worst_far), static_cast<double>(worst_near));
+  }
+  return out.obstacles.size() / per_base;
+}
+
+// Walks whose vertical plane meets an obstacle standing on the floor where the frame sees
+// its base (in the image, nearer than max range, beyond the bottom row) must end at a
+// boundary; returns how many did.
+std::size_t check_detected(const FloorCue& cue, float pan, float tilt) {
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(pan, tilt);
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const Eigen::Vector3f c = camera_in_world(pan, tilt).translation_m;
+  std::size_t detected = 0;
+  for (std::size_t i = 0; i < cue.column_count(); ++i) {
+    const FloorColumn& col = cue.column(i);
+    const Eigen::Vector3f d(std::cos(col.azimuth_rad), std::sin(col.azimuth_rad), 0.0F);
+    std::size_t surface = 0;
+    float t = 0.0F;
+    bool in_view = false;
+    if (sim::cast_ray(g_scene.world, Eigen::Vector3f(c.x(), c.y(), 0.02F), d, surface, t)) {
+      const Eigen::Vector3f base(c.x() + t * d.x(), c.y() + t * d.y(), 0.0F);
+      const float rho = std::hypot(base.x(), base.y());
+      Eigen::Vector2f px;
+      const Eigen::Vector3f base_ptu =
+          base - Eigen::Vector3f(0.0F, 0.0F, g_rig.params().ptu_height_m);
+      in_view = rho > col.near_rho_m + 0.1F && rho < cue.params().max_range_m - 0.15F &&
+                RigModel::project_ptu(pose, camera, base_ptu, px) && px.x() >= 1.0F &&
+                px.y() >= 1.0F && px.x() <= static_cast<float>(camera.width_px) - 2.0F &&
+                px.y() <= static_cast<float>(camera.height_px) - 2.0F;
+    }
+    if (std::getenv("FLOOR_DEBUG") != nullptr) {
+      std::printf("\n   col u=%u end=%d base_rho %.3f free_rho %.3f truth %.3f in view %d",
+                  col.u_px, static_cast<int>(col.end), static_cast<double>(col.base_rho_m),
+                  static_cast<double>(col.free_rho_m), static_cast<double>(t), in_view ? 1 : 0);
+    }
+    if (in_view) {
+      CHECK_TEXT(col.end == FloorColumn::End::kBoundary, "an obstacle in view was missed");
+      ++detected;
+    }
+  }
+  return detected;
+}
+
+}  // namespace
+
+TEST_GROUP(FloorCue) {
+  FloorCue cue{g_rig};
+  Outputs out;
+
+  void teardown() override {
+    g_scene.renderer.reset();
+  }
+
+  void run(float pan, float tilt, std::uint32_t frame_index) {
+    render(pan, tilt, frame_index, g_frame);
+    out.obstacles.clear();
+    out.free.clear();
+    out.result = cue.process(g_frame, pan, tilt, out.obstacles, out.free);
+  }
+};
+
+TEST(FloorCue, OpenFloorGivesNoObstaclesAndFreeFloorOutToMaxRangeInEveryColumn) {
+  load("");
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  for (const float tilt : {kLookTilt, 0.0F}) {
+    run(0.7F, tilt, 2);
+    CHECK(out.result.model_valid);
+    CHECK_EQUAL(80U, out.result.columns);
+    CHECK_EQUAL(0U, out.obstacles.size());
+    CHECK_EQUAL(out.result.columns, out.free.size());
+    for (std::size_t i = 0; i < cue.column_count(); ++i) {
+      CHECK(cue.column(i).end == FloorColumn::End::kMaxRange);
+      // The farthest floor pixel within max range is at most one pixel's step short of it.
+      CHECK(cue.column(i).free_rho_m > cue.params().max_range_m - 0.2F);
+      CHECK(cue.column(i).free_rho_m <= cue.params().max_range_m);
+    }
+    check_against_truth(cue, out, 0.7F, tilt);
+  }
+}
+
+TEST(FloorCue, PlainBoxesAreFoundAtTheirBaseAndFreeFloorStopsThere) {
+  // Two plain 0.5 m boxes: a grey one with its front at 1.2 m on the left, one of the
+  // floor's own colour with its front at 2.4 m on the right (only its shading differs).
+  load(plain_box("near", "1.4 0.5 0.25", "0.4 0.6 0.5") +
+       plain_box("far", "2.6 -0.6 0.25", "0.4 0.8 0.5", "0.55 0.5 0.45"));
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  run(0.0F, kLookTilt, 1);
+  CHECK(check_against_truth(cue, out, 0.0F, kLookTilt) >= 10);
+  CHECK(check_detected(cue, 0.0F, kLookTilt) >= 10);
+  run(0.0F, 0.0F, 2);
+  CHECK(check_against_truth(cue, out, 0.0F, 0.0F) >= 5);
+  CHECK(check_detected(cue, 0.0F, 0.0F) >= 5);
+}
+
+TEST(FloorCue, AFeaturelessWallIsFoundInEveryColumn) {
+  load(plain_box("wall", "2.0 0 0.75", "0.1 8 1.5", "0.8 0.8 0.75"));
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  run(0.3F, kLookTilt, 3);
+  CHECK_EQUAL(out.result.columns, out.result.boundaries);
+  CHECK_EQUAL(out.result.columns, check_against_truth(cue, out, 0.3F, kLookTilt));
+  CHECK_EQUAL(out.result.columns, out.free.size());
+}
+
+TEST(FloorCue, TableLegsAreFoundAndTheFloorUnderTheTableIsOnlyFreeAtFloorHeight) {
+  load(table_at(1.8F, 0.0F));
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  run(0.0F, kLookTilt, 4);
+  CHECK(check_detected(cue, 0.0F, kLookTilt) >= 4);
+  CHECK(check_against_truth(cue, out, 0.0F, kLookTilt) >= 4);
+}
+
+TEST(FloorCue, AnObstacleInTheReferenceRegionDoesNotPoisonTheFloorModel) {
+  load(plain_box("front", "0.85 0.15 0.25", "0.3 0.4 0.5"));
+  // A fresh cue refuses a region with the box in part of it.
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kNotUniform == cue.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(cue.model().valid);
+  // Learnt elsewhere (the box out of view), the model is not updated from the box in front.
+  render(1.2F, kLookTilt, 2, g_frame2);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame2, 1.2F, kLookTilt));
+  const boticelli::stereo::FloorModel before = cue.model();
+  CHECK(FloorLearn::kInconsistent == cue.learn(g_frame, 0.0F, kLookTilt));
+  for (std::size_t c = 0; c < 3; ++c) {
+    CHECK_EQUAL(before.median[c], cue.model().median[c]);
+    CHECK_EQUAL(before.tolerance[c], cue.model().tolerance[c]);
+  }
+  // And with the kept model the box in front is found.
+  run(0.0F, kLookTilt, 1);
+  CHECK(check_detected(cue, 0.0F, kLookTilt) >= 5);
+  CHECK(check_against_truth(cue, out, 0.0F, kLookTilt) >= 5);
+}
+
+TEST(FloorCue, LearningAtLevelTiltFindsNoReferenceRegion) {
+  load("");
+  render(0.0F, 0.0F, 1, g_frame);
+  CHECK(FloorLearn::kNoRegion == cue.learn(g_frame, 0.0F, 0.0F));
+  CHECK_FALSE(cue.model().valid);
+  run(0.0F, 0.0F, 1);
+  CHECK_FALSE(out.result.model_valid);
+  CHECK_EQUAL(0U, out.obstacles.size() + out.free.size());
+}
+
+TEST(FloorCue, ProcessingNeverWritesPastTheOutputsAndDoesNotAllocate) {
+  load(plain_box("wall", "2.0 0 0.75", "0.1 8 1.5", "0.8 0.8 0.75"));
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  FixedVector<Reading, 7> obstacles;
+  FixedVector<Reading, 5> free;
+  FloorCueResult r;
+  CHECK_NO_ALLOCATION(r = cue.process(g_frame, 0.0F, kLookTilt, obstacles, free));
+  CHECK(r.truncated);
+  CHECK_EQUAL(7U, obstacles.size());
+  CHECK_EQUAL(5U, free.size());
+  CHECK_EQUAL(7U, r.obstacle_readings);
+  CHECK_EQUAL(5U, r.free_readings);
+  CHECK_NO_ALLOCATION(static_cast<void>(cue.learn(g_frame, 0.0F, kLookTilt)));
+}
+
+TEST(FloorCue, CoverageOfTheLookTiltsAndTheirStereoPartners) {
+  // Prints what each tilt of the look sees of the floor (centre column); the numbers the
+  // report quotes. The checks are the geometry's plain facts.
+  for (const float tilt : {0.0F, -0.134390352F, -0.5F, -0.634390352F, -0.55F, -0.6F}) {
+    float near_m = 0.0F;
+    float far_m = 0.0F;
+    CHECK(cue.floor_coverage(tilt, near_m, far_m));
+    std::printf("\n  tilt %+.3f rad: floor from %.2f m to %.2f m", static_cast<double>(tilt),
+                static_cast<double>(near_m), static_cast<double>(far_m));
+    CHECK(near_m < far_m);
+  }
+  float near0 = 0.0F;
+  float far0 = 0.0F;
+  CHECK(cue.floor_coverage(0.0F, near0, far0));
+  CHECK(std::isinf(far0));  // level: the top rows see the horizon
+}
