@@ -1,11 +1,15 @@
 // TargetTracker: grouping of target sightings (see target_tracker.h).
 #include "firmware/mission/target_tracker.h"
 
+#include <cmath>
+
 namespace boticelli::firmware::mission {
 
 void TargetTracker::add(const Eigen::Vector3f& point_world_m, float confidence,
                         std::uint32_t view) {
-  if (!point_world_m.allFinite()) return;
+  // A non-finite confidence would make the group's weighted mean NaN, and a NaN centre
+  // counts every sighting as within the radius.
+  if (!point_world_m.allFinite() || !std::isfinite(confidence)) return;
   sightings_[next_] = {point_world_m, confidence, view};
   next_ = (next_ + 1) % kMaxSightings;
   if (count_ < kMaxSightings) ++count_;

@@ -1,0 +1,187 @@
+// Tests of the TargetTracker: a goal only when two distinct views agree; outliers, NaN, refinement.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+
+#include <Eigen/Core>
+
+#include "firmware/mission/target_tracker.h"
+
+#include "CppUTest/TestHarness.h"
+
+using boticelli::firmware::mission::TargetTracker;
+using boticelli::firmware::mission::TargetTrackerParams;
+
+namespace {
+
+const Eigen::Vector3f kTarget(2.0F, 1.0F, 0.3F);  // world frame [m]
+
+void check_near(const Eigen::Vector3f& expected, const Eigen::Vector3f& actual, float tol_m) {
+  DOUBLES_EQUAL(expected.x(), actual.x(), tol_m);
+  DOUBLES_EQUAL(expected.y(), actual.y(), tol_m);
+  DOUBLES_EQUAL(expected.z(), actual.z(), tol_m);
+}
+
+}  // namespace
+
+TEST_GROUP(TargetTracker) {
+  TargetTracker tracker;
+  void setup() override {
+    tracker.configure(TargetTrackerParams{});
+  }
+};
+
+TEST(TargetTracker, OneSightingNeverConfirms) {
+  tracker.add(kTarget, 0.9F, 1);
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  UNSIGNED_LONGS_EQUAL(1, tracker.supporting_views());
+}
+
+TEST(TargetTracker, SightingsFromTheSameViewNeverConfirm) {
+  for (int i = 0; i < 10; ++i) {
+    tracker.add(kTarget + Eigen::Vector3f(0.01F * static_cast<float>(i), 0.0F, 0.0F), 0.9F, 7);
+  }
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(10, tracker.sightings());
+  UNSIGNED_LONGS_EQUAL(1, tracker.supporting_views());
+}
+
+TEST(TargetTracker, TwoViewsWithinTheRadiusConfirmWithTheirMean) {
+  const Eigen::Vector3f a = kTarget + Eigen::Vector3f(0.1F, 0.0F, 0.0F);
+  const Eigen::Vector3f b = kTarget - Eigen::Vector3f(0.1F, 0.0F, 0.0F);  // 0.2 m < 0.25 m
+  tracker.add(a, 0.8F, 1);
+  CHECK_FALSE(tracker.confirmed());
+  tracker.add(b, 0.8F, 2);
+  CHECK(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(2, tracker.supporting_views());
+  check_near(kTarget, tracker.estimate_m(), 1e-5F);
+}
+
+TEST(TargetTracker, TwoViewsFartherApartThanTheRadiusDoNotConfirm) {
+  tracker.add(kTarget, 0.8F, 1);
+  tracker.add(kTarget + Eigen::Vector3f(0.0F, 0.3F, 0.0F), 0.8F, 2);  // 0.3 m > 0.25 m
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(1, tracker.supporting_views());
+}
+
+TEST(TargetTracker, AConfidentSightingWeighsMoreThanAnUnsureOne) {
+  const Eigen::Vector3f sure = kTarget + Eigen::Vector3f(0.1F, 0.0F, 0.0F);
+  const Eigen::Vector3f unsure = kTarget - Eigen::Vector3f(0.1F, 0.0F, 0.0F);
+  tracker.add(sure, 1.0F, 1);
+  tracker.add(unsure, 0.0F, 2);
+  CHECK(tracker.confirmed());
+  // Still between the two, but nearer the confident one.
+  CHECK(tracker.estimate_m().x() > kTarget.x() + 0.05F);
+  CHECK(tracker.estimate_m().x() < sure.x());
+}
+
+TEST(TargetTracker, AFarOutlierDoesNotMoveTheEstimate) {
+  tracker.add(kTarget + Eigen::Vector3f(0.05F, 0.0F, 0.0F), 0.8F, 1);
+  tracker.add(kTarget - Eigen::Vector3f(0.05F, 0.0F, 0.0F), 0.8F, 2);
+  CHECK(tracker.confirmed());
+  const Eigen::Vector3f before = tracker.estimate_m();
+  tracker.add(kTarget + Eigen::Vector3f(1.5F, -2.0F, 0.4F), 1.0F, 3);  // a reflection
+  CHECK(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(2, tracker.supporting_views());
+  check_near(before, tracker.estimate_m(), 1e-6F);
+  // An outlier just outside the radius of the group's mean does not pull it either.
+  tracker.add(kTarget + Eigen::Vector3f(0.0F, 0.0F, 0.27F), 1.0F, 4);
+  check_near(before, tracker.estimate_m(), 1e-6F);
+}
+
+TEST(TargetTracker, AGroupWithMoreViewsWinsOverAnEarlierPair) {
+  // A false pair first (two views of a reflection), then the real target from three views.
+  const Eigen::Vector3f ghost(-1.0F, 3.0F, 0.5F);
+  tracker.add(ghost, 0.9F, 1);
+  tracker.add(ghost, 0.9F, 2);
+  CHECK(tracker.confirmed());
+  check_near(ghost, tracker.estimate_m(), 1e-6F);
+  tracker.add(kTarget, 0.5F, 3);
+  tracker.add(kTarget, 0.5F, 4);
+  tracker.add(kTarget, 0.5F, 5);
+  UNSIGNED_LONGS_EQUAL(3, tracker.supporting_views());
+  check_near(kTarget, tracker.estimate_m(), 1e-6F);
+}
+
+TEST(TargetTracker, MoreSightingsRefineTheEstimate) {
+  // Noisy sightings (σ = 5 cm per axis) from distinct views: the error of the estimate after
+  // 40 sightings is well below that after the first two that confirmed it.
+  std::mt19937 rng(12345);
+  std::normal_distribution<float> noise(0.0F, 0.05F);
+  auto sighting = [&] {
+    return Eigen::Vector3f(kTarget + Eigen::Vector3f(noise(rng), noise(rng), noise(rng)));
+  };
+  float first_error = 0.0F;
+  float sum_first = 0.0F;
+  float sum_last = 0.0F;
+  constexpr int kTrials = 20;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    tracker.clear();
+    std::uint32_t view = 0;
+    while (!tracker.confirmed()) tracker.add(sighting(), 0.7F, view++);
+    first_error = (tracker.estimate_m() - kTarget).norm();
+    for (int i = 0; i < 40; ++i) tracker.add(sighting(), 0.7F, view++);
+    sum_first += first_error;
+    sum_last += (tracker.estimate_m() - kTarget).norm();
+  }
+  const float mean_first = sum_first / kTrials;
+  const float mean_last = sum_last / kTrials;
+  CHECK(mean_last < 0.5F * mean_first);
+  CHECK(mean_last < 0.03F);
+}
+
+TEST(TargetTracker, ANonFiniteSightingIsIgnored) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  tracker.add(kTarget, 0.8F, 1);
+  tracker.add(Eigen::Vector3f(nan, 1.0F, 0.3F), 0.8F, 2);
+  tracker.add(Eigen::Vector3f(2.0F, inf, 0.3F), 0.8F, 3);
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  CHECK_FALSE(tracker.confirmed());
+  tracker.add(kTarget, 0.8F, 4);
+  CHECK(tracker.confirmed());
+  CHECK(tracker.estimate_m().allFinite());
+  check_near(kTarget, tracker.estimate_m(), 1e-6F);
+}
+
+TEST(TargetTracker, ANonFiniteConfidenceDoesNotPoisonTheEstimate) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  tracker.add(kTarget, 0.8F, 1);
+  tracker.add(Eigen::Vector3f(-2.0F, 0.0F, 0.2F), nan, 2);  // far away, confidence NaN
+  tracker.add(Eigen::Vector3f(4.0F, 3.0F, 0.2F), 0.8F, 3);
+  CHECK_FALSE(tracker.confirmed());  // three lone sightings, none agreeing
+  tracker.add(kTarget, 0.8F, 4);
+  CHECK(tracker.confirmed());
+  CHECK(tracker.estimate_m().allFinite());
+  check_near(kTarget, tracker.estimate_m(), 1e-6F);
+}
+
+TEST(TargetTracker, TheRingBufferOverwritesTheOldestAfter64) {
+  // Five views of A, then 64 sightings of B from only two views: while A keeps more views
+  // than B it stays the estimate; once B's sightings have overwritten every one of A's,
+  // B is the estimate.
+  const Eigen::Vector3f a(1.0F, 0.0F, 0.3F);
+  const Eigen::Vector3f b(-1.0F, 2.0F, 0.3F);
+  for (std::uint32_t v = 0; v < 5; ++v) tracker.add(a, 0.8F, v);
+  for (std::uint32_t i = 0; i < 59; ++i) tracker.add(b, 0.8F, 100 + i % 2);
+  UNSIGNED_LONGS_EQUAL(TargetTracker::kMaxSightings, tracker.sightings());
+  UNSIGNED_LONGS_EQUAL(5, tracker.supporting_views());
+  check_near(a, tracker.estimate_m(), 1e-6F);
+  for (std::uint32_t i = 59; i < 64; ++i) tracker.add(b, 0.8F, 100 + i % 2);
+  UNSIGNED_LONGS_EQUAL(TargetTracker::kMaxSightings, tracker.sightings());
+  UNSIGNED_LONGS_EQUAL(2, tracker.supporting_views());
+  check_near(b, tracker.estimate_m(), 1e-6F);
+}
+
+TEST(TargetTracker, ClearForgetsEverything) {
+  tracker.add(kTarget, 0.8F, 1);
+  tracker.add(kTarget, 0.8F, 2);
+  CHECK(tracker.confirmed());
+  tracker.clear();
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
+  tracker.add(kTarget, 0.8F, 3);
+  CHECK_FALSE(tracker.confirmed());
+}
