@@ -1,0 +1,559 @@
+// Benchmark suite "look": one 360° look of the mission on the sim renderer, checked against the
+// world.
+#include <dirent.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "algo/core/fixed_vector.h"
+#include "algo/core/geometry.h"
+#include "algo/evidence/reading.h"
+#include "algo/evidence/reading_limits.h"
+#include "algo/image/low_res_frame.h"
+#include "algo/mapping/local_model_builder.h"
+#include "algo/stereo/floor_cue.h"
+#include "algo/stereo/rig.h"
+#include "algo/stereo/stereo_processor.h"
+#include "bench.h"
+#include "board_config.h"
+#include "firmware/mission/mission.h"
+#include "firmware/mission/mission_params.h"
+#include "hal/sim/renderer.h"
+#include "hal/sim/sim_world.h"
+#include "hal/sim/textures.h"
+#include "hal/sim/world.h"
+#include "hal/sim/world_geometry.h"
+
+namespace boticelli::bench {
+namespace {
+
+constexpr const char* kSuite = "look";
+constexpr double kGridStepM = 0.02;       // area integration step [m]
+constexpr double kReachStepM = 0.05;      // reachability flood-fill cell [m]
+constexpr double kTargetViewM = 3.5;      // target counted "in view" up to this range [m]
+constexpr float kTargetMarginPx = 16.0F;  // ... and this far inside the full-resolution image
+constexpr std::size_t kVisibilityRays = 720;
+
+using Readings = core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFeatures>;
+using FloorObstacles =
+    core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFloorObstacles>;
+using FloorFree = core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFloorFree>;
+
+// Large objects live outside the stack.
+hal::sim::World g_world;
+hal::sim::TextureBank g_bank;
+hal::sim::SimWorld g_sim;
+hal::sim::Renderer g_renderer;
+image::LowResFrame g_first;
+image::LowResFrame g_second;
+Readings g_features;
+FloorObstacles g_floor_obstacles;
+FloorFree g_floor_free;
+mapping::LocalModelBuilder g_builder;
+
+std::int64_t cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+}
+
+long env_long(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  if (v == nullptr || *v == '\0') return fallback;
+  const long n = std::strtol(v, nullptr, 10);
+  return n > 0 ? n : fallback;
+}
+
+double env_double(const char* name, double fallback) {
+  const char* v = std::getenv(name);
+  if (v == nullptr || *v == '\0') return fallback;
+  return std::atof(v);
+}
+
+// Shipped worlds, optionally restricted by BOTICELLI_LOOK_WORLDS=name[,name...].
+std::vector<std::string> world_names() {
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(BOTICELLI_WORLDS_DIR); d != nullptr) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n.size() > 4 && n.compare(n.size() - 4, 4, ".sdf") == 0) {
+        names.push_back(n.substr(0, n.size() - 4));
+      }
+    }
+    ::closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  const char* only = std::getenv("BOTICELLI_LOOK_WORLDS");
+  if (only == nullptr || *only == '\0') return names;
+  std::vector<std::string> wanted;
+  std::stringstream list(only);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    if (item.size() > 4 && item.compare(item.size() - 4, 4, ".sdf") == 0)
+      item.resize(item.size() - 4);
+    if (std::find(names.begin(), names.end(), item) != names.end()) wanted.push_back(item);
+  }
+  return wanted;
+}
+
+float quantise(float rad, float resolution_rad) {
+  return resolution_rad > 0.0F ? std::round(rad / resolution_rad) * resolution_rad : rad;
+}
+
+// The views of one look, as Mission::view_angles: pans spread over the PTU's pan range, rows
+// lowest tilt first, every other row swept back; a pair's tilt leaves room for the second frame.
+struct View {
+  float pan_rad;
+  float tilt_rad;
+  bool pair;
+};
+
+std::vector<View> look_views(const firmware::mission::MissionParams& params,
+                             const hal::PanTiltLimits& lim) {
+  std::vector<firmware::mission::LookRow> rows(params.rows, params.rows + params.row_count);
+  std::sort(rows.begin(), rows.end(),
+            [](const auto& a, const auto& b) { return a.tilt_rad < b.tilt_rad; });
+  std::vector<View> views;
+  for (std::size_t row = 0; row < rows.size(); ++row) {
+    for (std::size_t k = 0; k < params.pan_positions; ++k) {
+      const std::size_t i = row % 2 == 1 ? params.pan_positions - 1 - k : k;
+      const float t = params.pan_positions == 1
+                          ? 0.5F
+                          : static_cast<float>(i) / static_cast<float>(params.pan_positions - 1);
+      View v{lim.pan_min_rad + t * (lim.pan_max_rad - lim.pan_min_rad),
+             std::clamp(rows[row].tilt_rad, lim.tilt_min_rad, lim.tilt_max_rad), rows[row].pair};
+      if (v.pair && v.tilt_rad - params.rig.tilt_step_rad < lim.tilt_min_rad) {
+        v.tilt_rad = lim.tilt_min_rad + params.rig.tilt_step_rad;
+      }
+      views.push_back(v);
+    }
+  }
+  return views;
+}
+
+// Cells reachable by the robot's disc from the world's start (4-neighbour flood fill).
+struct Reach {
+  double x0 = 0.0, y0 = 0.0;
+  std::size_t nx = 0, ny = 0;
+  std::vector<std::uint8_t> reached;
+  bool at(double x, double y) const {
+    const double fx = (x - x0) / kReachStepM;
+    const double fy = (y - y0) / kReachStepM;
+    if (fx < 0.0 || fy < 0.0) return false;
+    const auto ix = static_cast<std::size_t>(fx);
+    const auto iy = static_cast<std::size_t>(fy);
+    return ix < nx && iy < ny && reached[iy * nx + ix] != 0;
+  }
+};
+
+Reach reachable(const hal::sim::World& w, float radius_m, float height_m) {
+  Reach r;
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  auto grow = [&](double x, double y) {
+    x0 = std::min(x0, x);
+    x1 = std::max(x1, x);
+    y0 = std::min(y0, y);
+    y1 = std::max(y1, y);
+  };
+  for (std::size_t i = 0; i < w.collider_count; ++i) {
+    const hal::sim::Collider& c = w.colliders[i];
+    if (c.circle) {
+      grow(c.centre_x_m - c.radius_m, c.centre_y_m - c.radius_m);
+      grow(c.centre_x_m + c.radius_m, c.centre_y_m + c.radius_m);
+    } else {
+      for (std::size_t k = 0; k < c.hull_size; ++k) grow(c.hull[k].x_m, c.hull[k].y_m);
+    }
+  }
+  grow(w.start.x_m, w.start.y_m);
+  r.x0 = x0;
+  r.y0 = y0;
+  r.nx = static_cast<std::size_t>((x1 - x0) / kReachStepM) + 1;
+  r.ny = static_cast<std::size_t>((y1 - y0) / kReachStepM) + 1;
+  r.reached.assign(r.nx * r.ny, 0);
+  std::vector<std::uint8_t> seen(r.nx * r.ny, 0);
+  const auto sx = static_cast<std::size_t>((static_cast<double>(w.start.x_m) - x0) / kReachStepM);
+  const auto sy = static_cast<std::size_t>((static_cast<double>(w.start.y_m) - y0) / kReachStepM);
+  std::vector<std::size_t> queue{sy * r.nx + sx};
+  seen[queue[0]] = 1;
+  while (!queue.empty()) {
+    const std::size_t c = queue.back();
+    queue.pop_back();
+    const std::size_t ix = c % r.nx;
+    const std::size_t iy = c / r.nx;
+    const double x = x0 + (static_cast<double>(ix) + 0.5) * kReachStepM;
+    const double y = y0 + (static_cast<double>(iy) + 0.5) * kReachStepM;
+    if (hal::sim::disc_clearance_m(w, static_cast<float>(x), static_cast<float>(y), radius_m,
+                                   height_m) < 0.0F) {
+      continue;
+    }
+    r.reached[c] = 1;
+    const std::size_t next[4] = {ix > 0 ? c - 1 : c, ix + 1 < r.nx ? c + 1 : c,
+                                 iy > 0 ? c - r.nx : c, iy + 1 < r.ny ? c + r.nx : c};
+    for (const std::size_t n : next) {
+      if (seen[n] == 0) {
+        seen[n] = 1;
+        queue.push_back(n);
+      }
+    }
+  }
+  return r;
+}
+
+// A floor point is truly free when no collider in the robot's height band covers it.
+bool truly_free(double x, double y, float height_m) {
+  return hal::sim::disc_clearance_m(g_world, static_cast<float>(x), static_cast<float>(y), 0.0F,
+                                    height_m) > 0.0F;
+}
+
+// How far the floor is visible from (x, y) in direction a within `bound` (first collider
+// footprint in the height band), by sphere tracing on the footprint clearance [m].
+double visible_range(double x, double y, double a, double bound, float height_m) {
+  double t = 0.0;
+  const double c = std::cos(a), s = std::sin(a);
+  while (t < bound) {
+    const float d = hal::sim::disc_clearance_m(g_world, static_cast<float>(x + t * c),
+                                               static_cast<float>(y + t * s), 0.0F, height_m);
+    if (d < 0.002F) return t;
+    t += std::max(static_cast<double>(d), 0.005);
+  }
+  return bound;
+}
+
+struct Quality {
+  double safety = 1.0;      // free polygon area that is truly free / its area
+  double coverage = 0.0;    // truly free floor in sight within the circle that the polygon holds
+  double nav_safety = 1.0;  // navigable area whose robot disc is truly free / its area
+  double free_area_m2 = 0.0;
+  double nav_area_m2 = 0.0;
+};
+
+Quality quality(const core::Pose2& pose, const mapping::LocalMap& map, double bound,
+                float robot_radius_m, float height_m) {
+  std::vector<double> sight(kVisibilityRays);
+  for (std::size_t k = 0; k < kVisibilityRays; ++k) {
+    const double a = 2.0 * std::numbers::pi * static_cast<double>(k) / kVisibilityRays;
+    sight[k] = visible_range(pose.x_m, pose.y_m, a, bound, height_m);
+  }
+  std::size_t in_poly = 0, in_poly_free = 0, visible_free = 0, visible_free_in_poly = 0;
+  std::size_t in_nav = 0, in_nav_safe = 0;
+  for (double dy = -bound; dy <= bound; dy += kGridStepM) {
+    for (double dx = -bound; dx <= bound; dx += kGridStepM) {
+      const double rho = std::hypot(dx, dy);
+      if (rho > bound) continue;
+      const double x = static_cast<double>(pose.x_m) + dx;
+      const double y = static_cast<double>(pose.y_m) + dy;
+      const bool is_free = truly_free(x, y, height_m);
+      const core::Point2 q = core::to_robot(pose, {static_cast<float>(x), static_cast<float>(y)});
+      const bool inside = map.free.contains(q);
+      double a = std::atan2(dy, dx);
+      if (a < 0.0) a += 2.0 * std::numbers::pi;
+      const auto k =
+          static_cast<std::size_t>(std::lround(a / (2.0 * std::numbers::pi) * kVisibilityRays)) %
+          kVisibilityRays;
+      const bool visible = rho <= sight[k];
+      in_poly += inside ? 1U : 0U;
+      in_poly_free += (inside && is_free) ? 1U : 0U;
+      visible_free += (visible && is_free) ? 1U : 0U;
+      visible_free_in_poly += (visible && is_free && inside) ? 1U : 0U;
+      if (map.navigable.contains(q)) {
+        ++in_nav;
+        in_nav_safe +=
+            hal::sim::disc_clearance_m(g_world, static_cast<float>(x), static_cast<float>(y),
+                                       robot_radius_m, height_m) >= 0.0F
+                ? 1U
+                : 0U;
+      }
+    }
+  }
+  Quality q;
+  const double cell = kGridStepM * kGridStepM;
+  q.safety = in_poly > 0 ? static_cast<double>(in_poly_free) / static_cast<double>(in_poly) : 1.0;
+  q.coverage = visible_free > 0
+                   ? static_cast<double>(visible_free_in_poly) / static_cast<double>(visible_free)
+                   : 0.0;
+  q.nav_safety = in_nav > 0 ? static_cast<double>(in_nav_safe) / static_cast<double>(in_nav) : 1.0;
+  q.free_area_m2 = static_cast<double>(in_poly) * cell;
+  q.nav_area_m2 = static_cast<double>(in_nav) * cell;
+  return q;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(
+      std::clamp(p * static_cast<double>(v.size() - 1), 0.0, static_cast<double>(v.size() - 1)));
+  return v[i];
+}
+
+double mean(const std::vector<double>& v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double s = 0.0;
+  for (const double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+
+// Is the target's corner in both frames of a pair, within kTargetViewM, on a face turned to
+// the camera and not hidden? (Pinhole projection; the margin absorbs the mild distortion.)
+bool target_in_view(const hal::sim::RigidTransform& first, const hal::sim::RigidTransform& second,
+                    const stereo::CameraIntrinsics& cam) {
+  const Eigen::Vector3f target = g_world.target_point_m;
+  const Eigen::Vector3f to_target = target - first.translation_m;
+  const float dist = to_target.norm();
+  if (static_cast<double>(dist) > kTargetViewM || g_world.target_normal.dot(-to_target) <= 0.0F)
+    return false;
+  for (const hal::sim::RigidTransform* t : {&first, &second}) {
+    const Eigen::Vector3f p = t->rotation.transpose() * (target - t->translation_m);
+    if (p.z() <= 0.05F) return false;
+    const float u = cam.focal_px * p.x() / p.z() + cam.principal_x_px;
+    const float v = cam.focal_px * p.y() / p.z() + cam.principal_y_px;
+    if (u < kTargetMarginPx || v < kTargetMarginPx ||
+        u > static_cast<float>(cam.width_px) - kTargetMarginPx ||
+        v > static_cast<float>(cam.height_px) - kTargetMarginPx) {
+      return false;
+    }
+  }
+  std::size_t surface = 0;
+  float t = 0.0F;
+  if (hal::sim::cast_ray(g_world, first.translation_m, to_target, surface, t) &&
+      t < 1.0F - 0.02F / dist) {
+    return false;  // something in front of it
+  }
+  return true;
+}
+
+struct WorldStats {
+  std::vector<double> readings, floor_obstacles, floor_free, weak_share;
+  std::vector<double> range_error_m, range_error_rel;  // |r − r_true| [m] and / δr (Eq 3.7)
+  std::vector<double> safety, coverage, nav_safety, free_area, nav_area, pieces;
+  std::vector<double> render_ms, stereo_ms, target_ms, floor_ms, think_ms;
+  std::size_t target_views = 0, target_found = 0, target_false = 0;
+  std::vector<double> target_error_m;
+};
+
+int run_world(const std::string& name, std::size_t poses, double min_clearance_m) {
+  const firmware::BoardConfig config = boards::sim::make_config();
+  const firmware::mission::MissionParams params = firmware::mission::make_mission_params(config);
+  const boards::sim::SimSettings settings = boards::sim::make_settings(config, 1);
+  static const stereo::RigModel rig(params.rig);
+  static stereo::StereoProcessor stereo(rig, params.stereo);
+  static stereo::FloorCue floor_cue(rig);
+
+  const std::string path = std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
+  char error[256] = "";
+  if (!hal::sim::load_world(path.c_str(), g_world, error, sizeof error) ||
+      !g_bank.build(g_world, error, sizeof error) ||
+      !g_sim.init(g_world, rig, settings.physics, error, sizeof error) ||
+      !g_renderer.init(g_world, g_bank, rig.camera(), settings.render, error, sizeof error)) {
+    std::fprintf(stderr, "look: %s: %s\n", name.c_str(), error);
+    return 1;
+  }
+  const hal::PanTiltLimits lim = settings.physics.ptu.limits;
+  const std::vector<View> views = look_views(params, lim);
+  const stereo::CameraIntrinsics& cam = rig.camera();
+  const std::size_t stride = 2U * cam.width_px;
+  std::vector<std::uint8_t> first_yuyv(stride * cam.height_px);
+  std::vector<std::uint8_t> second_yuyv(stride * cam.height_px);
+  const float height = config.robot_height_m;
+  const float radius = config.robot_radius_m;
+
+  // Poses: uniform in the reachable area, centre at least min_clearance_m from every
+  // obstacle footprint in the robot's height band, random heading (seeded per world).
+  const Reach reach = reachable(g_world, radius, height);
+  std::mt19937 rng(12345U + static_cast<std::uint32_t>(std::hash<std::string>{}(name)&0xFFFFU));
+  std::uniform_real_distribution<double> ux(reach.x0,
+                                            reach.x0 + static_cast<double>(reach.nx) * kReachStepM);
+  std::uniform_real_distribution<double> uy(reach.y0,
+                                            reach.y0 + static_cast<double>(reach.ny) * kReachStepM);
+  std::uniform_real_distribution<double> uyaw(-std::numbers::pi, std::numbers::pi);
+  std::vector<core::Pose2> pose_list;
+  for (int tries = 0; pose_list.size() < poses && tries < 100000; ++tries) {
+    const double x = ux(rng), y = uy(rng), yaw = uyaw(rng);
+    if (!reach.at(x, y)) continue;
+    if (hal::sim::disc_clearance_m(g_world, static_cast<float>(x), static_cast<float>(y), 0.0F,
+                                   height) < static_cast<float>(min_clearance_m)) {
+      continue;
+    }
+    pose_list.push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(yaw)});
+  }
+
+  WorldStats st;
+  std::uint32_t frame_index = 0;
+  for (const core::Pose2& pose : pose_list) {
+    g_features.clear();
+    g_floor_obstacles.clear();
+    g_floor_free.clear();
+    floor_cue.reset();  // the mission's first look: nothing known about the floor yet
+    double render_ns = 0, stereo_ns = 0, target_ns = 0, floor_ns = 0;
+    for (const View& view : views) {
+      stereo::PairPose pp;
+      pp.pan_rad = quantise(view.pan_rad, lim.pan_resolution_rad);
+      pp.first_tilt_rad = quantise(view.tilt_rad, lim.tilt_resolution_rad);
+      pp.second_tilt_rad =
+          quantise(view.tilt_rad - params.rig.tilt_step_rad, lim.tilt_resolution_rad);
+      const hal::sim::RigidTransform first_pose =
+          g_sim.camera_pose(pose, pp.pan_rad, pp.first_tilt_rad);
+      const hal::sim::RigidTransform second_pose =
+          g_sim.camera_pose(pose, pp.pan_rad, pp.second_tilt_rad);
+      std::int64_t t0 = cpu_ns();
+      g_renderer.render(first_pose, frame_index++, first_yuyv.data(), stride, nullptr);
+      if (view.pair) {
+        g_renderer.render(second_pose, frame_index++, second_yuyv.data(), stride, nullptr);
+      }
+      (void)image::downsample_yuyv(first_yuyv.data(), cam.width_px, cam.height_px,
+                                   static_cast<std::uint32_t>(stride), params.rig.downsample_factor,
+                                   g_first);
+      if (view.pair) {
+        (void)image::downsample_yuyv(second_yuyv.data(), cam.width_px, cam.height_px,
+                                     static_cast<std::uint32_t>(stride),
+                                     params.rig.downsample_factor, g_second);
+      }
+      render_ns += static_cast<double>(cpu_ns() - t0);
+      if (view.pair) {
+        t0 = cpu_ns();
+        (void)stereo.process(g_first, g_second, pp, g_features);
+        stereo_ns += static_cast<double>(cpu_ns() - t0);
+        // Range error of this pair's points against the ray caster along the same line of
+        // sight from the first optical centre.
+        for (const stereo::StereoPoint& sp : stereo.points()) {
+          const core::Point2 w = core::to_world(pose, {sp.point_ptu_m.x(), sp.point_ptu_m.y()});
+          const Eigen::Vector3f p(w.x_m, w.y_m, sp.point_ptu_m.z() + params.rig.ptu_height_m);
+          const Eigen::Vector3f d = p - first_pose.translation_m;
+          std::size_t surface = 0;
+          float t = 0.0F;
+          if (!hal::sim::cast_ray(g_world, first_pose.translation_m, d, surface, t)) continue;
+          const double err =
+              std::fabs(static_cast<double>(d.norm()) * (1.0 - static_cast<double>(t)));
+          st.range_error_m.push_back(err);
+          if (sp.range_error_m > 0.0F)
+            st.range_error_rel.push_back(err / static_cast<double>(sp.range_error_m));
+        }
+        t0 = cpu_ns();
+        const stereo::TargetFix fix = stereo.locate_target(g_first, g_second, pp);
+        target_ns += static_cast<double>(cpu_ns() - t0);
+        const bool in_view = target_in_view(first_pose, second_pose, cam);
+        st.target_views += in_view ? 1U : 0U;
+        if (fix.found) {
+          const core::Point2 w = core::to_world(pose, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
+          const Eigen::Vector3f p(w.x_m, w.y_m, fix.point_ptu_m.z() + params.rig.ptu_height_m);
+          const double e = (p - g_world.target_point_m).norm();
+          if (in_view) {
+            ++st.target_found;
+            st.target_error_m.push_back(e);
+          } else {
+            st.target_false += e > 0.3 ? 1U : 0U;  // a fix of the target seen at the edge is fine
+          }
+        }
+      }
+      t0 = cpu_ns();
+      if (!view.pair || pp.first_tilt_rad < -0.3F) {
+        (void)floor_cue.learn(g_first, pp.pan_rad, pp.first_tilt_rad);
+      }
+      (void)floor_cue.process(g_first, pp.pan_rad, pp.first_tilt_rad, g_floor_obstacles,
+                              g_floor_free);
+      floor_ns += static_cast<double>(cpu_ns() - t0);
+    }
+    std::size_t weak = 0;
+    for (const evidence::Reading& r : g_features) weak += r.m < 0.6F ? 1U : 0U;
+    st.readings.push_back(static_cast<double>(g_features.size()));
+    st.weak_share.push_back(g_features.empty() ? 0.0
+                                               : static_cast<double>(weak) /
+                                                     static_cast<double>(g_features.size()));
+    st.floor_obstacles.push_back(static_cast<double>(g_floor_obstacles.size()));
+    st.floor_free.push_back(static_cast<double>(g_floor_free.size()));
+
+    // Think, as Mission::begin_think: filter by the reading limits, then the local model.
+    const std::int64_t t0 = cpu_ns();
+    (void)evidence::filter_readings(g_features, params.limits);
+    g_builder.start(params.model, g_features.span(), g_floor_obstacles.span(), g_floor_free.span());
+    g_builder.run();
+    st.think_ms.push_back(static_cast<double>(cpu_ns() - t0) * 1e-6);
+    st.pieces.push_back(static_cast<double>(g_builder.stats().pieces));
+    st.render_ms.push_back(render_ns * 1e-6);
+    st.stereo_ms.push_back(stereo_ns * 1e-6);
+    st.target_ms.push_back(target_ns * 1e-6);
+    st.floor_ms.push_back(floor_ns * 1e-6);
+
+    const Quality q =
+        quality(pose, g_builder.map(),
+                static_cast<double>(params.model.extraction.bounding_radius_m), radius, height);
+    st.safety.push_back(q.safety);
+    st.coverage.push_back(q.coverage);
+    st.nav_safety.push_back(q.nav_safety);
+    st.free_area.push_back(q.free_area_m2);
+    st.nav_area.push_back(q.nav_area_m2);
+  }
+
+  std::size_t unsafe_nav = 0;
+  for (const double s : st.nav_safety) unsafe_nav += s < 1.0 ? 1U : 0U;
+  const double min_safety = st.safety.empty()
+                                ? std::numeric_limits<double>::quiet_NaN()
+                                : *std::min_element(st.safety.begin(), st.safety.end());
+  const double min_nav = st.nav_safety.empty()
+                             ? std::numeric_limits<double>::quiet_NaN()
+                             : *std::min_element(st.nav_safety.begin(), st.nav_safety.end());
+  JsonLine(kSuite, name.c_str())
+      .integer("poses", static_cast<std::int64_t>(pose_list.size()))
+      .integer("views", static_cast<std::int64_t>(views.size()))
+      .num("readings", mean(st.readings))
+      .num("share_m_below_0_6", mean(st.weak_share))
+      .num("floor_obstacle_readings", mean(st.floor_obstacles))
+      .num("floor_free_readings", mean(st.floor_free))
+      .integer("range_points", static_cast<std::int64_t>(st.range_error_m.size()))
+      .num("range_err_median_m", percentile(st.range_error_m, 0.5))
+      .num("range_err_p90_m", percentile(st.range_error_m, 0.9))
+      .num("range_err_p99_m", percentile(st.range_error_m, 0.99))
+      .num("range_err_median_dr", percentile(st.range_error_rel, 0.5))
+      .num("range_err_p90_dr", percentile(st.range_error_rel, 0.9))
+      .num("range_err_p99_dr", percentile(st.range_error_rel, 0.99))
+      .num("pieces", mean(st.pieces))
+      .num("safety", mean(st.safety))
+      .num("safety_min", min_safety)
+      .num("coverage", mean(st.coverage))
+      .num("nav_safety", mean(st.nav_safety))
+      .num("nav_safety_min", min_nav)
+      .integer("looks_nav_unsafe", static_cast<std::int64_t>(unsafe_nav))
+      .num("free_area_m2", mean(st.free_area))
+      .num("nav_area_m2", mean(st.nav_area))
+      .integer("target_views", static_cast<std::int64_t>(st.target_views))
+      .integer("target_found", static_cast<std::int64_t>(st.target_found))
+      .num("target_rate", st.target_views > 0 ? static_cast<double>(st.target_found) /
+                                                    static_cast<double>(st.target_views)
+                                              : std::numeric_limits<double>::quiet_NaN())
+      .num("target_err_median_m", percentile(st.target_error_m, 0.5))
+      .num("target_err_max_m", percentile(st.target_error_m, 1.0))
+      .integer("target_false", static_cast<std::int64_t>(st.target_false))
+      .num("render_ms", mean(st.render_ms))
+      .num("stereo_ms", mean(st.stereo_ms))
+      .num("target_ms", mean(st.target_ms))
+      .num("floor_ms", mean(st.floor_ms))
+      .num("think_ms", mean(st.think_ms))
+      .emit();
+  return 0;
+}
+
+int run() {
+  const auto poses = static_cast<std::size_t>(env_long("BOTICELLI_LOOK_POSES", 20));
+  const double clearance = env_double("BOTICELLI_LOOK_CLEARANCE_M", 0.35);
+  int status = 0;
+  for (const std::string& name : world_names()) {
+    if (run_world(name, poses, clearance) != 0) status = 1;
+  }
+  return status;
+}
+
+[[maybe_unused]] const bool g_registered = register_suite(
+    {kSuite, "one 360-degree look on the sim renderer vs the world's geometry", &run});
+
+}  // namespace
+}  // namespace boticelli::bench

@@ -1,0 +1,453 @@
+// Benchmark suite "mission": the firmware binary run on every shipped world, checked against it.
+#include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "algo/aln/text_format.h"
+#include "algo/mapping/local_model_builder.h"
+#include "bench.h"
+#include "board_config.h"
+#include "firmware/mission_state.h"
+#include "firmware/persistence.h"
+#include "hal/sim/world.h"
+#include "hal/sim/world_geometry.h"
+
+namespace boticelli::bench {
+namespace {
+
+constexpr const char* kSuite = "mission";
+constexpr double kGridCellM = 0.1;     // the grid the model's size is compared with [m]
+constexpr double kGridCeilingM = 2.5;  // its height: BoardConfig::ceiling_height_m [m]
+
+// What the firmware's last line and console said.
+struct MissionLine {
+  bool found_line = false;
+  std::string result = "none";
+  long long cycles = -1;
+  long long collisions = -1;
+  double sim_time_s = std::numeric_limits<double>::quiet_NaN();
+  double wall_time_s = std::numeric_limits<double>::quiet_NaN();
+  double target_error_m = std::numeric_limits<double>::quiet_NaN();
+  bool found_cpu = false;
+  double look_s = std::numeric_limits<double>::quiet_NaN();
+  double think_s = std::numeric_limits<double>::quiet_NaN();
+  double plan_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+// The whole file ("" when it cannot be read).
+std::string read_file(const std::string& path) {
+  std::string text;
+  if (std::FILE* f = std::fopen(path.c_str(), "rb"); f != nullptr) {
+    char buffer[65536];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
+    std::fclose(f);
+  }
+  return text;
+}
+
+// "key=value" in a line of space-separated fields; NaN when absent or not a number.
+double field(std::string_view line, const char* key) {
+  const std::string k = std::string(" ") + key + "=";
+  const std::size_t at = line.find(k);
+  if (at == std::string_view::npos) return std::numeric_limits<double>::quiet_NaN();
+  const std::string value(
+      line.substr(at + k.size(), line.find(' ', at + k.size()) - at - k.size()));
+  char* end = nullptr;
+  const double v = std::strtod(value.c_str(), &end);
+  return end != value.c_str() ? v : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The console output (stdout of --console stdio): the LAST "MISSION ..." line and the last
+// "LOG info mission cpu ..." line. Console lines end in "\r\n".
+MissionLine parse_output(const std::string& path) {
+  MissionLine m;
+  const std::string text = read_file(path);
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(begin, end - begin);
+    begin = end + 1;
+    while (!line.empty() && (line.back() == '\r' || line.back() == '\n')) line.pop_back();
+    if (line.rfind("MISSION ", 0) == 0) {
+      m.found_line = true;
+      const std::size_t at = line.find("result=");
+      m.result = at == std::string::npos ? "?" : line.substr(at + 7, line.find(' ', at) - at - 7);
+      m.cycles = static_cast<long long>(field(line, "cycles"));
+      m.collisions = static_cast<long long>(field(line, "collisions"));
+      m.sim_time_s = field(line, "sim_time_s");
+      m.wall_time_s = field(line, "wall_time_s");
+      m.target_error_m = field(line, "target_error_m");
+    } else if (line.find("LOG info mission cpu ") != std::string::npos) {
+      m.found_cpu = true;
+      m.look_s = field(line, "look_s");
+      m.think_s = field(line, "think_s");
+      m.plan_s = field(line, "plan_s");
+    }
+  }
+  return m;
+}
+
+// The directory of this executable (the firmware is built next to it: build/<preset>/bin).
+std::string own_directory() {
+  char path[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return ".";
+  path[n] = '\0';
+  char* slash = std::strrchr(path, '/');
+  if (slash == nullptr) return ".";
+  *slash = '\0';
+  return path;
+}
+
+// Shipped worlds (BOTICELLI_WORLDS_DIR/*.sdf, sorted), optionally restricted by
+// BOTICELLI_MISSION_WORLDS=name[,name...] (with or without ".sdf").
+std::vector<std::string> world_names() {
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(BOTICELLI_WORLDS_DIR); d != nullptr) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n.size() > 4 && n.compare(n.size() - 4, 4, ".sdf") == 0) {
+        names.push_back(n.substr(0, n.size() - 4));
+      }
+    }
+    ::closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  const char* only = std::getenv("BOTICELLI_MISSION_WORLDS");
+  if (only == nullptr || *only == '\0') return names;
+  std::vector<std::string> wanted;
+  std::stringstream list(only);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    if (item.size() > 4 && item.compare(item.size() - 4, 4, ".sdf") == 0)
+      item.resize(item.size() - 4);
+    if (std::find(names.begin(), names.end(), item) != names.end()) {
+      wanted.push_back(item);
+    } else {
+      std::fprintf(stderr, "mission: no shipped world '%s'\n", item.c_str());
+    }
+  }
+  return wanted;
+}
+
+long env_long(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  if (v == nullptr || *v == '\0') return fallback;
+  const long n = std::strtol(v, nullptr, 10);
+  return n > 0 ? n : fallback;
+}
+
+double wall_s() {
+  return static_cast<double>(now_ns()) * 1e-9;
+}
+
+// Runs the firmware with stdin from /dev/null, stdout (the stdio console and the MISSION
+// line) into `out_path`, stderr into `err_path`. SIGTERM after `timeout_s` (the firmware
+// then aborts and still prints its MISSION line), SIGKILL 10 s later. Returns the exit
+// status (-1 when it could not be started or was killed by a signal) and the child's CPU
+// time (user + system) [s]: on a shared host the wall time mostly measures the neighbours.
+int run_firmware(const std::vector<std::string>& args, const std::string& out_path,
+                 const std::string& err_path, double timeout_s, bool& timed_out, double& cpu_s) {
+  timed_out = false;
+  cpu_s = std::numeric_limits<double>::quiet_NaN();
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    const int in = ::open("/dev/null", O_RDONLY);
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (in < 0 || out < 0 || err < 0) ::_exit(126);
+    ::dup2(in, STDIN_FILENO);
+    ::dup2(out, STDOUT_FILENO);
+    ::dup2(err, STDERR_FILENO);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  const double start = wall_s();
+  bool termed = false;
+  for (;;) {
+    int status = 0;
+    rusage usage{};
+    const pid_t r = ::wait4(pid, &status, WNOHANG, &usage);
+    if (r == pid) {
+      cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+              static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
+      if (WIFEXITED(status)) return WEXITSTATUS(status);
+      return -1;
+    }
+    if (r < 0 && errno != EINTR) return -1;
+    const double elapsed = wall_s() - start;
+    if (!termed && elapsed > timeout_s) {
+      timed_out = true;
+      termed = true;
+      ::kill(pid, SIGTERM);
+    } else if (termed && elapsed > timeout_s + 10.0) {
+      ::kill(pid, SIGKILL);
+    }
+    ::usleep(20000);
+  }
+}
+
+// Size of the last local model as the firmware keeps it, from the state file: the ALN's
+// pieces and nodes in binary plus the global map's points (two floats each).
+struct ModelSize {
+  bool ok = false;
+  std::size_t text_bytes = 0;
+  std::size_t pieces = 0;
+  std::size_t binary_bytes = 0;
+  std::size_t points = 0;
+  std::size_t points_bytes = 0;
+};
+
+firmware::MissionState g_state;  // large: static
+mapping::OccupancyModel g_model;
+
+ModelSize model_size(const std::string& state_file) {
+  ModelSize s;
+  const std::string file = read_file(state_file);
+  if (file.empty()) return s;
+  const char* why = "";
+  if (!firmware::decode_state(file, g_state, &why)) {
+    std::fprintf(stderr, "mission: %s: %s\n", state_file.c_str(), why);
+    return s;
+  }
+  s.text_bytes = g_state.model_bytes;
+  s.points = g_state.obstacles.size() + g_state.exploration.size();
+  s.points_bytes = s.points * sizeof(core::Point2);
+  aln::TextError error{};
+  if (g_state.model_bytes > 0 &&
+      aln::read_text(g_state.model.data(), g_state.model_bytes, g_model, error)) {
+    s.pieces = g_model.piece_count();
+    s.binary_bytes = g_model.piece_count() * sizeof(mapping::OccupancyModel::PieceType) +
+                     g_model.node_count() * sizeof(mapping::OccupancyModel::Node);
+  }
+  s.ok = true;
+  return s;
+}
+
+// A 0.1 m occupancy grid (one byte a cell) over the colliders' floor bounding box, from the
+// floor to the readings' ceiling: what a grid map of the same room would hold.
+std::size_t grid_bytes(const hal::sim::World& w) {
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  for (std::size_t i = 0; i < w.collider_count; ++i) {
+    const hal::sim::Collider& c = w.colliders[i];
+    if (c.circle) {
+      x0 = std::min<double>(x0, c.centre_x_m - c.radius_m);
+      x1 = std::max<double>(x1, c.centre_x_m + c.radius_m);
+      y0 = std::min<double>(y0, c.centre_y_m - c.radius_m);
+      y1 = std::max<double>(y1, c.centre_y_m + c.radius_m);
+    } else {
+      for (std::size_t k = 0; k < c.hull_size; ++k) {
+        x0 = std::min<double>(x0, c.hull[k].x_m);
+        x1 = std::max<double>(x1, c.hull[k].x_m);
+        y0 = std::min<double>(y0, c.hull[k].y_m);
+        y1 = std::max<double>(y1, c.hull[k].y_m);
+      }
+    }
+  }
+  if (x1 < x0) return 0;
+  const auto cells = [](double a, double b) {
+    return static_cast<std::size_t>(std::ceil((b - a) / kGridCellM - 1e-9));
+  };
+  return cells(x0, x1) * cells(y0, y1) * cells(0.0, kGridCeilingM);
+}
+
+hal::sim::World g_world;
+
+// Removes a directory with its files and its subdirectories' files (two levels: the run's
+// directory and its state directory).
+void remove_tree(const std::string& dir) {
+  if (DIR* d = ::opendir(dir.c_str()); d != nullptr) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n == "." || n == "..") continue;
+      const std::string p = dir + "/" + n;
+      if (::unlink(p.c_str()) != 0) remove_tree(p);
+    }
+    ::closedir(d);
+  }
+  ::rmdir(dir.c_str());
+}
+
+int run() {
+  const std::string bin_dir = own_directory();
+  const std::string firmware_bin = bin_dir + "/boticelli";
+  if (::access(firmware_bin.c_str(), X_OK) != 0) {
+    std::fprintf(stderr, "mission: no firmware binary at %s (build the 'boticelli' target)\n",
+                 firmware_bin.c_str());
+    return 1;
+  }
+  const long max_cycles = env_long("BOTICELLI_MISSION_CYCLES", 60);
+  const long seed = env_long("BOTICELLI_MISSION_SEED", 1);
+  const double timeout_s = static_cast<double>(env_long("BOTICELLI_MISSION_TIMEOUT_S", 900));
+  const bool keep = std::getenv("BOTICELLI_MISSION_KEEP") != nullptr;
+  const firmware::BoardConfig config = boards::sim::make_config();
+
+  char tmp_template[] = "/tmp/boticelli-mission-XXXXXX";
+  const char* tmp = ::mkdtemp(tmp_template);
+  if (tmp == nullptr) {
+    std::fprintf(stderr, "mission: cannot create a temporary directory: %s\n",
+                 std::strerror(errno));
+    return 1;
+  }
+
+  const std::vector<std::string> names = world_names();
+  std::size_t worlds = 0;
+  std::size_t with_target = 0;
+  std::size_t successes = 0;
+  double spl_sum = 0.0;
+  for (const std::string& name : names) {
+    const std::string world_path = std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
+    char error[256] = "";
+    if (!hal::sim::load_world(world_path.c_str(), g_world, error, sizeof error)) {
+      std::fprintf(stderr, "mission: %s\n", error);
+      continue;
+    }
+    ++worlds;
+    bool has_target = false;
+    for (std::size_t i = 0; i < g_world.surface_count; ++i) {
+      has_target = has_target || g_world.surfaces[i].target_face != hal::sim::kNoFace;
+    }
+    if (!has_target) {
+      JsonLine(kSuite, name.c_str()).text("skipped", "no target").emit();
+      continue;
+    }
+    ++with_target;
+    const std::string dir = std::string(tmp) + "/" + name;
+    ::mkdir(dir.c_str(), 0755);
+    const std::string trace = dir + "/trace.csv";
+    const std::string out = dir + "/console.txt";
+    const std::string err = dir + "/stderr.txt";
+    const std::string state_dir = dir + "/state";
+    const std::vector<std::string> args = {firmware_bin,
+                                           "--world",
+                                           world_path,
+                                           "--seed",
+                                           std::to_string(seed),
+                                           "--max-cycles",
+                                           std::to_string(max_cycles),
+                                           "--trace",
+                                           trace,
+                                           "--console",
+                                           "stdio",
+                                           "--state",
+                                           state_dir};
+    bool timed_out = false;
+    double cpu_s = 0.0;
+    const double t0 = wall_s();
+    const int exit_code = run_firmware(args, out, err, timeout_s, timed_out, cpu_s);
+    const double wall = wall_s() - t0;
+    const MissionLine m = parse_output(out);
+
+    // The trace against the world's geometry (true poses; the robot's cylinder).
+    std::vector<hal::sim::TraceRow> rows;
+    std::string trace_error;
+    hal::sim::TraceCheck check{};
+    const bool trace_ok = hal::sim::read_trace(trace.c_str(), rows, trace_error);
+    if (trace_ok) {
+      check = hal::sim::check_trace(g_world, rows, config.robot_radius_m, config.robot_height_m);
+    } else {
+      std::fprintf(stderr, "mission: %s: %s\n", name.c_str(), trace_error.c_str());
+    }
+    const core::Point2 start{g_world.start.x_m, g_world.start.y_m};
+    const core::Point2 goal{g_world.target_point_m.x(), g_world.target_point_m.y()};
+    const double shortest = hal::sim::shortest_path_m(g_world, start, goal, config.goal_standoff_m,
+                                                      config.robot_radius_m, config.robot_height_m);
+    const bool success = m.result == "found";
+    const double path = trace_ok ? check.path_length_m : std::numeric_limits<double>::quiet_NaN();
+    double spl = 0.0;
+    if (success && std::isfinite(shortest) && std::isfinite(path)) {
+      spl = std::max(path, shortest) > 0.0 ? shortest / std::max(path, shortest) : 1.0;
+    }
+    successes += success ? 1U : 0U;
+    spl_sum += spl;
+    const double compute_s = m.look_s + m.think_s + m.plan_s;
+    const ModelSize size = model_size(state_dir + "/" + firmware::StateStore::kFileName);
+
+    JsonLine line(kSuite, name.c_str());
+    line.text("result", m.result.c_str())
+        .integer("exit_code", exit_code)
+        .flag("timed_out", timed_out)
+        .integer("cycles", m.cycles)
+        .num("path_length_m", path)
+        .num("shortest_m", shortest)
+        .num("spl", spl)
+        .num("sim_time_s", m.sim_time_s)
+        .num("wall_time_s", wall)
+        .num("firmware_wall_time_s", m.wall_time_s)
+        .num("process_cpu_s", cpu_s)
+        .integer("collisions", trace_ok ? static_cast<std::int64_t>(check.collisions) : -1)
+        .integer("firmware_collisions", m.collisions)
+        .num("min_clearance_m",
+             trace_ok ? check.min_clearance_m : std::numeric_limits<double>::quiet_NaN())
+        .num("max_trace_gap_s",
+             trace_ok ? check.max_gap_s : std::numeric_limits<double>::quiet_NaN())
+        .integer("trace_rows", static_cast<std::int64_t>(check.rows))
+        .num("target_error_m", m.target_error_m)
+        .num("look_cpu_s", m.look_s)
+        .num("think_cpu_s", m.think_s)
+        .num("plan_cpu_s", m.plan_s)
+        .num("compute_share_of_sim_time", m.sim_time_s > 0.0
+                                              ? compute_s / m.sim_time_s
+                                              : std::numeric_limits<double>::quiet_NaN())
+        .num("wall_per_sim_s",
+             m.sim_time_s > 0.0 ? wall / m.sim_time_s : std::numeric_limits<double>::quiet_NaN());
+    if (size.ok) {
+      line.integer("model_pieces", static_cast<std::int64_t>(size.pieces))
+          .integer("model_bytes", static_cast<std::int64_t>(size.binary_bytes))
+          .integer("model_text_bytes", static_cast<std::int64_t>(size.text_bytes))
+          .integer("map_points", static_cast<std::int64_t>(size.points))
+          .integer("map_points_bytes", static_cast<std::int64_t>(size.points_bytes));
+    }
+    line.integer("grid_0_1m_bytes", static_cast<std::int64_t>(grid_bytes(g_world)));
+    line.emit();
+    if (!m.found_line || !m.found_cpu) {
+      std::fprintf(stderr, "mission: %s: %s%s (console output in %s)\n", name.c_str(),
+                   m.found_line ? "" : "no MISSION line ", m.found_cpu ? "" : "no cpu line",
+                   out.c_str());
+    }
+    if (!keep) remove_tree(dir);
+  }
+  if (!keep) {
+    ::rmdir(tmp);
+  } else {
+    std::fprintf(stderr, "mission: outputs kept in %s\n", tmp);
+  }
+  JsonLine(kSuite, "summary")
+      .integer("worlds", static_cast<std::int64_t>(worlds))
+      .integer("with_target", static_cast<std::int64_t>(with_target))
+      .integer("found", static_cast<std::int64_t>(successes))
+      .num("mean_spl", with_target > 0 ? spl_sum / static_cast<double>(with_target) : 0.0)
+      .integer("max_cycles", max_cycles)
+      .integer("seed", seed)
+      .emit();
+  return 0;
+}
+
+[[maybe_unused]] const bool g_registered = register_suite(
+    {kSuite, "firmware binary on every shipped world: SPL, collisions, CPU split", &run});
+
+}  // namespace
+}  // namespace boticelli::bench
