@@ -1,0 +1,288 @@
+// Tests of the LocalModelBuilder (one look's Think stage) on synthetic readings of a round room
+// with a plain box only the floor cue reports.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <span>
+
+#include "algo/core/angles.h"
+#include "algo/core/fixed_vector.h"
+#include "algo/core/geometry.h"
+#include "algo/evidence/occupancy_model.h"
+#include "algo/evidence/reading.h"
+#include "algo/evidence/reading_limits.h"
+#include "algo/mapping/local_model_builder.h"
+#include "algo/mapping/star_polygon.h"
+
+#include "CppUTest/TestHarness.h"
+#include "alloc_guard.h"
+
+using boticelli::core::FixedVector;
+using boticelli::core::Point2;
+using boticelli::evidence::Reading;
+namespace mapping = boticelli::mapping;
+namespace evidence = boticelli::evidence;
+
+namespace {
+
+// The board's choices (firmware/board.h, firmware/mission/mission_params.cpp).
+constexpr float kPtuHeight_m = 0.6F;
+constexpr float kRobotRadius_m = 0.25F;
+constexpr float kRobotHeight_m = 0.8F;
+constexpr float kMargin_m = 0.05F;
+constexpr float kGroundClearance_m = 0.03F;
+
+// The room: a round wall of radius 2.5 m about the robot; a plain 0.5 m cube whose front
+// face is 1.5 m away at pan 90° (x ∈ [−0.25, 0.25], y ∈ [1.5, 2.0]). A second look of the
+// same room has no readings at all in the pan sector [200°, 230°] (nothing seen there).
+constexpr float kWall_m = 2.5F;
+constexpr float kBoxNear_m = 1.5F;
+constexpr float kBoxFar_m = 2.0F;
+constexpr float kBoxHalfWidth_m = 0.25F;
+constexpr float kBoxHeight_m = 0.5F;
+constexpr float kGapFirst_deg = 200.0F;
+constexpr float kGapLast_deg = 230.0F;
+
+mapping::LocalModelParams make_params() {
+  mapping::LocalModelParams m;
+  const evidence::ReadingLimits limits = evidence::make_reading_limits(kPtuHeight_m, 2.5F, 4.5F);
+  const evidence::ModelBox box = evidence::model_box(limits, evidence::ray_sample_reach(m.rays));
+  m.model_lowest_h_m = box.lowest_h_m;
+  m.model_highest_h_m = box.highest_h_m;
+  m.model_max_range_m = box.max_range_m;
+  m.seam_margin_rad = evidence::kSeamMarginRad;
+  mapping::ExtractionParams& e = m.extraction;
+  e.ptu_height_m = kPtuHeight_m;
+  e.lowest_height_m = kGroundClearance_m;
+  e.robot_height_m = kRobotHeight_m;
+  e.robot_radius_m = kRobotRadius_m;
+  e.clearance_margin_m = kMargin_m;
+  e.height_count = 5;
+  e.bounding_radius_m = 3.0F;
+  m.trainer.epsilon = 0.15;
+  m.trainer.max_iterations = 10;
+  m.trainer.max_pieces = mapping::kLookMaxPieces;
+  return m;
+}
+
+float deg(float d) {
+  return boticelli::core::deg_to_rad(d);
+}
+
+bool in_gap(float alpha_deg) {
+  return alpha_deg >= kGapFirst_deg && alpha_deg <= kGapLast_deg;
+}
+bool in_open(float alpha_deg) {  // 30° or more from the box (at 90°) and from the gap
+  return std::fabs(alpha_deg - 90.0F) >= 30.0F &&
+         !(alpha_deg > kGapFirst_deg - 30.0F && alpha_deg < kGapLast_deg + 30.0F);
+}
+
+// Horizontal distance [m] at pan α to the box's front face, or 0 if the ray misses it.
+float box_front_m(float alpha_rad) {
+  const float s = std::sin(alpha_rad);
+  if (s <= 0.0F) return 0.0F;
+  const float rho = kBoxNear_m / s;
+  const float x = rho * std::cos(alpha_rad);
+  return std::fabs(x) <= kBoxHalfWidth_m ? rho : 0.0F;
+}
+
+// A reading of the point at pan α, horizontal distance ρ, height z above the floor.
+Reading at(float alpha_rad, float rho_m, float z_m, float m) {
+  const float h = z_m - kPtuHeight_m;
+  return {alpha_rad, h, std::sqrt(rho_m * rho_m + h * h), m};
+}
+
+// Distance [m] from p (floor plane) to the box's footprint (0 inside).
+float distance_to_box_m(Point2 p) {
+  const float dx = std::max(std::fabs(p.x_m) - kBoxHalfWidth_m, 0.0F);
+  const float dy = std::max({kBoxNear_m - p.y_m, p.y_m - kBoxFar_m, 0.0F});
+  return std::hypot(dx, dy);
+}
+
+struct Look {
+  FixedVector<Reading, 4096> features;
+  FixedVector<Reading, 2048> obstacles;
+  FixedVector<Reading, 512> free;
+};
+
+// One look from the room's centre: stereo features on the wall at six heights every degree
+// (m = 0.9; the box, plain, gives none, and hides the wall's low part behind it); the floor
+// cue's obstacle readings at the base of the wall or the box (0.05, 0.2, 0.4 m above the
+// floor, m = 0.9) and its free readings on the floor just short of that base (m = 0).
+// `with_gap`: nothing at all in the sector [200°, 230°].
+void build_look(Look& look, bool with_gap) {
+  constexpr float kWallHeights_m[] = {0.1F, 0.3F, 0.6F, 0.9F, 1.2F, 1.6F};
+  constexpr float kBaseHeights_m[] = {0.05F, 0.2F, 0.4F};
+  for (int d = 0; d < 360; ++d) {
+    const auto alpha_deg = static_cast<float>(d);
+    if (with_gap && in_gap(alpha_deg)) continue;
+    const float alpha = deg(alpha_deg);
+    const float box = box_front_m(alpha);
+    for (const float z : kWallHeights_m) {
+      // Hidden by the box if the line of sight is below its top where it meets the front face.
+      const bool hidden =
+          box > 0.0F && kPtuHeight_m + (z - kPtuHeight_m) * box / kWall_m < kBoxHeight_m;
+      if (!hidden) (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
+    }
+    const float base = box > 0.0F ? box : kWall_m;
+    for (const float z : kBaseHeights_m) (void)look.obstacles.push_back(at(alpha, base, z, 0.9F));
+    (void)look.free.push_back(at(alpha, base - 0.03F, 0.0F, 0.0F));
+  }
+}
+
+// The looks and their built models, made once and read by several tests. Several MB each:
+// static.
+Look g_look;
+Look g_gap_look;
+mapping::LocalModelBuilder g_builder;
+mapping::LocalModelBuilder g_gap_builder;
+mapping::LocalModelBuilder g_other;  // re-runs
+
+const mapping::LocalModelBuilder& build_once(mapping::LocalModelBuilder& b, Look& look,
+                                             bool with_gap) {
+  if (!b.done()) {
+    build_look(look, with_gap);
+    b.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
+    b.run();
+  }
+  return b;
+}
+const mapping::LocalModelBuilder& built() {
+  return build_once(g_builder, g_look, false);
+}
+const mapping::LocalModelBuilder& built_with_gap() {
+  return build_once(g_gap_builder, g_gap_look, true);
+}
+
+float vertex_deg(const mapping::StarPolygon& p, std::size_t k) {
+  return boticelli::core::rad_to_deg(p.angle_rad(k));
+}
+
+}  // namespace
+
+TEST_GROUP(LocalModelBuilder){};
+
+TEST(LocalModelBuilder, FitsAModelOfTheRoomAndCanMove) {
+  const mapping::LocalModelBuilder& b = built();
+  CHECK(b.done());
+  CHECK(b.stats().model_valid);
+  CHECK(b.stats().pieces > 1);
+  CHECK(b.stats().samples > 0);
+  CHECK(b.map().can_move);
+}
+
+TEST(LocalModelBuilder, NoNavigablePointBringsTheRobotsDiscNearTheBoxOrTheWall) {
+  const mapping::LocalModelBuilder& b = built();
+  const mapping::StarPolygon& nav = b.map().navigable;
+  const float keep_m = kRobotRadius_m + kMargin_m;
+  float worst_box_m = 1e9F;
+  float worst_wall_m = 1e9F;
+  // Every point of the star polygon lies on a ray from the centre below radius_at_m(θ).
+  for (int i = 0; i < 360 * 8; ++i) {
+    const float theta = deg(static_cast<float>(i) / 8.0F);
+    const float reach = nav.radius_at_m(theta);
+    for (float s = 0.0F; s <= reach; s += 0.005F) {
+      const Point2 p{s * std::cos(theta), s * std::sin(theta)};
+      worst_box_m = std::min(worst_box_m, distance_to_box_m(p));
+      worst_wall_m = std::min(worst_wall_m, kWall_m - std::hypot(p.x_m, p.y_m));
+    }
+    const Point2 edge{reach * std::cos(theta), reach * std::sin(theta)};
+    worst_box_m = std::min(worst_box_m, distance_to_box_m(edge));
+    worst_wall_m = std::min(worst_wall_m, kWall_m - std::hypot(edge.x_m, edge.y_m));
+  }
+  std::printf("\n  nearest navigable point: %.3f m from the box, %.3f m from the wall\n",
+              static_cast<double>(worst_box_m), static_cast<double>(worst_wall_m));
+  CHECK_TEXT(worst_box_m >= keep_m, "the robot's disc (radius + margin) reaches the box");
+  CHECK_TEXT(worst_wall_m >= keep_m, "the robot's disc (radius + margin) reaches the wall");
+}
+
+TEST(LocalModelBuilder, TheFreePolygonReachesCloseToTheWallInOpenDirections) {
+  const mapping::LocalModelBuilder& b = built();
+  const mapping::StarPolygon& free = b.map().free;
+  const mapping::StarPolygon& nav = b.map().navigable;
+  float least_free_m = 1e9F;
+  float least_nav_m = 1e9F;
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) {
+    if (!in_open(vertex_deg(free, k))) continue;
+    least_free_m = std::min(least_free_m, free.rho_m(k));
+    least_nav_m = std::min(least_nav_m, nav.rho_m(k));
+  }
+  std::printf("\n  open directions: free ρ ≥ %.3f m, navigable ρ ≥ %.3f m\n",
+              static_cast<double>(least_free_m), static_cast<double>(least_nav_m));
+  CHECK(least_free_m >= 1.8F);
+  CHECK(least_nav_m >= 1.5F);
+}
+
+TEST(LocalModelBuilder, TheFreePolygonStopsInFrontOfTheBoxTheStereoDoesNotSee) {
+  const mapping::LocalModelBuilder& b = built();
+  const mapping::StarPolygon& free = b.map().free;
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) {
+    const float box = box_front_m(free.angle_rad(k));
+    if (box > 0.0F) CHECK(free.rho_m(k) <= box);
+  }
+  // Straight at the box: the navigable polygon keeps the disc and the margin off it.
+  CHECK(b.map().navigable.radius_at_m(deg(90.0F)) <= kBoxNear_m - kRobotRadius_m - kMargin_m);
+}
+
+TEST(LocalModelBuilder, ADirectionWithNoReadingsIsNotFree) {
+  const mapping::LocalModelBuilder& b = built_with_gap();
+  const mapping::StarPolygon& free = b.map().free;
+  float most_m = 0.0F;
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) {
+    const float d = vertex_deg(free, k);
+    if (d >= kGapFirst_deg + 5.0F && d <= kGapLast_deg - 5.0F) {
+      most_m = std::max(most_m, free.rho_m(k));
+    }
+  }
+  std::printf("\n  unseen sector: free ρ ≤ %.3f m\n", static_cast<double>(most_m));
+  CHECK(most_m <= 0.05F);
+  CHECK(b.map().navigable.radius_at_m(deg(0.5F * (kGapFirst_deg + kGapLast_deg))) <= 0.05F);
+}
+
+// Fails (found while writing these tests): the unseen sector's vertices get ρ = 0 in the
+// seen-free polygon, so the free polygon's boundary runs through the robot's centre, the
+// shrink (shrink_for_robot) finds no clearance and the whole look says "cannot move",
+// although the room is seen free for 2 m in every other direction.
+TEST(LocalModelBuilder, AnUnseenSectorDoesNotStopTheRobotFromMovingElsewhere) {
+  const mapping::LocalModelBuilder& b = built_with_gap();
+  CHECK_TEXT(b.map().can_move, "one unseen sector made the whole look immovable");
+  const mapping::StarPolygon& nav = b.map().navigable;
+  float least_nav_m = 1e9F;
+  for (std::size_t k = 0; k < nav.vertex_count(); ++k) {
+    if (in_open(vertex_deg(nav, k))) least_nav_m = std::min(least_nav_m, nav.rho_m(k));
+  }
+  CHECK(least_nav_m >= 1.0F);
+}
+
+TEST(LocalModelBuilder, SteppingInSmallSlicesGivesTheSamePolygonAsOneShot) {
+  const mapping::LocalModelBuilder& reference = built();  // default units, by run()
+  mapping::LocalModelParams params = make_params();
+  params.readings_per_unit = 7;
+  params.visits_per_unit = 333;
+  g_other.start(params, g_look.features.span(), g_look.obstacles.span(), g_look.free.span());
+  std::size_t units = 0;
+  while (!g_other.step()) ++units;
+  CHECK(units > reference.stats().units);  // it did take more, smaller units
+  const mapping::LocalMap& a = reference.map();
+  const mapping::LocalMap& c = g_other.map();
+  UNSIGNED_LONGS_EQUAL(a.free.vertex_count(), c.free.vertex_count());
+  UNSIGNED_LONGS_EQUAL(reference.stats().pieces, g_other.stats().pieces);
+  for (std::size_t k = 0; k < a.free.vertex_count(); ++k) {
+    DOUBLES_EQUAL(a.free.rho_m(k), c.free.rho_m(k), 1e-6);
+    DOUBLES_EQUAL(a.navigable.rho_m(k), c.navigable.rho_m(k), 1e-6);
+  }
+  CHECK(a.can_move == c.can_move);
+}
+
+TEST(LocalModelBuilder, StartingAndSteppingDoNotAllocate) {
+  (void)built();
+  const mapping::LocalModelParams params = make_params();
+  CHECK_NO_ALLOCATION({
+    g_other.start(params, g_look.features.span(), g_look.obstacles.span(), g_look.free.span());
+    while (!g_other.step()) {
+    }
+  });
+  CHECK(g_other.done());
+  CHECK(g_other.map().can_move);
+}
