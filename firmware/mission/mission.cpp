@@ -377,8 +377,35 @@ void Mission::control_drive(std::uint64_t now_us) {
       return finish(Result::kFound, "within the stand-off of the target");
     }
   }
+  if (ok && ++steps_this_look_ < params_.steps_per_look && next_step_on_look()) return;
   end_cycle(ok ? "step done" : driver_.failure());
   if (phase_ != Phase::kDone) begin_look(now_us);
+}
+
+// Another step on the same look: the look's navigable polygon as seen from where the robot
+// is now (each ray as far as the straight move stays inside it), and the same value function.
+bool Mission::next_step_on_look() {
+  const core::Pose2 here = odometry_pose();
+  const mapping::StarPolygon& nav = builder_.map().navigable;
+  if (!nav.contains(core::to_robot(look_pose_, {here.x_m, here.y_m}))) return false;
+  from_here_.set_vertex_count(nav.vertex_count());
+  const float reach = params_.value.step_m;
+  constexpr int kSamples = 20;
+  for (std::size_t k = 0; k < from_here_.vertex_count(); ++k) {
+    const float a = from_here_.angle_rad(k) + here.yaw_rad;
+    float rho = 0.0F;
+    for (int i = 1; i <= kSamples; ++i) {
+      const float t = reach * static_cast<float>(i) / kSamples;
+      const core::Point2 p{here.x_m + t * std::cos(a), here.y_m + t * std::sin(a)};
+      if (!nav.contains(core::to_robot(look_pose_, p))) break;
+      rho = t;
+    }
+    from_here_.set_rho_m(k, rho);
+  }
+  decision_ = planning::choose_step(value_, from_here_, here, params_.step);
+  if (decision_.kind != planning::StepKind::kMove) return false;
+  drive_pending_ = true;
+  return true;
 }
 
 void Mission::end_cycle(const char* what) {
@@ -479,12 +506,16 @@ void Mission::process_view() {
       tracker_.add(world, fix.confidence, static_cast<std::uint32_t>(state_.cycle * 256U + view_));
     }
   }
-  // The floor cue: learn from the lowest rows, then walk the columns of the first frame.
-  if (view_pair_ == false || pair_pose_.first_tilt_rad < -0.3F) {
-    (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
-  }
+  // The floor cue: learn from the frames that see the floor close in front, then walk the
+  // columns; a low pair's second frame sees nearer floor than its first.
+  (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
   (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad, floor_obstacles_,
                            floor_free_);
+  if (view_pair_ && pair_pose_.second_tilt_rad < -0.3F) {
+    (void)floor_cue_.learn(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad);
+    (void)floor_cue_.process(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad,
+                             floor_obstacles_, floor_free_);
+  }
 }
 
 void Mission::begin_think() {
@@ -497,21 +528,30 @@ void Mission::begin_think() {
 void Mission::after_think() {
   const mapping::LocalMap& local = builder_.map();
   last_pieces_ = static_cast<std::uint32_t>(builder_.stats().pieces);
-  // Map points (§5.4.4): obstacles where the fit and the guard put them; exploration points
-  // on the bounding circle and where only the lack of seen floor cuts the polygon (§7.2.3).
+  // Map points (§5.4.4): obstacles where evidence backs the polygon's boundary; exploration
+  // points on the bounding circle and where only the lack of seen floor cuts it.
   cycle_obstacles_.clear();
   cycle_exploration_.clear();
   const float radius = params_.model.extraction.bounding_radius_m;
-  (void)mapping::extract_map_points(builder_.obstacle_polygon(), radius, params_.points,
-                                    cycle_obstacles_, cycle_exploration_);
-  (void)mapping::extract_gap_exploration_points(builder_.obstacle_polygon(), local.free, radius,
-                                                params_.points, cycle_exploration_);
-  // Guard points are obstacles too.
-  for (const core::Point2& g : builder_.guard_points()) {
-    if (!cycle_obstacles_.push_back(g)) break;
-  }
+  (void)builder_.map_points(params_.points, cycle_obstacles_, cycle_exploration_);
   (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
                    params_.points);
+  // An exploration point the robot's disc cannot reach (it touches a known obstacle) would
+  // only draw the robot into a corner.
+  mapping::PointList& expl = map_.exploration();
+  std::size_t kept = 0;
+  const float reach = params_.value.robot_radius_m;
+  for (std::size_t i = 0; i < expl.size(); ++i) {
+    bool clear = true;
+    for (const core::Point2& o : map_.obstacles()) {
+      if (core::distance_m(o, expl[i]) < reach) {
+        clear = false;
+        break;
+      }
+    }
+    if (clear) expl[kept++] = expl[i];
+  }
+  expl.resize(kept);
   // The model in the text format, for the console and the state file.
   const std::size_t n = aln::write_text(builder_.model(), g_model_text, sizeof g_model_text);
   if (n > 0) (void)state_.set_model({g_model_text, n});
@@ -554,6 +594,7 @@ void Mission::after_plan() {
     }
     if (inside) {
       failed_cycles_ = 0;
+      steps_this_look_ = 0;
       drive_pending_ = true;
       phase_ = Phase::kDrive;
       return;

@@ -61,6 +61,7 @@ MissionParams make_mission_params(const BoardConfig& c) {
     p.rows[i] = {c.look_tilt_rad[i], c.look_tilt_is_pair[i]};
   }
   p.settle_us = c.camera_settle_ms * 1000U;
+  p.steps_per_look = std::max<std::uint32_t>(c.steps_per_look, 1);
   return p;
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "algo/core/angles.h"
 #include "algo/evidence/occupancy_model.h"
@@ -160,6 +161,12 @@ void LocalModelBuilder::build_seen_free() {
       see(r.alpha_rad, horizontal_m(r) * (1.0F - 2.0F * dr));
     }
   }
+  // The robot stands on its own disc: that much is free whatever was seen (an unseen sector
+  // must not pin the robot where it is; the shrink still keeps it off the unknown).
+  const float own = p.robot_radius_m + p.clearance_margin_m + 0.02F;
+  for (std::size_t k = 0; k < seen_free_.vertex_count(); ++k) {
+    seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), own));
+  }
   // A vertex no reading fell on (a gap between image columns) takes the smaller of its
   // nearest seen neighbours when they are close; a wider gap stays unknown (0).
   constexpr std::size_t kMaxGap = 3;
@@ -191,13 +198,73 @@ void LocalModelBuilder::extract() {
     obstacle_polygon_.set_vertex_count(p.vertex_count);  // nothing known: nothing free
   }
   exclude_points(guard_.span(), obstacle_polygon_);
+  // The floor cue's obstacle bases are obstacles whatever the fit says: nothing beyond a
+  // base along its ray is free at the robot's lowest slice.
+  for (const evidence::Reading& r : obstacles_) {
+    const std::size_t k = vertex_of(obstacle_polygon_, r.alpha_rad);
+    const float base = std::max(horizontal_m(r) - params_.base_margin_m, 0.0F);
+    obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), base));
+  }
   build_seen_free();
+  // Nearest evidence of an obstacle per vertex ray (for the map points).
+  evidence_.set_vertex_count(p.vertex_count);
+  evidence_.fill(std::numeric_limits<float>::infinity());
+  auto evidence_at = [&](float alpha, float rho) {
+    const std::size_t k = vertex_of(evidence_, alpha);
+    evidence_.set_rho_m(k, std::min(evidence_.rho_m(k), rho));
+  };
+  for (const evidence::Reading& r : obstacles_) evidence_at(r.alpha_rad, horizontal_m(r));
+  for (const core::Point2& g : guard_) {
+    evidence_at(std::atan2(g.y_m, g.x_m), std::hypot(g.x_m, g.y_m));
+  }
+  const float h_lo = slice_height_m(p, 0);
+  const float h_hi = slice_height_m(p, p.height_count == 0 ? 0 : p.height_count - 1);
+  for (const evidence::Reading& r : features_) {
+    if (r.h_m >= h_lo && r.h_m <= h_hi && r.m >= p.safe_occupancy) {
+      evidence_at(r.alpha_rad, horizontal_m(r));
+    }
+  }
   map_.free = obstacle_polygon_;
   if (params_.clamp_to_seen_free) {
     (void)intersect_into(map_.free, seen_free_);
   }
   map_.can_move =
       shrink_for_robot(map_.free, p.robot_radius_m, p.clearance_margin_m, map_.navigable);
+}
+
+bool LocalModelBuilder::map_points(const MapPointParams& params, PointList& obstacles_robot,
+                                   PointList& exploration_robot) const {
+  const StarPolygon& free = map_.free;
+  const std::size_t n = free.vertex_count();
+  const float radius = params_.extraction.bounding_radius_m;
+  const float dr = params_.rays.delta_r_fraction;
+  bool ok = true;
+  core::Point2 last_obstacle{1e9F, 1e9F};
+  core::Point2 last_exploration{1e9F, 1e9F};
+  for (std::size_t k = 0; k < n; ++k) {
+    const float rho = free.rho_m(k);
+    const float a = free.angle_rad(k);
+    const core::Point2 at{rho * std::cos(a), rho * std::sin(a)};
+    const bool on_circle = rho >= radius - params.on_circle_tolerance_m;
+    // Evidence within its range error (and the shrink's margin) of the boundary.
+    const float e = evidence_.rho_m(k);
+    const bool backed = std::isfinite(e) && std::fabs(e - rho) <= 2.0F * dr * e + 0.1F;
+    const bool unknown = !backed;  // the fit alone, or floor not seen: look there
+    if (backed && !on_circle) {
+      if (core::distance_m(at, last_obstacle) >= params.obstacle_spacing_m) {
+        ok = obstacles_robot.push_back(at) && ok;
+        last_obstacle = at;
+      }
+    } else if ((on_circle || unknown) && rho > params.gap_point_inset_m) {
+      const float d = rho - params.gap_point_inset_m;
+      const core::Point2 p{d * std::cos(a), d * std::sin(a)};
+      if (core::distance_m(p, last_exploration) >= params.exploration_spacing_m) {
+        ok = exploration_robot.push_back(p) && ok;
+        last_exploration = p;
+      }
+    }
+  }
+  return ok;
 }
 
 }  // namespace boticelli::mapping

@@ -65,14 +65,15 @@ struct BoardConfig {
   static constexpr std::size_t kMaxTiltRows = 4;
   std::array<float, kMaxTiltRows> look_tilt_rad = {0.0F, -0.5F, -0.8F, 0.0F};
   std::array<bool, kMaxTiltRows> look_tilt_is_pair = {true, true, false, false};
-  std::uint32_t look_tilt_rows = 3;
+  std::uint32_t look_tilt_rows = 2;
   std::uint32_t camera_settle_ms = 60;  // after the PTU stops, before a frame counts [ms]
   // What the camera can be trusted for (thesis §3.4: about 0.1 m to 4.5 m).
   float max_range_m = 4.5F;
   float ceiling_height_m = 2.5F;     // readings above this height are errors [m]
   float clearance_margin_m = 0.05F;  // kept beyond the robot radius from every obstacle [m]
   float ground_clearance_m = 0.03F;  // lowest obstacle height the base cannot drive over [m]
-  float goal_standoff_m = 0.55F;     // the mission ends this far from the target [m]
+  float goal_standoff_m = 0.75F;     // the mission ends this far from the target [m]
+  std::uint32_t steps_per_look = 3;  // steps driven on one look's polygon before the next look
 };
 
 // Ground truth a simulated board can report (never used to decide anything): the trace and

@@ -131,6 +131,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   void after_think();
   void begin_plan();
   void after_plan();
+  bool next_step_on_look();
   void write_trace(std::uint64_t now_us);
   void write_snapshot();
   [[nodiscard]] core::Pose2 odometry_pose() const;
@@ -199,7 +200,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
 
   // Drive.
   DriveController driver_;
-  bool drive_pending_ = false;                  // a step was chosen; control starts it
+  bool drive_pending_ = false;  // a step was chosen; control starts it
+  std::uint32_t steps_this_look_ = 0;
+  mapping::StarPolygon from_here_{};  // the look's navigable polygon seen from the robot now
   core::FixedVector<core::Point2, 1024> path_;  // where the robot has been (snapshots)
 
   double cpu_s_[3] = {0.0, 0.0, 0.0};

@@ -45,6 +45,7 @@ struct MissionParams {
   std::uint32_t trace_period_us = 100000;    // one trace row per this much time [µs]
   std::uint32_t vi_work_per_unit = 256;      // value-iteration work per background unit
   std::size_t max_failed_cycles = 4;         // cycles in a row with no safe step → not_found
+  std::uint32_t steps_per_look = 3;          // steps on one look's navigable polygon
 };
 
 // The camera rig the stereo and the sim renderer both use, from the board's declaration.

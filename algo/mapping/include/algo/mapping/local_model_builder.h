@@ -15,6 +15,7 @@
 #include "algo/mapping/aln_free_range.h"
 #include "algo/mapping/extraction.h"
 #include "algo/mapping/feature_guard.h"
+#include "algo/mapping/map_points.h"
 #include "algo/mapping/star_polygon.h"
 
 namespace boticelli::mapping {
@@ -45,6 +46,8 @@ struct LocalModelParams {
   // Only space something showed free counts as free (§4.9.1: unknown is not free): the free
   // polygon is cut to the farthest floor seen in each vertex direction.
   bool clamp_to_seen_free = true;
+  // A floor-cue obstacle base cuts the polygon's vertex ray this much in front of it [m].
+  float base_margin_m = 0.05F;
   std::size_t readings_per_unit = 64;  // work per unit while building samples
   std::size_t visits_per_unit = 1024;  // trainer sample visits per unit
 };
@@ -93,6 +96,14 @@ class LocalModelBuilder {
   }
   [[nodiscard]] const LocalModelStats& stats() const { return stats_; }
   [[nodiscard]] const LocalModelParams& params() const { return params_; }
+  // §5.4.4 map points of this look (robot frame), appended: obstacle points where the free
+  // polygon's boundary is backed by evidence (a floor-cue base, a guard point or a feature in
+  // the robot's height band within the range error), spaced obstacle_spacing_m along it;
+  // exploration points where nothing backs the boundary (the floor was not seen beyond it, or
+  // only the fit draws it) or on the bounding circle, spaced exploration_spacing_m,
+  // gap_point_inset_m inside the boundary. False if a list was full.
+  bool map_points(const MapPointParams& params, PointList& obstacles_robot,
+                  PointList& exploration_robot) const;
   // Occupancy of the fitted model at (α, h, r) (0 before a fit).
   [[nodiscard]] float occupancy(float alpha_rad, float h_m, float r_m) const;
 
@@ -120,6 +131,7 @@ class LocalModelBuilder {
   StarPolygon obstacle_polygon_{};
   StarPolygon seen_free_{};
   StarPolygon scratch_{};
+  StarPolygon evidence_{};  // nearest evidence of an obstacle along each vertex ray [m]
   LocalMap map_{};
   LocalModelStats stats_{};
 };
