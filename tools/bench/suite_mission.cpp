@@ -45,6 +45,7 @@ struct MissionLine {
   double sim_time_s = std::numeric_limits<double>::quiet_NaN();
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
   double target_error_m = std::numeric_limits<double>::quiet_NaN();
+  std::string end_reason;  // "LOG info stopping: WHY"
   bool found_cpu = false;
   double look_s = std::numeric_limits<double>::quiet_NaN();
   double think_s = std::numeric_limits<double>::quiet_NaN();
@@ -96,6 +97,9 @@ MissionLine parse_output(const std::string& path) {
       m.sim_time_s = field(line, "sim_time_s");
       m.wall_time_s = field(line, "wall_time_s");
       m.target_error_m = field(line, "target_error_m");
+    } else if (const std::size_t at = line.find("LOG info stopping: "); at != std::string::npos) {
+      m.end_reason = line.substr(at + 19);
+      std::replace(m.end_reason.begin(), m.end_reason.end(), '"', '\'');
     } else if (line.find("LOG info mission cpu ") != std::string::npos) {
       m.found_cpu = true;
       m.look_s = field(line, "look_s");
@@ -388,6 +392,7 @@ int run() {
 
     JsonLine line(kSuite, name.c_str());
     line.text("result", m.result.c_str())
+        .text("end_reason", m.end_reason.c_str())
         .integer("exit_code", exit_code)
         .flag("timed_out", timed_out)
         .integer("cycles", m.cycles)
