@@ -161,12 +161,6 @@ void LocalModelBuilder::build_seen_free() {
       see(r.alpha_rad, horizontal_m(r) * (1.0F - 2.0F * dr));
     }
   }
-  // The robot stands on its own disc: that much is free whatever was seen (an unseen sector
-  // must not pin the robot where it is; the shrink still keeps it off the unknown).
-  const float own = p.robot_radius_m + p.clearance_margin_m + 0.02F;
-  for (std::size_t k = 0; k < seen_free_.vertex_count(); ++k) {
-    seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), own));
-  }
   // A vertex no reading fell on (a gap between image columns) takes the smaller of its
   // nearest seen neighbours when they are close; a wider gap stays unknown (0).
   constexpr std::size_t kMaxGap = 3;
@@ -182,6 +176,13 @@ void LocalModelBuilder::build_seen_free() {
     std::size_t dr_i = 1;
     for (; dr_i <= kMaxGap && right <= 0.0F; ++dr_i) right = scratch_.rho_m((k + dr_i) % n);
     if (left > 0.0F && right > 0.0F) seen_free_.set_rho_m(k, std::min(left, right));
+  }
+  // The robot stands on its own disc: that much is free whatever was seen (an unseen sector
+  // must not pin the robot where it is; the shrink still keeps it off the unknown). After the
+  // gap fill, which looks for unseen (0) vertices.
+  const float own = p.robot_radius_m + p.clearance_margin_m + 0.02F;
+  for (std::size_t k = 0; k < seen_free_.vertex_count(); ++k) {
+    seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), own));
   }
 }
 
