@@ -43,8 +43,10 @@ rpi4: deps-cross
 armhf: deps-armhf
 	$(call build,armhf)
 
+SNAPSHOTS ?= build/run-snapshots
 run: sim
-	build/sim/bin/boticelli --world $(WORLD) $(ARGS)
+	@echo "snapshots of each cycle go to $(SNAPSHOTS)/"
+	build/sim/bin/boticelli --world $(WORLD) --snapshots $(SNAPSHOTS) --max-cycles 60 $(ARGS)
 
 test-sim: sim
 	ctest --preset sim -j $(JOBS)

@@ -43,7 +43,7 @@ class TextureBank {
     std::size_t slot;  // index into camouflage_ or leaves_, by pattern
   };
   static std::uint8_t camouflage_tone(const std::uint8_t* packed, std::size_t i) {
-    return kCamouflageTones[(packed[i >> 2U] >> ((i & 3U) * 2U)) & 3U];
+    return kCamouflageTones[(static_cast<unsigned>(packed[i >> 2U]) >> ((i & 3U) * 2U)) & 3U];
   }
   Key keys_[kMaxTextures]{};
   std::size_t count_ = 0;

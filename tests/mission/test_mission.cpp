@@ -1,0 +1,132 @@
+// The mission end to end on the sim board: Look-Think-Drive finds the target without touching
+// anything, checked against the world's geometry from the trace, and is deterministic.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "firmware/firmware_main.h"
+#include "hal/sim/world.h"
+#include "hal/sim/world_geometry.h"
+#include "sim_board.h"
+
+#include "CppUTest/TestHarness.h"
+#include "CppUTest/MemoryLeakWarningPlugin.h"
+
+namespace sim = boticelli::hal::sim;
+
+namespace {
+
+// The board is large (world, textures): one static instance, re-initialised by every run.
+boticelli::boards::sim::SimBoard g_board;
+
+struct MissionRun {
+  int exit_code = -1;
+  std::string mission_line;
+  std::string trace_path;
+  std::vector<sim::TraceRow> trace;
+  sim::TraceCheck check{};
+  double target_error_m = -1.0;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string world_path(const char* name) {
+  return std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
+}
+
+// Runs firmware_main on the sim board with stdout captured; checks the trace against the
+// world's colliders with the robot's disc (not the simulator's own contact counter).
+MissionRun run_mission(const char* world, const char* seed, float odometry_noise = 0.0F) {
+  char dir_template[] = "/tmp/boticelli-mission-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  MissionRun run;
+  run.trace_path = dir + "/trace.csv";
+  const std::string out = dir + "/stdout.txt";
+  const std::string path = world_path(world);
+  g_board.settings() = boticelli::boards::sim::make_settings(g_board.config(), 1);
+  g_board.settings().physics.base.odometry_noise = odometry_noise;
+  // The console on stdio, stdin at end of file and stdout (telemetry, the MISSION line) into
+  // a file.
+  const char* argv[] = {
+      "boticelli", "--world", path.c_str(),   "--seed", seed, "--trace", run.trace_path.c_str(),
+      "--console", "stdio",   "--max-cycles", "40"};
+  std::fflush(stdout);
+  const int saved = dup(1);
+  const int saved_in = dup(0);
+  FILE* f = std::fopen(out.c_str(), "w");
+  FILE* null_in = std::fopen("/dev/null", "r");
+  dup2(fileno(f), 1);
+  dup2(fileno(null_in), 0);
+  run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(sizeof argv / sizeof argv[0]),
+                                                     argv, g_board);
+  std::fflush(stdout);
+  dup2(saved, 1);
+  dup2(saved_in, 0);
+  close(saved);
+  close(saved_in);
+  std::fclose(f);
+  std::fclose(null_in);
+  const std::string text = slurp(out);
+  const std::size_t at = text.rfind("MISSION ");
+  if (at != std::string::npos) run.mission_line = text.substr(at, text.find('\n', at) - at);
+  const std::size_t e = run.mission_line.find("target_error_m=");
+  if (e != std::string::npos) run.target_error_m = std::atof(run.mission_line.c_str() + e + 15);
+  std::string error;
+  if (sim::read_trace(run.trace_path.c_str(), run.trace, error)) {
+    const auto& c = g_board.config();
+    run.check = sim::check_trace(g_board.world(), run.trace, c.robot_radius_m, c.robot_height_m);
+  } else {
+    run.mission_line += " trace: " + error;
+  }
+  std::remove(out.c_str());
+  return run;
+}
+
+void check_found_safely(const MissionRun& r) {
+  CHECK_EQUAL_TEXT(0, r.exit_code, r.mission_line.c_str());
+  STRCMP_CONTAINS("MISSION result=found", r.mission_line.c_str());
+  CHECK_TEXT(r.check.rows > 100, r.mission_line.c_str());
+  UNSIGNED_LONGS_EQUAL_TEXT(0, r.check.collisions, r.mission_line.c_str());
+  CHECK_TEXT(r.check.min_clearance_m > 0.0, r.mission_line.c_str());
+  CHECK_TEXT(r.check.max_gap_s <= 0.1001, "a trace row at least every 0.1 s");
+  CHECK_TEXT(r.target_error_m >= 0.0 && r.target_error_m <= 0.3, r.mission_line.c_str());
+}
+
+}  // namespace
+
+// The board allocates its world, textures and buffers at init and keeps them for the next run
+// (static storage, as on the robot): not leaks, so CppUTest's leak check is off here.
+TEST_GROUP(Mission){void setup()
+                        override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
+}
+void teardown() override {
+  MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
+}
+}
+;
+
+TEST(Mission, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
+  const MissionRun r = run_mission("thesis_room", "2", 0.02F);
+  check_found_safely(r);
+  std::remove(r.trace_path.c_str());
+}
+
+TEST(Mission, FindsTheTargetInTheThesisRoomAndTheSameSeedGivesTheSameTraceBitForBit) {
+  const MissionRun a = run_mission("thesis_room", "3");
+  const MissionRun b = run_mission("thesis_room", "3");
+  check_found_safely(a);
+  CHECK(slurp(a.trace_path) == slurp(b.trace_path));
+  std::remove(a.trace_path.c_str());
+  std::remove(b.trace_path.c_str());
+}
