@@ -1,5 +1,4 @@
-// Benchmark suite "look": one 360° look of the mission on the sim renderer, checked against the
-// world.
+// Benchmark suite "look": one 360° look of the mission on the sim renderer vs the world.
 #include <dirent.h>
 #include <time.h>
 
