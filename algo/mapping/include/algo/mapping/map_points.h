@@ -22,7 +22,7 @@ struct MapPointParams {
   // bounding circle, is contradicted by the newer view and retired [m]. It came from an
   // earlier, coarser model or from a pose that odometry has since corrected. Larger than
   // obstacle_spacing_m's half and than the polygon's per-ray error (about ρ·Δθ, 5 cm at
-  // 3 m with 360 rays), so a point on or near the new boundary, where the wall still is,
+  // 3 m with 360 rays), so a point on or near the newer boundary, where the wall still is,
   // is kept.
   float obstacle_retire_margin_m = 0.15F;
   float exploration_merge_radius_m = 0.35F;  // likewise for exploration points [m]

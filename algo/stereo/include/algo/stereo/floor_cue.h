@@ -38,7 +38,7 @@ struct FloorCueParams {
   // Learning accepts a region only if at least this fraction of its pixels look like floor,
   // both to the region's own model and to the model already known (if any).
   float consistency_min = 0.9F;
-  float learn_rate = 0.5F;         // weight of a new region when updating a model, (0, 1]
+  float learn_rate = 0.5F;         // weight of a fresh region when updating a model, (0, 1]
   std::uint32_t column_step = 2;   // every column_step-th column is walked [px]
   std::uint32_t boundary_run = 3;  // k: non-floor pixels in a row that end the floor [px]
   // Obstacle readings at the base's ρ, at these heights above the floor [m] (the robot must
