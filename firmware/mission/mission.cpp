@@ -537,21 +537,9 @@ void Mission::after_think() {
   (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
                    params_.points);
   // An exploration point the robot's disc cannot reach (it touches a known obstacle) would
-  // only draw the robot into a corner.
-  mapping::PointList& expl = map_.exploration();
-  std::size_t kept = 0;
-  const float reach = params_.value.robot_radius_m;
-  for (std::size_t i = 0; i < expl.size(); ++i) {
-    bool clear = true;
-    for (const core::Point2& o : map_.obstacles()) {
-      if (core::distance_m(o, expl[i]) < reach) {
-        clear = false;
-        break;
-      }
-    }
-    if (clear) expl[kept++] = expl[i];
-  }
-  expl.resize(kept);
+  // only draw the robot into a corner: move it clear, toward where the robot looked from.
+  (void)map_.clear_exploration({look_pose_.x_m, look_pose_.y_m}, params_.value.robot_radius_m,
+                               radius, params_.points);
   // The model in the text format, for the console and the state file.
   const std::size_t n = aln::write_text(builder_.model(), g_model_text, sizeof g_model_text);
   if (n > 0) (void)state_.set_model({g_model_text, n});

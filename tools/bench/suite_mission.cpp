@@ -124,9 +124,15 @@ std::string own_directory() {
 
 // Shipped worlds (BOTICELLI_WORLDS_DIR/*.sdf, sorted), optionally restricted by
 // BOTICELLI_MISSION_WORLDS=name[,name...] (with or without ".sdf").
+// The folder of worlds: the shipped ones, or BOTICELLI_MISSION_WORLDS_DIR (e.g. tests/worlds).
+std::string worlds_dir() {
+  const char* dir = std::getenv("BOTICELLI_MISSION_WORLDS_DIR");
+  return dir != nullptr && *dir != '\0' ? std::string(dir) : std::string(BOTICELLI_WORLDS_DIR);
+}
+
 std::vector<std::string> world_names() {
   std::vector<std::string> names;
-  if (DIR* d = ::opendir(BOTICELLI_WORLDS_DIR); d != nullptr) {
+  if (DIR* d = ::opendir(worlds_dir().c_str()); d != nullptr) {
     while (const dirent* e = ::readdir(d)) {
       const std::string n = e->d_name;
       if (n.size() > 4 && n.compare(n.size() - 4, 4, ".sdf") == 0) {
@@ -147,7 +153,7 @@ std::vector<std::string> world_names() {
     if (std::find(names.begin(), names.end(), item) != names.end()) {
       wanted.push_back(item);
     } else {
-      std::fprintf(stderr, "mission: no shipped world '%s'\n", item.c_str());
+      std::fprintf(stderr, "mission: no world '%s' in %s\n", item.c_str(), worlds_dir().c_str());
     }
   }
   return wanted;
@@ -323,7 +329,7 @@ int run() {
   std::size_t successes = 0;
   double spl_sum = 0.0;
   for (const std::string& name : names) {
-    const std::string world_path = std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
+    const std::string world_path = worlds_dir() + "/" + name + ".sdf";
     char error[256] = "";
     if (!hal::sim::load_world(world_path.c_str(), g_world, error, sizeof error)) {
       std::fprintf(stderr, "mission: %s\n", error);

@@ -178,6 +178,37 @@ bool extract_map_points(const StarPolygon& free, float bounding_radius_m,
   return ok;
 }
 
+std::size_t GlobalMap::clear_exploration(core::Point2 origin, float clearance_m,
+                                         float pull_reach_m, const MapPointParams& params) {
+  const auto clear_at = [&](core::Point2 p) {
+    for (const core::Point2& o : obstacles_) {
+      if (core::distance_m(o, p) < clearance_m) return false;
+    }
+    return true;
+  };
+  const float step = std::max(params.exploration_pull_step_m, 1e-3F);
+  std::size_t kept = 0;
+  const std::size_t n = exploration_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const core::Point2 p = exploration_[i];
+    const float d = core::distance_m(p, origin);
+    bool found = clear_at(p);
+    core::Point2 q = p;
+    if (!found && d <= pull_reach_m && d > 0.0F) {
+      const float ux = (origin.x_m - p.x_m) / d;
+      const float uy = (origin.y_m - p.y_m) / d;
+      const float max_pull = std::min(params.exploration_max_pull_m, d);
+      for (float t = step; t <= max_pull + 1e-6F && !found; t += step) {
+        q = {p.x_m + t * ux, p.y_m + t * uy};
+        found = clear_at(q);
+      }
+    }
+    if (found) exploration_[kept++] = q;
+  }
+  exploration_.resize(kept);
+  return n - kept;
+}
+
 void GlobalMap::clear() {
   obstacles_.clear();
   exploration_.clear();

@@ -35,6 +35,9 @@ struct MapPointParams {
   // Such a point sits this far inside the plausibility boundary [m]; less than
   // explored_margin_m, so the polygon the point came from does not count it as explored.
   float gap_point_inset_m = 0.05F;
+  // GlobalMap::clear_exploration: how far an exploration point may move to clear obstacles.
+  float exploration_max_pull_m = 0.6F;
+  float exploration_pull_step_m = 0.05F;
 };
 
 // §5.4.4: splits the free polygon's boundary (robot frame) into sectors on the bounding
@@ -78,6 +81,15 @@ class GlobalMap {
   bool merge(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
              const PointList& obstacles_robot, const PointList& exploration_robot,
              const MapPointParams& params);
+
+  // Keeps exploration points reachable by the robot's disc: a point closer than clearance_m
+  // to an obstacle point is moved toward `origin` (the look's position, world frame) in
+  // steps of exploration_pull_step_m, at most exploration_max_pull_m, until it is clear;
+  // points that cannot be cleared, or lie farther than pull_reach_m from `origin` (not
+  // this look's), are dropped. A doorway's points thus stay, in the doorway's middle, instead
+  // of vanishing with the door frame's obstacle points. Returns the number dropped.
+  std::size_t clear_exploration(core::Point2 origin, float clearance_m, float pull_reach_m,
+                                const MapPointParams& params);
 
   void clear();
   [[nodiscard]] const PointList& obstacles() const { return obstacles_; }
