@@ -1,4 +1,4 @@
-// Tests of the global point lists: obstacle points that a newer free polygon contradicts.
+// Tests of the global point lists: retired obstacle points, explored and unreachable exploration points.
 #include <cmath>
 #include <cstddef>
 
@@ -129,4 +129,47 @@ TEST(GlobalMap, AWallFromACoarseEarlyViewGivesWayToTheWallSeenLater) {
   for (const Point2& o : global->obstacles()) {
     DOUBLES_EQUAL(2.5, core::distance_m(o, {kPose.x_m, kPose.y_m}), 1e-3);
   }
+}
+
+TEST(GlobalMap, AKnownExplorationPointNearALaterLooksPositionIsExplored) {
+  free->fill(0.5F);  // a small polygon: covers neither point below
+  const Point2 near_look = seen_at(0.9F, 1.0F);
+  const Point2 far_look = seen_at(1.1F, 1.0F);
+  CHECK_TRUE(global->exploration().push_back(near_look));
+  CHECK_TRUE(global->exploration().push_back(far_look));
+  CHECK_TRUE(global->merge(kPose, *free, 3.0F, none, none, params));
+  CHECK_FALSE(holds(global->exploration(), near_look));
+  CHECK_TRUE(holds(global->exploration(), far_look));
+}
+
+TEST(GlobalMap, AnExplorationPointTouchingAnObstacleMovesTowardTheLookUntilTheDiscClears) {
+  const Point2 origin{0.0F, 0.0F};
+  // A door frame's obstacle point 0.1 m beside the point; the look is 2 m away along -x.
+  CHECK_TRUE(global->obstacles().push_back({2.0F, 0.1F}));
+  CHECK_TRUE(global->exploration().push_back({2.0F, 0.0F}));
+  CHECK_EQUAL(0U, global->clear_exploration(origin, 0.3F, 3.0F, params));
+  CHECK_EQUAL(1U, global->exploration().size());
+  const Point2 moved = global->exploration()[0];
+  CHECK(core::distance_m(moved, {2.0F, 0.1F}) >= 0.3F);
+  // The first clear position on the way in 5 cm steps: at x = 1.75 the obstacle is
+  // sqrt(0.25² + 0.1²) = 0.269 m off, at x = 1.70 0.316 m.
+  DOUBLES_EQUAL(1.70, moved.x_m, 1e-4);
+  DOUBLES_EQUAL(0.0, moved.y_m, 1e-6);
+}
+
+TEST(GlobalMap, AnExplorationPointThatCannotBeClearedOrIsNotThisLooksIsDropped) {
+  const Point2 origin{0.0F, 0.0F};
+  // Boxed in by obstacle points all along its way back to the look.
+  for (int i = 0; i <= 20; ++i) {
+    CHECK_TRUE(global->obstacles().push_back({2.0F - 0.05F * static_cast<float>(i), 0.1F}));
+  }
+  CHECK_TRUE(global->exploration().push_back({2.0F, 0.0F}));
+  // Touching an obstacle, 4 m from the look (beyond its 3 m reach): not moved, dropped.
+  CHECK_TRUE(global->obstacles().push_back({-4.0F, 0.1F}));
+  CHECK_TRUE(global->exploration().push_back({-4.0F, 0.0F}));
+  // Clear already: kept where it is.
+  CHECK_TRUE(global->exploration().push_back({0.0F, 2.0F}));
+  CHECK_EQUAL(2U, global->clear_exploration(origin, 0.3F, 3.0F, params));
+  CHECK_EQUAL(1U, global->exploration().size());
+  CHECK_TRUE(holds(global->exploration(), {0.0F, 2.0F}));
 }

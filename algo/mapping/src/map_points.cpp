@@ -235,6 +235,16 @@ bool GlobalMap::merge(const core::Pose2& pose, const StarPolygon& free, float bo
   }
   // Explored: well inside this cycle's free polygon (and the bounding circle).
   (void)remove_well_inside(exploration_, pose, free, bounding_radius_m, params.explored_margin_m);
+  {
+    const core::Point2 here{pose.x_m, pose.y_m};
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < exploration_.size(); ++i) {
+      if (core::distance_m(exploration_[i], here) >= params.explored_look_radius_m) {
+        exploration_[kept++] = exploration_[i];
+      }
+    }
+    exploration_.resize(kept);
+  }
   for (const core::Point2& p : exploration_robot) {
     const core::Point2 w = core::to_world(pose, p);
     if (near_any(exploration_, w, params.exploration_merge_radius_m)) {

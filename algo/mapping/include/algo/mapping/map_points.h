@@ -28,6 +28,10 @@ struct MapPointParams {
   float exploration_merge_radius_m = 0.35F;  // likewise for exploration points [m]
   // An exploration point this far inside a later free polygon has been explored [m].
   float explored_margin_m = 0.1F;
+  // A known exploration point this close to a later look's position has been explored too:
+  // the robot came there and looked all around (a point by a wall, which no polygon reaches
+  // because the fit's boundary stands off walls, would otherwise draw the robot back) [m].
+  float explored_look_radius_m = 1.0F;
   // §7.2.3 belief–plausibility exploration: a ray whose belief free distance exceeds its
   // plausibility free distance (both cut to the bounding circle) by at least this much
   // crosses an unknown band, the polygon form of a high uncertainty interval Pl − Bel [m].
@@ -73,7 +77,8 @@ class GlobalMap {
   // and inside the bounding circle: the polygon speaks only about what it saw) are retired;
   // then incoming obstacle points closer than obstacle_merge_radius_m to a known one are
   // dropped (deduplicated). Known exploration points that this free polygon covers
-  // (explored_margin_m inside it) are removed as explored, then incoming ones are added
+  // (explored_margin_m inside it) or that lie within explored_look_radius_m of the look's
+  // position are removed as explored, then incoming ones are added
   // unless one is already that close. Removal keeps the order of the points that stay.
   // `free` should be the polygon after the feature guard's exclusions (extract_local_map's
   // LocalMap::free), so an obstacle the model smooths away is not retired by it. Returns
