@@ -90,7 +90,7 @@ int fail(const char* what, const char* why) {
 
 }  // namespace
 
-int firmware_main(int argc, const char* const* argv, Board& board) {
+int firmware_main(int argc, const char* const* argv, Board& board, const MainHooks* hooks) {
   const double wall_start_s = wall_seconds();
   const BoardInfo& info = board.info();
   Options options;
@@ -209,6 +209,7 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
   mission.start(start_us);
   console.log(LogLevel::kInfo, "boticelli %s on %s: ready", BOTICELLI_VERSION, info.name);
   notifier.ready();
+  if (hooks != nullptr && hooks->loop_started != nullptr) hooks->loop_started(hooks->context);
 
   const char* stop_reason = "";
   for (;;) {
@@ -230,6 +231,9 @@ int firmware_main(int argc, const char* const* argv, Board& board) {
       stop_reason = mission.end_reason();
       break;
     }
+  }
+  if (hooks != nullptr && hooks->loop_ended != nullptr) {
+    hooks->loop_ended(hooks->context, executive);
   }
   if (!mission.finished()) {
     // Stopped from outside: --max-cycles is the end of the search, anything else an abort.

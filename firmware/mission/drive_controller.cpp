@@ -23,6 +23,19 @@ void DriveController::start(const core::Pose2& from, core::Point2 end, std::uint
   status_ = distance < params_.position_tolerance_m ? DriveStatus::kDone : DriveStatus::kTurning;
 }
 
+void DriveController::start_turn(const core::Pose2& from, float heading_rad,
+                                 std::uint64_t now_us) {
+  start_ = {from.x_m, from.y_m};
+  end_ = start_;  // the leg after the turn is already at its end: it stops at once
+  heading_rad_ = heading_rad;
+  const float turn = std::fabs(core::wrap_pi(heading_rad_ - from.yaw_rad));
+  const float nominal_s = turn / params_.max_turn_rate_rad_s + 1.0F;
+  deadline_us_ = now_us + static_cast<std::uint64_t>(nominal_s * params_.timeout_factor * 1e6F);
+  failure_ = "";
+  after_stop_ = DriveStatus::kDone;
+  status_ = DriveStatus::kTurning;
+}
+
 void DriveController::abort(const char* why) {
   if (busy()) {
     failure_ = why;

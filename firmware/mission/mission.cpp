@@ -105,6 +105,8 @@ void Mission::start(std::uint64_t now_us) {
   end_reason_ = "";
   cycles_this_run_ = 0;
   failed_cycles_ = 0;
+  turned_round_ = false;
+  turn_pending_ = false;
   map_.clear();
   for (const core::Point2& p : state_.obstacles) (void)map_.obstacles().push_back(p);
   for (const core::Point2& p : state_.exploration) (void)map_.exploration().push_back(p);
@@ -357,7 +359,13 @@ void Mission::on_frame(const hal::Frame& frame) {
 void Mission::control_drive(std::uint64_t now_us) {
   if (drive_pending_) {
     drive_pending_ = false;
-    driver_.start(odometry_pose(), decision_.target, now_us);
+    const core::Pose2 from = odometry_pose();
+    if (turn_pending_) {
+      turn_pending_ = false;
+      driver_.start_turn(from, core::wrap_pi(from.yaw_rad + core::kPi<float>), now_us);
+    } else {
+      driver_.start(from, decision_.target, now_us);
+    }
   }
   const hal::Odometry o = hal_.base.odometry();
   const DriveCommand cmd = driver_.update(odometry_pose(), o.v_m_s, o.omega_rad_s, now_us);
@@ -378,7 +386,9 @@ void Mission::control_drive(std::uint64_t now_us) {
     }
   }
   if (ok && ++steps_this_look_ < params_.steps_per_look && next_step_on_look()) return;
-  end_cycle(ok ? "step done" : driver_.failure());
+  end_cycle(ok ? (turned_round_ && steps_this_look_ > params_.steps_per_look ? "turned round"
+                                                                            : "step done")
+               : driver_.failure());
   if (phase_ != Phase::kDone) begin_look(now_us);
 }
 
@@ -534,6 +544,8 @@ void Mission::after_think() {
   cycle_exploration_.clear();
   const float radius = params_.model.extraction.bounding_radius_m;
   (void)builder_.map_points(params_.points, cycle_obstacles_, cycle_exploration_);
+  // Known exploration points this look saw are explored; then this look's points go in.
+  (void)map_.mark_explored(look_pose_, builder_.seen_free(), radius, params_.points);
   (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
                    params_.points);
   // An exploration point the robot's disc cannot reach (it touches a known obstacle) would
@@ -562,8 +574,26 @@ void Mission::begin_plan() {
 void Mission::after_plan() {
   const core::Pose2 here = odometry_pose();
   if (map_.exploration().size() == 0 && !tracker_.confirmed()) {
-    end_cycle("nothing left to explore");
-    return finish(Result::kNotFound, "nothing left to explore");
+    // The sector behind the robot that the PTU cannot pan to was never seen here: turn
+    // round and look once more before giving up.
+    const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
+    const float fov_rad =
+        2.0F * std::atan(0.5F * static_cast<float>(params_.rig.camera.width_px) /
+                         params_.rig.camera.focal_px);
+    const bool blind = lim.pan_max_rad - lim.pan_min_rad + fov_rad < 2.0F * core::kPi<float>;
+    const bool turned_here =
+        turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
+    if (!blind || turned_here) {
+      end_cycle("nothing left to explore");
+      return finish(Result::kNotFound, "nothing left to explore");
+    }
+    turned_round_ = true;
+    turned_round_at_ = {here.x_m, here.y_m};
+    turn_pending_ = true;
+    drive_pending_ = true;
+    steps_this_look_ = params_.steps_per_look;  // no further step on this look
+    phase_ = Phase::kDrive;
+    return;
   }
   decision_ = planning::choose_step(value_, builder_.map().navigable, here, params_.step);
   if (decision_.kind == planning::StepKind::kAtGoal) {

@@ -48,6 +48,8 @@ MissionParams make_mission_params(const BoardConfig& c) {
 
   // Drive: value iteration keeps the robot radius plus the polygon's margin from obstacles.
   p.value.robot_radius_m = c.robot_radius_m + c.clearance_margin_m;
+  // An unknown stretch narrower than the robot's radius and margin is a shadow, not a frontier.
+  p.points.min_frontier_width_m = c.robot_radius_m + c.clearance_margin_m;
   p.value.step_m = 0.4F;
   p.value.window_half_size_m = 4.0F;
   p.rewards.goal_standoff_m = c.goal_standoff_m;

@@ -296,3 +296,16 @@ TEST(DriveController, ASmallSidePushIsCorrected) {
   d.run();
   check_ended_at_rest_at(d, end);
 }
+
+TEST(DriveController, ATurnInPlaceFacesTheHeadingAndEndsAtRestWhereItStarted) {
+  d.base.pose = {1.0F, 1.0F, 0.4F};
+  d.controller.start_turn(d.base.pose, 0.4F - 3.0F, d.now_us);
+  CHECK(d.controller.status() == DriveStatus::kTurning);
+  d.run();
+  CHECK(d.controller.status() == DriveStatus::kDone);
+  CHECK(std::fabs(wrap_pi(d.base.pose.yaw_rad - (0.4F - 3.0F))) <=
+        d.controller.params().heading_tolerance_rad + 0.01F);
+  DOUBLES_EQUAL(0.0, d.log.max_v_m_s, 0.0);  // never drove
+  CHECK(distance_m({d.base.pose.x_m, d.base.pose.y_m}, {1.0F, 1.0F}) < 1e-4F);
+  CHECK(std::fabs(d.base.w_rad_s) <= d.controller.params().settle_rate_rad_s);
+}

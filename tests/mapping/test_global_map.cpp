@@ -173,3 +173,14 @@ TEST(GlobalMap, AnExplorationPointThatCannotBeClearedOrIsNotThisLooksIsDropped) 
   CHECK_EQUAL(1U, global->exploration().size());
   CHECK_TRUE(holds(global->exploration(), {0.0F, 2.0F}));
 }
+
+TEST(GlobalMap, AKnownExplorationPointALookSawIsExploredAndOneBeyondWhatItSawStays) {
+  free->fill(2.0F);  // how far this look saw the floor, all round
+  const Point2 seen = seen_at(1.8F, -1.0F);    // 0.2 m inside what was seen
+  const Point2 beyond = seen_at(1.95F, 2.5F);  // only 0.05 m inside: not by the margin
+  CHECK_TRUE(global->exploration().push_back(seen));
+  CHECK_TRUE(global->exploration().push_back(beyond));
+  CHECK_EQUAL(1U, global->mark_explored(kPose, *free, 3.0F, params));
+  CHECK_FALSE(holds(global->exploration(), seen));
+  CHECK_TRUE(holds(global->exploration(), beyond));
+}

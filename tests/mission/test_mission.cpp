@@ -6,15 +6,18 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "firmware/executive.h"
 #include "firmware/firmware_main.h"
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
 #include "sim_board.h"
 
+#include "alloc_guard.h"
 #include "CppUTest/TestHarness.h"
 #include "CppUTest/MemoryLeakWarningPlugin.h"
 
@@ -47,7 +50,8 @@ std::string world_path(const char* name) {
 
 // Runs firmware_main on the sim board with stdout captured; checks the trace against the
 // world's colliders with the robot's disc (not the simulator's own contact counter).
-MissionRun run_mission(const char* world, const char* seed, float odometry_noise = 0.0F) {
+MissionRun run_mission(const char* world, const char* seed, float odometry_noise = 0.0F,
+                       const boticelli::firmware::MainHooks* hooks = nullptr) {
   char dir_template[] = "/tmp/boticelli-mission-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
   MissionRun run;
@@ -69,7 +73,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   dup2(fileno(f), 1);
   dup2(fileno(null_in), 0);
   run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(sizeof argv / sizeof argv[0]),
-                                                     argv, g_board);
+                                                     argv, g_board, hooks);
   std::fflush(stdout);
   dup2(saved, 1);
   dup2(saved_in, 0);
@@ -119,6 +123,57 @@ void teardown() override {
 TEST(Mission, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
   const MissionRun r = run_mission("thesis_room", "2", 0.02F);
   check_found_safely(r);
+  std::remove(r.trace_path.c_str());
+}
+
+// Counts heap allocations from the loop's first frame to its last (after every init).
+struct LoopCount {
+  std::size_t allocations = 0;
+  std::uint64_t frames = 0;
+  std::uint64_t frame_overruns = 0;
+  std::uint64_t background_overruns = 0;
+  bool ended = false;
+};
+std::optional<boticelli::test::AllocationGuard> g_loop_guard;
+
+void on_loop_started(void*) {
+  g_loop_guard.emplace();
+}
+
+void on_loop_ended(void* context, const boticelli::firmware::Executive& executive) {
+  auto* count = static_cast<LoopCount*>(context);
+  count->allocations = g_loop_guard->allocations();
+  g_loop_guard.reset();
+  const boticelli::firmware::FrameStats& stats = executive.frame_stats();
+  count->frames = stats.frames;
+  count->frame_overruns = stats.overruns;
+  count->background_overruns = stats.background_overruns;
+  count->ended = true;
+}
+
+TEST(Mission, AWholeMissionAfterInitAllocatesNothingAndNoFrameOverruns) {
+  // The guard sees allocations with the leak check's operators off (the mission test's
+  // setting): a canary, so the zero below means something.
+  std::size_t canary = 0;
+  {
+    boticelli::test::AllocationGuard guard;
+    int* volatile p = new int(1);
+    delete p;
+    canary = guard.allocations();
+  }
+  CHECK(canary > 0);
+  LoopCount count;
+  boticelli::firmware::MainHooks hooks;
+  hooks.loop_started = on_loop_started;
+  hooks.loop_ended = on_loop_ended;
+  hooks.context = &count;
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks);
+  check_found_safely(r);
+  CHECK(count.ended);
+  CHECK(count.frames > 10000);
+  UNSIGNED_LONGS_EQUAL_TEXT(0, count.allocations, "heap allocations after init");
+  UNSIGNED_LONGS_EQUAL(0, count.frame_overruns);
+  UNSIGNED_LONGS_EQUAL(0, count.background_overruns);
   std::remove(r.trace_path.c_str());
 }
 

@@ -2,6 +2,7 @@
 #include "algo/mapping/local_model_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -239,24 +240,58 @@ bool LocalModelBuilder::map_points(const MapPointParams& params, PointList& obst
   const std::size_t n = free.vertex_count();
   const float radius = params_.extraction.bounding_radius_m;
   const float dr = params_.rays.delta_r_fraction;
+  auto vertex = [&](std::size_t k) {
+    const float rho = free.rho_m(k);
+    const float a = free.angle_rad(k);
+    return core::Point2{rho * std::cos(a), rho * std::sin(a)};
+  };
+  // Each vertex: an obstacle (evidence within its range error, and the shrink's margin, of
+  // the boundary), on the bounding circle, or unknown (the fit alone, or floor not seen).
+  enum Kind : std::uint8_t { kObstacle, kCircle, kUnknown };
+  std::array<Kind, kMaxPolygonVertices> kind{};
+  for (std::size_t k = 0; k < n; ++k) {
+    const float rho = free.rho_m(k);
+    const float e = evidence_.rho_m(k);
+    const bool backed = std::isfinite(e) && std::fabs(e - rho) <= 2.0F * dr * e + 0.1F;
+    kind[k] = rho >= radius - params.on_circle_tolerance_m ? kCircle
+              : backed                                     ? kObstacle
+                                                           : kUnknown;
+  }
+  // An unknown stretch narrower than min_frontier_width_m (a shadow behind a box, a few
+  // vertices the floor cue missed) leads the robot nowhere: no exploration points there.
+  std::array<bool, kMaxPolygonVertices> frontier{};
+  std::size_t first_obstacle = n;
+  for (std::size_t k = 0; k < n && first_obstacle == n; ++k) {
+    if (kind[k] != kUnknown) first_obstacle = k;
+  }
+  if (first_obstacle == n) {
+    frontier.fill(true);  // unknown all round
+  } else {
+    for (std::size_t i = 1; i <= n; ++i) {
+      const std::size_t k = (first_obstacle + i) % n;
+      if (kind[k] != kUnknown) continue;
+      std::size_t len = 0;  // the run of unknown vertices starting at k
+      while (len < n && kind[(k + len) % n] == kUnknown) ++len;
+      const float width = core::distance_m(vertex(k), vertex((k + len - 1) % n));
+      for (std::size_t j = 0; j < len; ++j) {
+        frontier[(k + j) % n] = width >= params.min_frontier_width_m;
+      }
+      i += len - 1;
+    }
+  }
   bool ok = true;
   core::Point2 last_obstacle{1e9F, 1e9F};
   core::Point2 last_exploration{1e9F, 1e9F};
   for (std::size_t k = 0; k < n; ++k) {
     const float rho = free.rho_m(k);
     const float a = free.angle_rad(k);
-    const core::Point2 at{rho * std::cos(a), rho * std::sin(a)};
-    const bool on_circle = rho >= radius - params.on_circle_tolerance_m;
-    // Evidence within its range error (and the shrink's margin) of the boundary.
-    const float e = evidence_.rho_m(k);
-    const bool backed = std::isfinite(e) && std::fabs(e - rho) <= 2.0F * dr * e + 0.1F;
-    const bool unknown = !backed;  // the fit alone, or floor not seen: look there
-    if (backed && !on_circle) {
+    const core::Point2 at = vertex(k);
+    if (kind[k] == kObstacle) {
       if (core::distance_m(at, last_obstacle) >= params.obstacle_spacing_m) {
         ok = obstacles_robot.push_back(at) && ok;
         last_obstacle = at;
       }
-    } else if ((on_circle || unknown) && rho > params.gap_point_inset_m) {
+    } else if ((kind[k] == kCircle || frontier[k]) && rho > params.gap_point_inset_m) {
       const float d = rho - params.gap_point_inset_m;
       const core::Point2 p{d * std::cos(a), d * std::sin(a)};
       if (core::distance_m(p, last_exploration) >= params.exploration_spacing_m) {

@@ -178,6 +178,11 @@ bool extract_map_points(const StarPolygon& free, float bounding_radius_m,
   return ok;
 }
 
+std::size_t GlobalMap::mark_explored(const core::Pose2& pose, const StarPolygon& seen,
+                                     float bounding_radius_m, const MapPointParams& params) {
+  return remove_well_inside(exploration_, pose, seen, bounding_radius_m, params.explored_margin_m);
+}
+
 std::size_t GlobalMap::clear_exploration(core::Point2 origin, float clearance_m,
                                          float pull_reach_m, const MapPointParams& params) {
   const auto clear_at = [&](core::Point2 p) {

@@ -13,8 +13,20 @@ inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
 inline constexpr int kExitNotFound = 3;
 
+class Executive;
+
+// Called around the cyclic loop: loop_started after every init (devices, files, tasks, the
+// mission's start), loop_ended after the last frame, before the orderly stop. Tests count heap
+// allocations over a whole mission and read the executive's statistics with them.
+struct MainHooks {
+  void (*loop_started)(void* context) = nullptr;
+  void (*loop_ended)(void* context, const Executive& executive) = nullptr;
+  void* context = nullptr;
+};
+
 // Parses the command line and runs the firmware on the board until a signal, the console's
 // shutdown or --max-cycles; prints the MISSION line last and returns the exit code.
-int firmware_main(int argc, const char* const* argv, Board& board);
+int firmware_main(int argc, const char* const* argv, Board& board,
+                  const MainHooks* hooks = nullptr);
 
 }  // namespace boticelli::firmware

@@ -13,6 +13,7 @@ bool CameraSim::setup(float fps, char* error, std::size_t error_size) {
     return false;
   }
   period_us_ = static_cast<std::uint64_t>(std::llround(1e6 / static_cast<double>(fps)));
+  sequence_ = 0;  // a new run: the same seed gives the same frames
   const std::size_t pixels = static_cast<std::size_t>(renderer_.width_px()) * renderer_.height_px();
   image_.reset(new std::uint8_t[2 * pixels]());
   depth_.reset(new float[pixels]());

@@ -41,6 +41,8 @@ class DriveController {
   [[nodiscard]] const DriveParams& params() const { return params_; }
 
   void start(const core::Pose2& from, core::Point2 end, std::uint64_t now_us);
+  // Turns in place to `heading_rad` (odometry frame) and stops there: no straight leg.
+  void start_turn(const core::Pose2& from, float heading_rad, std::uint64_t now_us);
   // One control period; the base must get the returned setpoint.
   DriveCommand update(const core::Pose2& odometry, float v_m_s, float omega_rad_s,
                       std::uint64_t now_us);

@@ -160,6 +160,11 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   bool released_ = false;
   bool submit_pending_ = false;
   std::size_t failed_cycles_ = 0;
+  // The PTU's pan range leaves a sector behind the robot unseen: before giving up at a place,
+  // the robot turns round once and looks again (where it did, and whether the turn is due).
+  bool turned_round_ = false;
+  core::Point2 turned_round_at_{};
+  bool turn_pending_ = false;
 
   // Look.
   stereo::RigModel rig_;

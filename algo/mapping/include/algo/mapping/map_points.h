@@ -39,6 +39,9 @@ struct MapPointParams {
   // Such a point sits this far inside the plausibility boundary [m]; less than
   // explored_margin_m, so the polygon the point came from does not count it as explored.
   float gap_point_inset_m = 0.05F;
+  // LocalModelBuilder::map_points: an unknown stretch of the boundary (end to end) narrower
+  // than this gives no exploration points; the mission sets the robot's width plus margins.
+  float min_frontier_width_m = 0.6F;
   // GlobalMap::clear_exploration: how far an exploration point may move to clear obstacles.
   float exploration_max_pull_m = 0.6F;
   float exploration_pull_step_m = 0.05F;
@@ -86,6 +89,13 @@ class GlobalMap {
   bool merge(const core::Pose2& pose, const StarPolygon& free, float bounding_radius_m,
              const PointList& obstacles_robot, const PointList& exploration_robot,
              const MapPointParams& params);
+
+  // Removes the known exploration points a look saw: at least explored_margin_m inside
+  // `seen` (robot frame at `pose`: how far the floor, or an obstacle's base, was seen along
+  // each ray) and its bounding circle. Call it before merge() with the same look, so the
+  // look's own new points (on or near the seen boundary) stay. Returns how many went.
+  std::size_t mark_explored(const core::Pose2& pose, const StarPolygon& seen,
+                            float bounding_radius_m, const MapPointParams& params);
 
   // Keeps exploration points reachable by the robot's disc: a point closer than clearance_m
   // to an obstacle point is moved toward `origin` (the look's position, world frame) in
