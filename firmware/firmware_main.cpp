@@ -215,6 +215,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   for (;;) {
     executive.set_background_max_slice_us(static_cast<std::uint32_t>(background_slice_us));
     executive.run_frame();
+    if (hooks != nullptr && hooks->after_frame != nullptr) hooks->after_frame(hooks->context);
     if (g_signal != 0) {
       stop_reason = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
       break;

@@ -548,6 +548,23 @@ void Mission::after_think() {
   (void)map_.mark_explored(look_pose_, builder_.seen_free(), radius, params_.points);
   (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
                    params_.points);
+  // A sighting no second view has confirmed yet: look at it again from the stand-off (the
+  // detector may miss it near the image's edge), unless the robot already looked from there.
+  if (!tracker_.confirmed() && tracker_.sightings() > 0) {
+    const Eigen::Vector3f& c = tracker_.candidate_m();
+    const float dx = look_pose_.x_m - c.x();
+    const float dy = look_pose_.y_m - c.y();
+    const float d = std::hypot(dx, dy);
+    if (d > params_.points.explored_look_radius_m + params_.rewards.goal_standoff_m) {
+      const float s = params_.rewards.goal_standoff_m / d;
+      const core::Point2 p{c.x() + s * dx, c.y() + s * dy};
+      bool known = false;
+      for (const core::Point2& q : map_.exploration()) {
+        known = known || core::distance_m(p, q) < params_.points.exploration_merge_radius_m;
+      }
+      if (!known) (void)map_.exploration().push_back(p);
+    }
+  }
   // An exploration point the robot's disc cannot reach (it touches a known obstacle) would
   // only draw the robot into a corner: move it clear, toward where the robot looked from.
   (void)map_.clear_exploration({look_pose_.x_m, look_pose_.y_m}, params_.value.robot_radius_m,

@@ -52,6 +52,7 @@ void TargetTracker::update_estimate() {
     }
   }
   support_ = best_views;
+  candidate_ = best;
   if (best_views >= params_.min_views) {
     confirmed_ = true;
     estimate_ = best;

@@ -39,6 +39,19 @@ TEST(TargetTracker, OneSightingNeverConfirms) {
   UNSIGNED_LONGS_EQUAL(1, tracker.supporting_views());
 }
 
+TEST(TargetTracker, AnUnconfirmedSightingIsTheCandidateToLookAtAgain) {
+  const Eigen::Vector3f lone = kTarget + Eigen::Vector3f(2.0F, 0.0F, 0.0F);
+  tracker.add(lone, 0.9F, 1);
+  CHECK_FALSE(tracker.confirmed());
+  check_near(lone, tracker.candidate_m(), 1e-6F);
+  // Two views of the target outvote the lone sighting: confirmed, and the candidate with it.
+  tracker.add(kTarget, 0.9F, 2);
+  tracker.add(kTarget, 0.9F, 3);
+  CHECK_TRUE(tracker.confirmed());
+  check_near(kTarget, tracker.candidate_m(), 1e-5F);
+  check_near(tracker.estimate_m(), tracker.candidate_m(), 1e-6F);
+}
+
 TEST(TargetTracker, SightingsFromTheSameViewNeverConfirm) {
   for (int i = 0; i < 10; ++i) {
     tracker.add(kTarget + Eigen::Vector3f(0.01F * static_cast<float>(i), 0.0F, 0.0F), 0.9F, 7);

@@ -44,27 +44,24 @@ std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-std::string world_path(const char* name) {
-  return std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
-}
-
 // Runs firmware_main on the sim board with stdout captured; checks the trace against the
 // world's colliders with the robot's disc (not the simulator's own contact counter).
 MissionRun run_mission(const char* world, const char* seed, float odometry_noise = 0.0F,
-                       const boticelli::firmware::MainHooks* hooks = nullptr) {
+                       const boticelli::firmware::MainHooks* hooks = nullptr,
+                       const char* world_dir = BOTICELLI_WORLDS_DIR) {
   char dir_template[] = "/tmp/boticelli-mission-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
   MissionRun run;
   run.trace_path = dir + "/trace.csv";
   const std::string out = dir + "/stdout.txt";
-  const std::string path = world_path(world);
+  const std::string path = std::string(world_dir) + "/" + world + ".sdf";
   g_board.settings() = boticelli::boards::sim::make_settings(g_board.config(), 1);
   g_board.settings().physics.base.odometry_noise = odometry_noise;
   // The console on stdio, stdin at end of file and stdout (telemetry, the MISSION line) into
   // a file.
   const char* argv[] = {
       "boticelli", "--world", path.c_str(),   "--seed", seed, "--trace", run.trace_path.c_str(),
-      "--console", "stdio",   "--max-cycles", "40"};
+      "--console", "stdio",   "--max-cycles", "45"};
   std::fflush(stdout);
   const int saved = dup(1);
   const int saved_in = dup(0);
@@ -111,19 +108,32 @@ void check_found_safely(const MissionRun& r) {
 
 // The board allocates its world, textures and buffers at init and keeps them for the next run
 // (static storage, as on the robot): not leaks, so CppUTest's leak check is off here.
-TEST_GROUP(Mission){void setup()
-                        override{MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();
-}
-void teardown() override {
-  MemoryLeakWarningPlugin::restoreNewDeleteOverloads();
-}
-}
-;
+#define MISSION_GROUP(name)                                           \
+  TEST_GROUP(name) {                                                  \
+    void setup() override {                                           \
+      MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();    \
+    }                                                                 \
+    void teardown() override {                                        \
+      MemoryLeakWarningPlugin::restoreNewDeleteOverloads();           \
+    }                                                                 \
+  }
 
-TEST(Mission, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
+MISSION_GROUP(MissionThesisRoom);
+MISSION_GROUP(MissionRooms);
+MISSION_GROUP(MissionEstop);
+
+TEST(MissionThesisRoom, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
   const MissionRun r = run_mission("thesis_room", "2", 0.02F);
   check_found_safely(r);
   std::remove(r.trace_path.c_str());
+}
+
+TEST(MissionThesisRoom, FindsItForFourMoreSeeds) {
+  for (const char* seed : {"2", "4", "5", "6"}) {
+    const MissionRun r = run_mission("thesis_room", seed);
+    check_found_safely(r);
+    std::remove(r.trace_path.c_str());
+  }
 }
 
 // Counts heap allocations from the loop's first frame to its last (after every init).
@@ -151,9 +161,9 @@ void on_loop_ended(void* context, const boticelli::firmware::Executive& executiv
   count->ended = true;
 }
 
-TEST(Mission, AWholeMissionAfterInitAllocatesNothingAndNoFrameOverruns) {
-  // The guard sees allocations with the leak check's operators off (the mission test's
-  // setting): a canary, so the zero below means something.
+TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothingAndNoFrameOverruns) {
+  // The guard sees allocations with the leak check's operators off (this group's setting):
+  // a canary, so the zero below means something.
   std::size_t canary = 0;
   {
     boticelli::test::AllocationGuard guard;
@@ -177,11 +187,92 @@ TEST(Mission, AWholeMissionAfterInitAllocatesNothingAndNoFrameOverruns) {
   std::remove(r.trace_path.c_str());
 }
 
-TEST(Mission, FindsTheTargetInTheThesisRoomAndTheSameSeedGivesTheSameTraceBitForBit) {
+TEST(MissionThesisRoom, TheSameSeedGivesTheSameTraceBitForBit) {
   const MissionRun a = run_mission("thesis_room", "3");
   const MissionRun b = run_mission("thesis_room", "3");
   check_found_safely(a);
   CHECK(slurp(a.trace_path) == slurp(b.trace_path));
   std::remove(a.trace_path.c_str());
   std::remove(b.trace_path.c_str());
+}
+
+TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {
+  for (const char* world :
+       {"box_in_cylindrical_room", "box_in_rectangular_room", "cluttered_room", "corridor",
+        "cylindrical_room", "cylindrical_room_offcentre", "l_shaped_room", "rectangular_room",
+        "two_rooms_doorway"}) {
+    const MissionRun r = run_mission(world, "1");
+    const std::string what = std::string(world) + ": " + r.mission_line;
+    CHECK_EQUAL_TEXT(0, r.exit_code, what.c_str());
+    UNSIGNED_LONGS_EQUAL_TEXT(0, r.check.collisions, what.c_str());
+    CHECK_TEXT(r.check.rows > 100, what.c_str());
+    CHECK_TEXT(r.target_error_m >= 0.0 && r.target_error_m <= 0.3, what.c_str());
+    std::remove(r.trace_path.c_str());
+  }
+}
+
+// Presses the e-stop the first time the base drives forward, holds it 3 s of simulated time,
+// and records what the base did meanwhile.
+struct EstopScript {
+  int phase = 0;  // 0 waiting for a drive, 1 pressed, 2 released
+  std::uint64_t pressed_us = 0;
+  int frames_to_stop = -1;  // frames after the press until the base reported stopped
+  int frames = 0;
+  boticelli::core::Pose2 settled{};  // true pose 1 s after the press
+  float moved_while_held_m = -1.0F;  // from 1 s after the press to the release
+  bool settled_taken = false;
+};
+
+void on_frame_estop(void* context) {
+  auto* e = static_cast<EstopScript*>(context);
+  sim::SimWorld& w = g_board.sim();
+  const std::uint64_t now = w.now_us();
+  if (e->phase == 0) {
+    if (w.odometry().v_m_s > 0.1F && w.base_health() == boticelli::hal::BaseHealth::kReady) {
+      w.set_estop_pressed(true);
+      e->pressed_us = now;
+      e->phase = 1;
+    }
+    return;
+  }
+  if (e->phase != 1) return;
+  ++e->frames;
+  if (e->frames_to_stop < 0 && w.base_health() == boticelli::hal::BaseHealth::kStopped) {
+    e->frames_to_stop = e->frames;
+  }
+  const boticelli::core::Pose2 p = w.true_pose();
+  if (!e->settled_taken && now >= e->pressed_us + 1000000U) {
+    e->settled = p;
+    e->settled_taken = true;
+  }
+  if (now >= e->pressed_us + 3000000U) {
+    e->moved_while_held_m =
+        std::hypot(p.x_m - e->settled.x_m, p.y_m - e->settled.y_m) +
+        std::fabs(p.yaw_rad - e->settled.yaw_rad);
+    w.set_estop_pressed(false);
+    e->phase = 2;
+  }
+}
+
+TEST(MissionEstop, PressedMidDriveTheBaseStopsWithinAFrameAndTheMissionCarriesOnAfterRelease) {
+  EstopScript e;
+  boticelli::firmware::MainHooks hooks;
+  hooks.after_frame = on_frame_estop;
+  hooks.context = &e;
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks);
+  CHECK_EQUAL(2, e.phase);
+  CHECK_TEXT(e.frames_to_stop >= 1 && e.frames_to_stop <= 1, "the base stops within one frame");
+  DOUBLES_EQUAL(0.0, e.moved_while_held_m, 1e-6);
+  // The trace shows the hold, then more driving, and the mission ends found.
+  bool held = false;
+  bool drove_after = false;
+  for (const sim::TraceRow& row : r.trace) {
+    if (row.t_s * 1e6 < static_cast<double>(e.pressed_us)) continue;
+    held = held || std::string(row.state) == "hold";
+    drove_after = drove_after || (held && std::string(row.state) == "drive");
+  }
+  CHECK(held);
+  CHECK(drove_after);
+  check_found_safely(r);
+  std::remove(r.trace_path.c_str());
 }

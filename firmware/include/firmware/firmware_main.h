@@ -16,10 +16,12 @@ inline constexpr int kExitNotFound = 3;
 class Executive;
 
 // Called around the cyclic loop: loop_started after every init (devices, files, tasks, the
-// mission's start), loop_ended after the last frame, before the orderly stop. Tests count heap
-// allocations over a whole mission and read the executive's statistics with them.
+// mission's start), after_frame after each minor frame, loop_ended after the last frame,
+// before the orderly stop. Tests count heap allocations over a whole mission, press buttons
+// at the right moment and read the executive's statistics with them.
 struct MainHooks {
   void (*loop_started)(void* context) = nullptr;
+  void (*after_frame)(void* context) = nullptr;
   void (*loop_ended)(void* context, const Executive& executive) = nullptr;
   void* context = nullptr;
 };

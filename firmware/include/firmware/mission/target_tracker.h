@@ -35,6 +35,9 @@ class TargetTracker {
   [[nodiscard]] const Eigen::Vector3f& estimate_m() const { return estimate_; }
   [[nodiscard]] std::size_t sightings() const { return count_; }
   [[nodiscard]] std::size_t supporting_views() const { return support_; }
+  // The largest group's mean even when too few views agree (valid when sightings() > 0): a
+  // sighting to look at again from closer.
+  [[nodiscard]] const Eigen::Vector3f& candidate_m() const { return candidate_; }
 
  private:
   struct Sighting {
@@ -51,6 +54,7 @@ class TargetTracker {
   bool confirmed_ = false;
   std::size_t support_ = 0;
   Eigen::Vector3f estimate_ = Eigen::Vector3f::Zero();
+  Eigen::Vector3f candidate_ = Eigen::Vector3f::Zero();
 };
 
 }  // namespace boticelli::firmware::mission
