@@ -513,7 +513,8 @@ void Mission::process_view() {
       // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
       const core::Point2 w = core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
       const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
-      tracker_.add(world, fix.confidence, static_cast<std::uint32_t>(state_.cycle * 256U + view_));
+      tracker_.add(world, fix.confidence, static_cast<std::uint32_t>(state_.cycle * 256U + view_),
+                   fix.point_ptu_m.norm());
     }
   }
   // The floor cue: learn from the frames that see the floor close in front, then walk the

@@ -1,16 +1,20 @@
 // TargetTracker: grouping of target sightings (see target_tracker.h).
 #include "firmware/mission/target_tracker.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace boticelli::firmware::mission {
 
 void TargetTracker::add(const Eigen::Vector3f& point_world_m, float confidence,
-                        std::uint32_t view) {
+                        std::uint32_t view, float range_m) {
   // A non-finite confidence would make the group's weighted mean NaN, and a NaN centre
   // counts every sighting as within the radius.
-  if (!point_world_m.allFinite() || !std::isfinite(confidence)) return;
-  sightings_[next_] = {point_world_m, confidence, view};
+  if (!point_world_m.allFinite() || !std::isfinite(confidence) || !std::isfinite(range_m)) {
+    return;
+  }
+  const float r = std::max(range_m, 0.5F);
+  sightings_[next_] = {point_world_m, confidence, (0.1F + confidence) / (r * r), view};
   next_ = (next_ + 1) % kMaxSightings;
   if (count_ < kMaxSightings) ++count_;
   update_estimate();
@@ -28,7 +32,7 @@ void TargetTracker::update_estimate() {
       float weight = 0.0F;
       for (std::size_t j = 0; j < count_; ++j) {
         if ((sightings_[j].point - centre).squaredNorm() <= r2) {
-          const float w = 0.1F + sightings_[j].confidence;
+          const float w = sightings_[j].weight;
           sum += w * sightings_[j].point;
           weight += w;
         }

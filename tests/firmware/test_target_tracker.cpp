@@ -90,6 +90,20 @@ TEST(TargetTracker, AConfidentSightingWeighsMoreThanAnUnsureOne) {
   CHECK(tracker.estimate_m().x() < sure.x());
 }
 
+TEST(TargetTracker, ACloseSightingWeighsMoreThanAFarOne) {
+  const Eigen::Vector3f close = kTarget + Eigen::Vector3f(0.1F, 0.0F, 0.0F);
+  const Eigen::Vector3f far = kTarget - Eigen::Vector3f(0.1F, 0.0F, 0.0F);
+  tracker.add(close, 0.5F, 1, 1.0F);
+  tracker.add(far, 0.5F, 2, 4.0F);  // 16 times less weight
+  CHECK(tracker.confirmed());
+  DOUBLES_EQUAL(kTarget.x() + 0.1F * 15.0F / 17.0F, tracker.estimate_m().x(), 1e-4);
+}
+
+TEST(TargetTracker, ANonFiniteRangeIsIgnored) {
+  tracker.add(kTarget, 0.5F, 1, std::numeric_limits<float>::quiet_NaN());
+  UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
+}
+
 TEST(TargetTracker, AFarOutlierDoesNotMoveTheEstimate) {
   tracker.add(kTarget + Eigen::Vector3f(0.05F, 0.0F, 0.0F), 0.8F, 1);
   tracker.add(kTarget - Eigen::Vector3f(0.05F, 0.0F, 0.0F), 0.8F, 2);

@@ -29,7 +29,10 @@ class TargetTracker {
   }
   // `view` identifies where it was seen from (e.g. cycle·64 + view index): two sightings of
   // the same view count once.
-  void add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view);
+  // `range_m` is how far the camera was: a stereo fix's error grows with the square of the
+  // range, so a sighting's weight in the mean is (0.1 + confidence) / max(range, 0.5 m)².
+  void add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view,
+           float range_m = 1.0F);
 
   [[nodiscard]] bool confirmed() const { return confirmed_; }
   [[nodiscard]] const Eigen::Vector3f& estimate_m() const { return estimate_; }
@@ -43,6 +46,7 @@ class TargetTracker {
   struct Sighting {
     Eigen::Vector3f point = Eigen::Vector3f::Zero();
     float confidence = 0.0F;
+    float weight = 0.0F;
     std::uint32_t view = 0;
   };
   void update_estimate();
