@@ -6,8 +6,8 @@
 
 namespace boticelli::firmware::mission {
 
-void TargetTracker::add(const Eigen::Vector3f& point_world_m, float confidence,
-                        std::uint32_t view, float range_m) {
+void TargetTracker::add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view,
+                        float range_m) {
   // A non-finite confidence would make the group's weighted mean NaN, and a NaN centre
   // counts every sighting as within the radius.
   if (!point_world_m.allFinite() || !std::isfinite(confidence) || !std::isfinite(range_m)) {
@@ -59,7 +59,20 @@ void TargetTracker::update_estimate() {
   candidate_ = best;
   if (best_views >= params_.min_views) {
     confirmed_ = true;
-    estimate_ = best;
+    const float q2 = params_.refine_radius_m * params_.refine_radius_m;
+    Eigen::Vector3f centre = best;
+    for (int pass = 0; pass < 2; ++pass) {
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      float weight = 0.0F;
+      for (std::size_t j = 0; j < count_; ++j) {
+        if ((sightings_[j].point - centre).squaredNorm() <= q2) {
+          sum += sightings_[j].weight * sightings_[j].point;
+          weight += sightings_[j].weight;
+        }
+      }
+      if (weight > 0.0F) centre = sum / weight;
+    }
+    estimate_ = centre;
   }
 }
 

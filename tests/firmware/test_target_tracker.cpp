@@ -99,6 +99,24 @@ TEST(TargetTracker, ACloseSightingWeighsMoreThanAFarOne) {
   DOUBLES_EQUAL(kTarget.x() + 0.1F * 15.0F / 17.0F, tracker.estimate_m().x(), 1e-4);
 }
 
+TEST(TargetTracker, OnceConfirmedTheEstimateTakesInSightingsScatteredAlongTheLineOfSight) {
+  TargetTrackerParams p;
+  p.agree_radius_m = 0.25F;
+  p.refine_radius_m = 1.0F;
+  tracker.configure(p);
+  // Two views agree 0.4 m beyond the target; a third fix 0.4 m short of it is too far from
+  // them to agree, but close enough to refine: the estimate lands on the target.
+  const Eigen::Vector3f beyond = kTarget + Eigen::Vector3f(0.4F, 0.0F, 0.0F);
+  const Eigen::Vector3f beyond2 = kTarget + Eigen::Vector3f(0.4F, 0.1F, 0.0F);
+  const Eigen::Vector3f short_of = kTarget - Eigen::Vector3f(0.4F, -0.05F, 0.0F);
+  tracker.add(beyond, 0.5F, 1, 3.0F);
+  tracker.add(beyond2, 0.5F, 2, 3.0F);
+  CHECK(tracker.confirmed());
+  tracker.add(short_of, 0.5F, 3, 2.12F);  // twice the weight of each of the others
+  DOUBLES_EQUAL(kTarget.x(), tracker.estimate_m().x(), 0.02);
+  DOUBLES_EQUAL(kTarget.y() + 0.05F, tracker.estimate_m().y(), 0.02);
+}
+
 TEST(TargetTracker, ANonFiniteRangeIsIgnored) {
   tracker.add(kTarget, 0.5F, 1, std::numeric_limits<float>::quiet_NaN());
   UNSIGNED_LONGS_EQUAL(0, tracker.sightings());

@@ -13,6 +13,10 @@ namespace boticelli::firmware::mission {
 struct TargetTrackerParams {
   float agree_radius_m = 0.25F;  // two sightings this close (3-D) are the same target
   std::size_t min_views = 2;     // distinct views (look, pan, tilt row) that must agree
+  // Once confirmed, the estimate is the weighted mean of every sighting within this of the
+  // group's centre (re-centred twice): stereo fixes scatter along the line of sight, farther
+  // than two of them need to agree.
+  float refine_radius_m = 0.25F;
 };
 
 // Keeps the last kMaxSightings sightings (world frame, odometry). The estimate is the mean of
