@@ -23,8 +23,7 @@ void DriveController::start(const core::Pose2& from, core::Point2 end, std::uint
   status_ = distance < params_.position_tolerance_m ? DriveStatus::kDone : DriveStatus::kTurning;
 }
 
-void DriveController::start_turn(const core::Pose2& from, float heading_rad,
-                                 std::uint64_t now_us) {
+void DriveController::start_turn(const core::Pose2& from, float heading_rad, std::uint64_t now_us) {
   start_ = {from.x_m, from.y_m};
   end_ = start_;  // the leg after the turn is already at its end: it stops at once
   heading_rad_ = heading_rad;

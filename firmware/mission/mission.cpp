@@ -387,7 +387,7 @@ void Mission::control_drive(std::uint64_t now_us) {
   }
   if (ok && ++steps_this_look_ < params_.steps_per_look && next_step_on_look()) return;
   end_cycle(ok ? (turned_round_ && steps_this_look_ > params_.steps_per_look ? "turned round"
-                                                                            : "step done")
+                                                                             : "step done")
                : driver_.failure());
   if (phase_ != Phase::kDone) begin_look(now_us);
 }
@@ -595,9 +595,8 @@ void Mission::after_plan() {
     // The sector behind the robot that the PTU cannot pan to was never seen here: turn
     // round and look once more before giving up.
     const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
-    const float fov_rad =
-        2.0F * std::atan(0.5F * static_cast<float>(params_.rig.camera.width_px) /
-                         params_.rig.camera.focal_px);
+    const float fov_rad = 2.0F * std::atan(0.5F * static_cast<float>(params_.rig.camera.width_px) /
+                                           params_.rig.camera.focal_px);
     const bool blind = lim.pan_max_rad - lim.pan_min_rad + fov_rad < 2.0F * core::kPi<float>;
     const bool turned_here =
         turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;

@@ -1,4 +1,5 @@
-// Tests of the global point lists: retired obstacle points, explored and unreachable exploration points.
+// Tests of the global point lists: retired obstacle points, explored and unreachable exploration
+// points.
 #include <cmath>
 #include <cstddef>
 
@@ -175,7 +176,7 @@ TEST(GlobalMap, AnExplorationPointThatCannotBeClearedOrIsNotThisLooksIsDropped) 
 }
 
 TEST(GlobalMap, AKnownExplorationPointALookSawIsExploredAndOneBeyondWhatItSawStays) {
-  free->fill(2.0F);  // how far this look saw the floor, all round
+  free->fill(2.0F);                            // how far this look saw the floor, all round
   const Point2 seen = seen_at(1.8F, -1.0F);    // 0.2 m inside what was seen
   const Point2 beyond = seen_at(1.95F, 2.5F);  // only 0.05 m inside: not by the margin
   CHECK_TRUE(global->exploration().push_back(seen));

@@ -108,14 +108,14 @@ void check_found_safely(const MissionRun& r) {
 
 // The board allocates its world, textures and buffers at init and keeps them for the next run
 // (static storage, as on the robot): not leaks, so CppUTest's leak check is off here.
-#define MISSION_GROUP(name)                                           \
-  TEST_GROUP(name) {                                                  \
-    void setup() override {                                           \
-      MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads();    \
-    }                                                                 \
-    void teardown() override {                                        \
-      MemoryLeakWarningPlugin::restoreNewDeleteOverloads();           \
-    }                                                                 \
+#define MISSION_GROUP(name)                                        \
+  TEST_GROUP(name) {                                               \
+    void setup() override {                                        \
+      MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads(); \
+    }                                                              \
+    void teardown() override {                                     \
+      MemoryLeakWarningPlugin::restoreNewDeleteOverloads();        \
+    }                                                              \
   }
 
 MISSION_GROUP(MissionThesisRoom);
@@ -197,10 +197,9 @@ TEST(MissionThesisRoom, TheSameSeedGivesTheSameTraceBitForBit) {
 }
 
 TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {
-  for (const char* world :
-       {"box_in_cylindrical_room", "box_in_rectangular_room", "cluttered_room", "corridor",
-        "cylindrical_room", "cylindrical_room_offcentre", "l_shaped_room", "rectangular_room",
-        "two_rooms_doorway"}) {
+  for (const char* world : {"box_in_cylindrical_room", "box_in_rectangular_room", "cluttered_room",
+                            "corridor", "cylindrical_room", "cylindrical_room_offcentre",
+                            "l_shaped_room", "rectangular_room", "two_rooms_doorway"}) {
     const MissionRun r = run_mission(world, "1");
     const std::string what = std::string(world) + ": " + r.mission_line;
     CHECK_EQUAL_TEXT(0, r.exit_code, what.c_str());
@@ -246,9 +245,8 @@ void on_frame_estop(void* context) {
     e->settled_taken = true;
   }
   if (now >= e->pressed_us + 3000000U) {
-    e->moved_while_held_m =
-        std::hypot(p.x_m - e->settled.x_m, p.y_m - e->settled.y_m) +
-        std::fabs(p.yaw_rad - e->settled.yaw_rad);
+    e->moved_while_held_m = std::hypot(p.x_m - e->settled.x_m, p.y_m - e->settled.y_m) +
+                            std::fabs(p.yaw_rad - e->settled.yaw_rad);
     w.set_estop_pressed(false);
     e->phase = 2;
   }

@@ -183,8 +183,8 @@ std::size_t GlobalMap::mark_explored(const core::Pose2& pose, const StarPolygon&
   return remove_well_inside(exploration_, pose, seen, bounding_radius_m, params.explored_margin_m);
 }
 
-std::size_t GlobalMap::clear_exploration(core::Point2 origin, float clearance_m,
-                                         float pull_reach_m, const MapPointParams& params) {
+std::size_t GlobalMap::clear_exploration(core::Point2 origin, float clearance_m, float pull_reach_m,
+                                         const MapPointParams& params) {
   const auto clear_at = [&](core::Point2 p) {
     for (const core::Point2& o : obstacles_) {
       if (core::distance_m(o, p) < clearance_m) return false;
