@@ -119,17 +119,18 @@ void check_found_safely(const MissionRun& r) {
   }
 
 MISSION_GROUP(MissionThesisRoom);
+MISSION_GROUP(MissionSeeds);
 MISSION_GROUP(MissionRooms);
 MISSION_GROUP(MissionEstop);
 
-TEST(MissionThesisRoom, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
+TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
   const MissionRun r = run_mission("thesis_room", "2", 0.02F);
   check_found_safely(r);
   std::remove(r.trace_path.c_str());
 }
 
-TEST(MissionThesisRoom, FindsItForFourMoreSeeds) {
-  for (const char* seed : {"2", "4", "5", "6"}) {
+TEST(MissionSeeds, FindsItForThreeMoreSeeds) {  // with seeds 1 and 3 below: five seeds
+  for (const char* seed : {"2", "4", "5"}) {
     const MissionRun r = run_mission("thesis_room", seed);
     check_found_safely(r);
     std::remove(r.trace_path.c_str());
