@@ -93,7 +93,7 @@ class GlobalMap {
   // Removes the known exploration points a look saw: at least explored_margin_m inside
   // `seen` (robot frame at `pose`: how far the floor, or an obstacle's base, was seen along
   // each ray) and its bounding circle. Call it before merge() with the same look, so the
-  // look's own new points (on or near the seen boundary) stay. Returns how many went.
+  // look's own fresh points (on or near the seen boundary) stay. Returns how many went.
   std::size_t mark_explored(const core::Pose2& pose, const StarPolygon& seen,
                             float bounding_radius_m, const MapPointParams& params);
 
