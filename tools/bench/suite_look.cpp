@@ -1,5 +1,4 @@
 // Benchmark suite "look": one 360° look of the mission on the sim renderer vs the world.
-#include <dirent.h>
 #include <time.h>
 
 #include <algorithm>
@@ -11,7 +10,6 @@
 #include <memory>
 #include <numbers>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,6 +23,7 @@
 #include "algo/stereo/rig.h"
 #include "algo/stereo/stereo_processor.h"
 #include "bench.h"
+#include "bench_worlds.h"
 #include "board_config.h"
 #include "firmware/mission/mission.h"
 #include "firmware/mission/mission_params.h"
@@ -65,45 +64,6 @@ std::int64_t cpu_ns() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
-}
-
-long env_long(const char* name, long fallback) {
-  const char* v = std::getenv(name);
-  if (v == nullptr || *v == '\0') return fallback;
-  const long n = std::strtol(v, nullptr, 10);
-  return n > 0 ? n : fallback;
-}
-
-double env_double(const char* name, double fallback) {
-  const char* v = std::getenv(name);
-  if (v == nullptr || *v == '\0') return fallback;
-  return std::atof(v);
-}
-
-// Shipped worlds, optionally restricted by BOTICELLI_LOOK_WORLDS=name[,name...].
-std::vector<std::string> world_names() {
-  std::vector<std::string> names;
-  if (DIR* d = ::opendir(BOTICELLI_WORLDS_DIR); d != nullptr) {
-    while (const dirent* e = ::readdir(d)) {
-      const std::string n = e->d_name;
-      if (n.size() > 4 && n.compare(n.size() - 4, 4, ".sdf") == 0) {
-        names.push_back(n.substr(0, n.size() - 4));
-      }
-    }
-    ::closedir(d);
-  }
-  std::sort(names.begin(), names.end());
-  const char* only = std::getenv("BOTICELLI_LOOK_WORLDS");
-  if (only == nullptr || *only == '\0') return names;
-  std::vector<std::string> wanted;
-  std::stringstream list(only);
-  std::string item;
-  while (std::getline(list, item, ',')) {
-    if (item.size() > 4 && item.compare(item.size() - 4, 4, ".sdf") == 0)
-      item.resize(item.size() - 4);
-    if (std::find(names.begin(), names.end(), item) != names.end()) wanted.push_back(item);
-  }
-  return wanted;
 }
 
 float quantise(float rad, float resolution_rad) {
@@ -338,7 +298,8 @@ struct WorldStats {
   std::vector<double> target_error_m, target_far_error_m;
 };
 
-int run_world(const std::string& name, std::size_t poses, double min_clearance_m) {
+int run_world(const std::string& dir, const std::string& name, std::size_t poses,
+              double min_clearance_m) {
   const firmware::BoardConfig config = boards::sim::make_config();
   const firmware::mission::MissionParams params = firmware::mission::make_mission_params(config);
   const boards::sim::SimSettings settings = boards::sim::make_settings(config, 1);
@@ -346,7 +307,7 @@ int run_world(const std::string& name, std::size_t poses, double min_clearance_m
   static stereo::StereoProcessor stereo(rig, params.stereo);
   static stereo::FloorCue floor_cue(rig);
 
-  const std::string path = std::string(BOTICELLI_WORLDS_DIR) + "/" + name + ".sdf";
+  const std::string path = dir + "/" + name + ".sdf";
   char error[256] = "";
   if (!hal::sim::load_world(path.c_str(), g_world, error, sizeof error) ||
       !g_bank.build(g_world, error, sizeof error) ||
@@ -558,8 +519,9 @@ int run() {
   const auto poses = static_cast<std::size_t>(env_long("BOTICELLI_LOOK_POSES", 20));
   const double clearance = env_double("BOTICELLI_LOOK_CLEARANCE_M", 0.35);
   int status = 0;
-  for (const std::string& name : world_names()) {
-    if (run_world(name, poses, clearance) != 0) status = 1;
+  const std::string dir = worlds_dir("BOTICELLI_LOOK_WORLDS_DIR", BOTICELLI_WORLDS_DIR);
+  for (const std::string& name : world_names(dir, "BOTICELLI_LOOK_WORLDS", kSuite)) {
+    if (run_world(dir, name, poses, clearance) != 0) status = 1;
   }
   return status;
 }

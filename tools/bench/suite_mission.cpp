@@ -15,7 +15,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +22,7 @@
 #include "algo/aln/text_format.h"
 #include "algo/mapping/local_model_builder.h"
 #include "bench.h"
+#include "bench_worlds.h"
 #include "board_config.h"
 #include "firmware/mission_state.h"
 #include "firmware/persistence.h"
@@ -120,50 +120,6 @@ std::string own_directory() {
   if (slash == nullptr) return ".";
   *slash = '\0';
   return path;
-}
-
-// Shipped worlds (BOTICELLI_WORLDS_DIR/*.sdf, sorted), optionally restricted by
-// BOTICELLI_MISSION_WORLDS=name[,name...] (with or without ".sdf").
-// The folder of worlds: the shipped ones, or BOTICELLI_MISSION_WORLDS_DIR (e.g. tests/worlds).
-std::string worlds_dir() {
-  const char* dir = std::getenv("BOTICELLI_MISSION_WORLDS_DIR");
-  return dir != nullptr && *dir != '\0' ? std::string(dir) : std::string(BOTICELLI_WORLDS_DIR);
-}
-
-std::vector<std::string> world_names() {
-  std::vector<std::string> names;
-  if (DIR* d = ::opendir(worlds_dir().c_str()); d != nullptr) {
-    while (const dirent* e = ::readdir(d)) {
-      const std::string n = e->d_name;
-      if (n.size() > 4 && n.compare(n.size() - 4, 4, ".sdf") == 0) {
-        names.push_back(n.substr(0, n.size() - 4));
-      }
-    }
-    ::closedir(d);
-  }
-  std::sort(names.begin(), names.end());
-  const char* only = std::getenv("BOTICELLI_MISSION_WORLDS");
-  if (only == nullptr || *only == '\0') return names;
-  std::vector<std::string> wanted;
-  std::stringstream list(only);
-  std::string item;
-  while (std::getline(list, item, ',')) {
-    if (item.size() > 4 && item.compare(item.size() - 4, 4, ".sdf") == 0)
-      item.resize(item.size() - 4);
-    if (std::find(names.begin(), names.end(), item) != names.end()) {
-      wanted.push_back(item);
-    } else {
-      std::fprintf(stderr, "mission: no world '%s' in %s\n", item.c_str(), worlds_dir().c_str());
-    }
-  }
-  return wanted;
-}
-
-long env_long(const char* name, long fallback) {
-  const char* v = std::getenv(name);
-  if (v == nullptr || *v == '\0') return fallback;
-  const long n = std::strtol(v, nullptr, 10);
-  return n > 0 ? n : fallback;
 }
 
 double wall_s() {
@@ -323,13 +279,14 @@ int run() {
     return 1;
   }
 
-  const std::vector<std::string> names = world_names();
+  const std::string folder = worlds_dir("BOTICELLI_MISSION_WORLDS_DIR", BOTICELLI_WORLDS_DIR);
+  const std::vector<std::string> names = world_names(folder, "BOTICELLI_MISSION_WORLDS", kSuite);
   std::size_t worlds = 0;
   std::size_t with_target = 0;
   std::size_t successes = 0;
   double spl_sum = 0.0;
   for (const std::string& name : names) {
-    const std::string world_path = worlds_dir() + "/" + name + ".sdf";
+    const std::string world_path = folder + "/" + name + ".sdf";
     char error[256] = "";
     if (!hal::sim::load_world(world_path.c_str(), g_world, error, sizeof error)) {
       std::fprintf(stderr, "mission: %s\n", error);

@@ -1,0 +1,23 @@
+// Settings from the environment and the list of world files, shared by the suites that run worlds.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace boticelli::bench {
+
+// The environment variable as a positive integer, else `fallback`.
+long env_long(const char* name, long fallback);
+// The environment variable as a number, else `fallback`.
+double env_double(const char* name, double fallback);
+
+// The environment variable `dir_env` if set, else `fallback` (a folder of *.sdf worlds).
+std::string worlds_dir(const char* dir_env, const char* fallback);
+
+// The worlds in `dir` (file names without ".sdf", sorted), restricted by the environment
+// variable `filter_env` = name[,name...] (with or without ".sdf") when it is set; a listed
+// name that is not in `dir` is reported on stderr with the `suite` prefix and skipped.
+std::vector<std::string> world_names(const std::string& dir, const char* filter_env,
+                                     const char* suite);
+
+}  // namespace boticelli::bench
