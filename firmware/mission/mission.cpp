@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <ctime>
 #include <limits>
 
@@ -106,7 +105,6 @@ void Mission::start(std::uint64_t now_us) {
   cycles_this_run_ = 0;
   failed_cycles_ = 0;
   turned_round_ = false;
-  turn_pending_ = false;
   map_.clear();
   for (const core::Point2& p : state_.obstacles) (void)map_.obstacles().push_back(p);
   for (const core::Point2& p : state_.exploration) (void)map_.exploration().push_back(p);
@@ -153,6 +151,12 @@ float Mission::target_error_m() const {
 }
 
 void Mission::view_angles(std::size_t view, float& pan_rad, float& tilt_rad, bool& pair) const {
+  if (view >= scan_views()) {
+    pan_rad = aimed_pan_rad_;
+    tilt_rad = aimed_tilt_rad_;
+    pair = true;
+    return;
+  }
   const std::size_t row = view / params_.pan_positions;
   std::size_t i = view % params_.pan_positions;
   if (row % 2 == 1) i = params_.pan_positions - 1 - i;  // sweep back on odd rows
@@ -273,6 +277,7 @@ void Mission::control_hold(std::uint64_t now_us) {
 
 void Mission::begin_look(std::uint64_t now_us) {
   phase_ = Phase::kLook;
+  drive_pending_ = turn_pending_ = turning_round_ = false;  // a planned move not begun is void
   view_ = 0;
   second_frame_ = false;
   look_step_ = LookStep::kMove;
@@ -280,9 +285,27 @@ void Mission::begin_look(std::uint64_t now_us) {
   floor_obstacles_.clear();
   floor_free_.clear();
   look_pose_ = odometry_pose();
+  aim_at_target();
   step_deadline_us_ = now_us + params_.ptu_timeout_us;
   think_started_ = false;
   plan_started_ = false;
+}
+
+void Mission::aim_at_target() {
+  aimed_ = false;
+  if (tracker_.sightings() == 0) return;
+  const Eigen::Vector3f& c = tracker_.confirmed() ? tracker_.estimate_m() : tracker_.candidate_m();
+  const core::Point2 q = core::to_robot(look_pose_, {c.x(), c.y()});
+  const float d = std::hypot(q.x_m, q.y_m);
+  const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
+  const float pan = std::atan2(q.y_m, q.x_m);
+  if (d > params_.limits.max_range_m || pan < lim.pan_min_rad || pan > lim.pan_max_rad) return;
+  // The vertex midway between the pair's two tilts, so both frames hold it.
+  const float elevation = std::atan2(c.z() - params_.rig.ptu_height_m, d);
+  const float phi = params_.rig.tilt_step_rad;
+  aimed_pan_rad_ = pan;
+  aimed_tilt_rad_ = std::clamp(elevation + 0.5F * phi, lim.tilt_min_rad + phi, lim.tilt_max_rad);
+  aimed_ = true;
 }
 
 void Mission::control_look(std::uint64_t now_us) {
@@ -362,6 +385,7 @@ void Mission::control_drive(std::uint64_t now_us) {
     const core::Pose2 from = odometry_pose();
     if (turn_pending_) {
       turn_pending_ = false;
+      turning_round_ = true;
       driver_.start_turn(from, core::wrap_pi(from.yaw_rad + core::kPi<float>), now_us);
     } else {
       driver_.start(from, decision_.target, now_us);
@@ -385,10 +409,19 @@ void Mission::control_drive(std::uint64_t now_us) {
       return finish(Result::kFound, "within the stand-off of the target");
     }
   }
+  if (turning_round_) {
+    // Only a finished turn counts: an interrupted one is tried again at the next dead end.
+    turning_round_ = false;
+    if (ok) {
+      turned_round_ = true;
+      turned_round_at_ = {here.x_m, here.y_m};
+    }
+    end_cycle(ok ? "turned round" : driver_.failure());
+    if (phase_ != Phase::kDone) begin_look(now_us);
+    return;
+  }
   if (ok && ++steps_this_look_ < params_.steps_per_look && next_step_on_look()) return;
-  end_cycle(ok ? (turned_round_ && steps_this_look_ > params_.steps_per_look ? "turned round"
-                                                                             : "step done")
-               : driver_.failure());
+  end_cycle(ok ? "step done" : driver_.failure());
   if (phase_ != Phase::kDone) begin_look(now_us);
 }
 
@@ -517,6 +550,7 @@ void Mission::process_view() {
                    fix.point_ptu_m.norm());
     }
   }
+  if (view_ >= scan_views()) return;  // the aimed pair looks up at the target, not the floor
   // The floor cue: learn from the frames that see the floor close in front, then walk the
   // columns; a low pair's second frame sees nearer floor than its first.
   (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
@@ -531,8 +565,7 @@ void Mission::process_view() {
 
 void Mission::begin_think() {
   think_started_ = true;
-  const std::size_t removed = evidence::filter_readings(features_, params_.limits);
-  (void)removed;
+  (void)evidence::filter_readings(features_, params_.limits);
   builder_.start(params_.model, features_.span(), floor_obstacles_.span(), floor_free_.span());
 }
 
@@ -604,11 +637,8 @@ void Mission::after_plan() {
       end_cycle("nothing left to explore");
       return finish(Result::kNotFound, "nothing left to explore");
     }
-    turned_round_ = true;
-    turned_round_at_ = {here.x_m, here.y_m};
     turn_pending_ = true;
     drive_pending_ = true;
-    steps_this_look_ = params_.steps_per_look;  // no further step on this look
     phase_ = Phase::kDrive;
     return;
   }

@@ -227,6 +227,8 @@ TEST(TargetTracker, ClearForgetsEverything) {
   tracker.clear();
   CHECK_FALSE(tracker.confirmed());
   UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
+  UNSIGNED_LONGS_EQUAL(0, tracker.supporting_views());
+  check_near(Eigen::Vector3f::Zero(), tracker.estimate_m(), 0.0F);
   tracker.add(kTarget, 0.8F, 3);
   CHECK_FALSE(tracker.confirmed());
 }

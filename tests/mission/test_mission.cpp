@@ -2,6 +2,7 @@
 // anything, checked against the world's geometry from the trace, and is deterministic.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "algo/core/geometry.h"
 #include "firmware/executive.h"
 #include "firmware/firmware_main.h"
 #include "hal/sim/world.h"
@@ -126,26 +128,46 @@ MISSION_GROUP(MissionEstop);
 TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
   const MissionRun r = run_mission("thesis_room", "2", 0.02F);
   check_found_safely(r);
+  // The trace's pose is the simulator's true one (where the robot stopped), not odometry,
+  // which the noise has carried away from it (odometry columns, mapped from the start pose).
+  const sim::TraceRow& first = r.trace.front();
+  const sim::TraceRow& last = r.trace.back();
+  const boticelli::core::Pose2 truth = g_board.sim().true_pose();
+  DOUBLES_EQUAL(truth.x_m, last.x_m, 0.02);
+  DOUBLES_EQUAL(truth.y_m, last.y_m, 0.02);
+  const std::string text = slurp(r.trace_path);
+  const std::size_t line = text.rfind('\n', text.size() - 2) + 1;
+  std::stringstream fields(text.substr(line));
+  std::string field;
+  double odo[3] = {0.0, 0.0, 0.0};
+  for (int i = 0; std::getline(fields, field, ','); ++i) {
+    if (i >= 7 && i <= 9) odo[i - 7] = std::atof(field.c_str());
+  }
+  const boticelli::core::Point2 odo_world =
+      boticelli::core::to_world({static_cast<float>(first.x_m), static_cast<float>(first.y_m),
+                                 static_cast<float>(first.yaw_rad)},
+                                {static_cast<float>(odo[0]), static_cast<float>(odo[1])});
+  const double drift = std::hypot(static_cast<double>(odo_world.x_m) - last.x_m,
+                                  static_cast<double>(odo_world.y_m) - last.y_m);
+  CHECK_TEXT(drift > 0.02, "2% odometry noise should carry odometry away from the true pose");
   std::remove(r.trace_path.c_str());
 }
 
-// With seeds 1 and 3 below: four seeds. Seed 5 is left out because it fails: found, no
-// contact, but a target error of 0.39 m. Its goal rests on fixes from 3-4 m only. That is an
-// open defect of the mission, not a tolerance.
-TEST(MissionSeeds, FindsItForTwoMoreSeeds) {
-  for (const char* seed : {"2", "4"}) {
+// With seeds 1 and 3 below: five seeds.
+TEST(MissionSeeds, FindsItForThreeMoreSeeds) {
+  for (const char* seed : {"2", "4", "5"}) {
     const MissionRun r = run_mission("thesis_room", seed);
     check_found_safely(r);
     std::remove(r.trace_path.c_str());
   }
 }
 
-// Counts heap allocations from the loop's first frame to its last (after every init).
+// Counts heap allocations from the loop's first frame to its last (after every init). Frame
+// overruns are not checked here: the sim board's time moves only when the executive sleeps,
+// so every measured duration is 0 and such a check could not fail.
 struct LoopCount {
   std::size_t allocations = 0;
   std::uint64_t frames = 0;
-  std::uint64_t frame_overruns = 0;
-  std::uint64_t background_overruns = 0;
   bool ended = false;
 };
 std::optional<boticelli::test::AllocationGuard> g_loop_guard;
@@ -160,12 +182,10 @@ void on_loop_ended(void* context, const boticelli::firmware::Executive& executiv
   g_loop_guard.reset();
   const boticelli::firmware::FrameStats& stats = executive.frame_stats();
   count->frames = stats.frames;
-  count->frame_overruns = stats.overruns;
-  count->background_overruns = stats.background_overruns;
   count->ended = true;
 }
 
-TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothingAndNoFrameOverruns) {
+TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothing) {
   // The guard sees allocations with the leak check's operators off (this group's setting):
   // a canary, so the zero below means something.
   std::size_t canary = 0;
@@ -186,8 +206,6 @@ TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothingAndNoFrameOverruns
   CHECK(count.ended);
   CHECK(count.frames > 10000);
   UNSIGNED_LONGS_EQUAL_TEXT(0, count.allocations, "heap allocations after init");
-  UNSIGNED_LONGS_EQUAL(0, count.frame_overruns);
-  UNSIGNED_LONGS_EQUAL(0, count.background_overruns);
   std::remove(r.trace_path.c_str());
 }
 

@@ -56,7 +56,6 @@ class DriveController {
            status_ == DriveStatus::kStopping;
   }
   [[nodiscard]] const char* failure() const { return failure_; }
-  [[nodiscard]] core::Point2 end() const { return end_; }
 
  private:
   DriveParams params_{};

@@ -99,13 +99,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] bool finished() const { return result_ != Result::kRunning; }
   [[nodiscard]] const char* end_reason() const { return end_reason_; }
   [[nodiscard]] std::uint64_t cycles_this_run() const { return cycles_this_run_; }
-  [[nodiscard]] bool has_target() const { return tracker_.confirmed(); }
-  [[nodiscard]] const Eigen::Vector3f& target_estimate_m() const { return tracker_.estimate_m(); }
   // Distance between the target estimate and the true target (NaN without either).
   [[nodiscard]] float target_error_m() const;
-  [[nodiscard]] Phase phase() const { return phase_; }
-  [[nodiscard]] const MissionParams& params() const { return params_; }
-  [[nodiscard]] const mapping::GlobalMap& global_map() const { return map_; }
   // Ends the mission from outside: shutdown (aborted) or --max-cycles (not found).
   void abort(const char* why);
   void finish_not_found(const char* why) { finish(Result::kNotFound, why); }
@@ -135,7 +130,10 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   void write_trace(std::uint64_t now_us);
   void write_snapshot();
   [[nodiscard]] core::Pose2 odometry_pose() const;
-  [[nodiscard]] std::size_t view_count() const { return params_.pan_positions * params_.row_count; }
+  // The scan's views (pans × rows), then the aimed pair when there is one.
+  [[nodiscard]] std::size_t scan_views() const { return params_.pan_positions * params_.row_count; }
+  [[nodiscard]] std::size_t view_count() const { return scan_views() + (aimed_ ? 1U : 0U); }
+  void aim_at_target();
   void view_angles(std::size_t view, float& pan_rad, float& tilt_rad, bool& pair) const;
 
   hal::Hal& hal_;
@@ -164,7 +162,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // the robot turns round once and looks again (where it did, and whether the turn is due).
   bool turned_round_ = false;
   core::Point2 turned_round_at_{};
-  bool turn_pending_ = false;
+  bool turn_pending_ = false;   // the next drive is the turn round, not a step
+  bool turning_round_ = false;  // the drive under way is the turn round
 
   // Look.
   stereo::RigModel rig_;
@@ -176,6 +175,11 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   float view_pan_rad_ = 0.0F;
   float view_tilt_rad_ = 0.0F;
   bool view_pair_ = false;
+  // After the scan, one stereo pair aimed at the target's estimate (or its unconfirmed
+  // candidate), so each look nearer to it refines the estimate with a closer fix.
+  bool aimed_ = false;
+  float aimed_pan_rad_ = 0.0F;
+  float aimed_tilt_rad_ = 0.0F;
   stereo::PairPose pair_pose_{};
   std::uint64_t step_deadline_us_ = 0;
   std::uint64_t settle_until_us_ = 0;

@@ -28,8 +28,9 @@ class TargetTracker {
 
   void configure(const TargetTrackerParams& params) { params_ = params; }
   void clear() {
-    count_ = next_ = 0;
+    count_ = next_ = support_ = 0;
     confirmed_ = false;
+    estimate_ = candidate_ = Eigen::Vector3f::Zero();
   }
   // `view` identifies where it was seen from (e.g. cycle·64 + view index): two sightings of
   // the same view count once.
