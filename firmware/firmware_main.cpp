@@ -131,6 +131,8 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     } else if (loaded != LoadResult::kLoaded) {
       return fail("cannot resume", error);
     } else {
+      if (!board.place_robot(g_state.pose, error, sizeof error))
+        return fail("cannot resume", error);
       std::fprintf(stderr, "boticelli: resumed from %s at cycle %llu\n", g_store.path(),
                    static_cast<unsigned long long>(g_state.cycle));
     }

@@ -35,6 +35,7 @@ void MissionState::clear() {
   pose = {};
   has_goal = false;
   goal = {};
+  goal_height_m = 0.0F;
   obstacles.clear();
   exploration.clear();
   model_bytes = 0;
@@ -57,7 +58,10 @@ bool operator==(const MissionState& a, const MissionState& b) {
       a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad || a.has_goal != b.has_goal) {
     return false;
   }
-  if (a.has_goal && (a.goal.x_m != b.goal.x_m || a.goal.y_m != b.goal.y_m)) return false;
+  if (a.has_goal && (a.goal.x_m != b.goal.x_m || a.goal.y_m != b.goal.y_m ||
+                     a.goal_height_m != b.goal_height_m)) {
+    return false;
+  }
   if (!same_points(a.obstacles, b.obstacles) || !same_points(a.exploration, b.exploration)) {
     return false;
   }

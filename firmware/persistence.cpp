@@ -165,10 +165,12 @@ bool decode_body(Reader& r, MissionState& s) {
   std::string_view v;
   std::string_view l;
   if (!r.line(l)) return false;
-  char header[32];
-  std::snprintf(header, sizeof header, "BOTICELLI-STATE %u", kStateFormatVersion);
   if (l.substr(0, 16) != "BOTICELLI-STATE ") return r.fail("not a state file");
-  if (l != header) return r.fail("unsupported state file version");
+  // Version 1 (a goal without its height) is still read: its goal stands on the floor.
+  std::uint64_t version = 0;
+  if (!parse_u64(l.substr(16), version) || version < 1 || version > kStateFormatVersion) {
+    return r.fail("unsupported state file version");
+  }
   if (!r.keyed("cycle", v) || !parse_u64(v, s.cycle)) return r.fail("bad cycle");
   if (!r.keyed("seed", v) || !parse_u64(v, s.seed)) return r.fail("bad seed");
   float pose[3];
@@ -178,10 +180,11 @@ bool decode_body(Reader& r, MissionState& s) {
   if (v == "none") {
     s.has_goal = false;
   } else {
-    float goal[2];
-    if (!parse_floats(v, goal, 2)) return r.fail("bad goal");
+    float goal[3] = {0.0F, 0.0F, 0.0F};
+    if (!parse_floats(v, goal, version == 1 ? 2 : 3)) return r.fail("bad goal");
     s.has_goal = true;
     s.goal = {goal[0], goal[1]};
+    s.goal_height_m = goal[2];
   }
   if (!read_points(r, "obstacles", MissionState::kMaxObstaclePoints, s.obstacles)) return false;
   if (!read_points(r, "exploration", MissionState::kMaxExplorationPoints, s.exploration)) {
@@ -230,7 +233,8 @@ std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity)
   w.printf("pose %.9g %.9g %.9g\n", static_cast<double>(s.pose.x_m),
            static_cast<double>(s.pose.y_m), static_cast<double>(s.pose.yaw_rad));
   if (s.has_goal) {
-    w.printf("goal %.9g %.9g\n", static_cast<double>(s.goal.x_m), static_cast<double>(s.goal.y_m));
+    w.printf("goal %.9g %.9g %.9g\n", static_cast<double>(s.goal.x_m),
+             static_cast<double>(s.goal.y_m), static_cast<double>(s.goal_height_m));
   } else {
     w.printf("goal none\n");
   }

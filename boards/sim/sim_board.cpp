@@ -55,4 +55,14 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   return true;
 }
 
+bool SimBoard::place_robot(const core::Pose2& mission_pose, char* error, std::size_t error_size) {
+  // The mission's frame is the odometry frame of its first run, which started at the world's
+  // start pose.
+  const core::Pose2 world = core::compose(world_.start, mission_pose);
+  if (sim_.teleport(world)) return true;
+  std::snprintf(error, error_size, "saved pose (%.2f, %.2f) m in the world collides",
+                static_cast<double>(world.x_m), static_cast<double>(world.y_m));
+  return false;
+}
+
 }  // namespace boticelli::boards::sim

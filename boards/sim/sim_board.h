@@ -35,6 +35,7 @@ class SimBoard final : public firmware::Board, public firmware::TruthSource {
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
   hal::Hal& hal() override { return hal_; }
   const firmware::TruthSource* truth() const override { return this; }
+  bool place_robot(const core::Pose2& mission_pose, char* error, std::size_t error_size) override;
   // TruthSource: the simulator's own pose and target (trace, target error).
   core::Pose2 robot_pose() const override { return sim_.true_pose(); }
   core::Pose2 odometry_origin() const override { return sim_.odometry_origin(); }

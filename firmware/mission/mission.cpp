@@ -108,10 +108,11 @@ void Mission::start(std::uint64_t now_us) {
   map_.clear();
   for (const core::Point2& p : state_.obstacles) (void)map_.obstacles().push_back(p);
   for (const core::Point2& p : state_.exploration) (void)map_.exploration().push_back(p);
+  anchor_frame();
   tracker_.clear();
   if (state_.has_goal) {
     // A resumed goal was confirmed before the restart: it stands as two agreeing views.
-    const Eigen::Vector3f g(state_.goal.x_m, state_.goal.y_m, 0.0F);
+    const Eigen::Vector3f g(state_.goal.x_m, state_.goal.y_m, state_.goal_height_m);
     tracker_.add(g, 1.0F, 0xFFFFFFF0U);
     tracker_.add(g, 1.0F, 0xFFFFFFF1U);
   }
@@ -121,7 +122,19 @@ void Mission::start(std::uint64_t now_us) {
 
 core::Pose2 Mission::odometry_pose() const {
   const hal::Odometry o = hal_.base.odometry();
-  return {static_cast<float>(o.x_m), static_cast<float>(o.y_m), static_cast<float>(o.yaw_rad)};
+  return core::compose(frame_from_odometry_, {static_cast<float>(o.x_m), static_cast<float>(o.y_m),
+                                              static_cast<float>(o.yaw_rad)});
+}
+
+void Mission::anchor_frame() {
+  const hal::Odometry o = hal_.base.odometry();
+  const core::Pose2 odometry{static_cast<float>(o.x_m), static_cast<float>(o.y_m),
+                             static_cast<float>(o.yaw_rad)};
+  frame_from_odometry_ = core::compose(state_.pose, core::inverse(odometry));
+}
+
+core::Pose2 Mission::frame_origin_in_world() const {
+  return core::compose(truth_->odometry_origin(), core::inverse(frame_from_odometry_));
 }
 
 core::Pose2 Mission::pose() const {
@@ -142,8 +155,8 @@ MapCounts Mission::map_counts() const {
 
 float Mission::target_error_m() const {
   if (truth_ == nullptr || !tracker_.confirmed()) return std::numeric_limits<float>::quiet_NaN();
-  // The estimate is in the odometry frame; the truth knows where that frame lies.
-  const core::Pose2 o = truth_->odometry_origin();
+  // The estimate is in the mission frame; the truth knows where the odometry frame lies.
+  const core::Pose2 o = frame_origin_in_world();
   const Eigen::Vector3f& e = tracker_.estimate_m();
   const core::Point2 w = core::to_world(o, {e.x(), e.y()});
   const Eigen::Vector3f world(w.x_m, w.y_m, e.z());
@@ -219,7 +232,10 @@ void Mission::control(std::uint64_t now_us) {
     case Phase::kStart: {
       const hal::PanTiltState ptu = hal_.pan_tilt.state();
       if (ptu.fault) return abort("pan-tilt unit fault");
-      if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) begin_look(now_us);
+      if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) {
+        anchor_frame();  // the odometry as the base reports it once ready
+        begin_look(now_us);
+      }
       return;
     }
     case Phase::kLook:
@@ -466,6 +482,7 @@ void Mission::end_cycle(const char* what) {
   state_.has_goal = tracker_.confirmed();
   if (state_.has_goal) {
     state_.goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
+    state_.goal_height_m = tracker_.estimate_m().z();
   }
   TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
   line.appendf("cycle %s x_m=%.2f y_m=%.2f pieces=%u features=%u obst=%u expl=%u", what,
@@ -763,8 +780,8 @@ void Mission::write_snapshot() {
   f.value_context = &value_;
   if (decision_.kind == planning::StepKind::kMove) f.step_end = decision_.target;
   if (truth_ != nullptr) {
-    // The truth is in the world frame; the pictures are in the odometry frame.
-    const core::Pose2 origin = truth_->odometry_origin();
+    // The truth is in the world frame; the pictures are in the mission frame.
+    const core::Pose2 origin = frame_origin_in_world();
     std::size_t used = 0;
     std::size_t count = 0;
     for (const std::span<const core::Point2> outline : truth_->outlines()) {

@@ -40,6 +40,7 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   s.pose = {0.1F * static_cast<float>(cycle), -0.37F, 0.001F * static_cast<float>(cycle)};
   s.has_goal = cycle % 3 == 0;
   s.goal = {1.0F / 3.0F, 2.5e-7F * static_cast<float>(cycle)};
+  s.goal_height_m = 0.01F * static_cast<float>(cycle % 40);
   const std::size_t n_obs = (cycle * 37) % MissionState::kMaxObstaclePoints;
   for (std::size_t i = 0; i < n_obs; ++i) {
     (void)s.obstacles.push_back({static_cast<float>(i) * 0.01F + 0.001F * static_cast<float>(cycle),
@@ -178,12 +179,31 @@ TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
        {head + "obstacles 3000\n" + tail, head + "obstacles 1\n1 nan\n" + tail,
         head + "obstacles 1\n1 2 3\n" + tail, head + "obstacles 2\n1 2\n" + tail,
         head + "obstacles -1\n" + tail, std::string("BOTICELLI-STATE 2\n") + "cycle 3\n",
+        "BOTICELLI-STATE 3" + head.substr(17) + "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 0" + head.substr(17) + "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 2x" + head.substr(17) + "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal 1 2\nobstacles 0\n" + tail,
         head + "obstacles 0\nexploration 0\nmodel 5\nab\n\nlog 0\nend\n",
         head + "obstacles 0\n" + tail + "extra\n", head + "obstacles 0\n" + tail.substr(0, 20),
         std::string("cycle 3\n")}) {
     f = with_crc(body);
     CHECK_FALSE_TEXT(decode_state(f, g_b, &why), body.c_str());
   }
+}
+
+TEST(Persistence, ReadsAVersionOneFileWhoseGoalHasNoHeight) {
+  const char* why = "";
+  const std::string body =
+      "BOTICELLI-STATE 1\ncycle 3\nseed 1\npose 0 0 0\ngoal 1.5 -2\nobstacles 0\n"
+      "exploration 0\nmodel 0\n\nlog 0\nend\n";
+  char line[32];
+  std::snprintf(line, sizeof line, "crc32 %08x\n", crc32(body.data(), body.size()));
+  g_b.goal_height_m = 9.0F;
+  CHECK_TRUE_TEXT(decode_state(body + line, g_b, &why), why);
+  CHECK(g_b.has_goal);
+  DOUBLES_EQUAL(1.5, g_b.goal.x_m, 0.0);
+  DOUBLES_EQUAL(-2.0, g_b.goal.y_m, 0.0);
+  DOUBLES_EQUAL(0.0, g_b.goal_height_m, 0.0);
 }
 
 TEST(Persistence, SavesAtomicallyAndLoadsBack) {

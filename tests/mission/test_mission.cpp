@@ -50,20 +50,22 @@ std::string slurp(const std::string& path) {
 // world's colliders with the robot's disc (not the simulator's own contact counter).
 MissionRun run_mission(const char* world, const char* seed, float odometry_noise = 0.0F,
                        const boticelli::firmware::MainHooks* hooks = nullptr,
-                       const char* world_dir = BOTICELLI_WORLDS_DIR) {
+                       const std::vector<const char*>& extra = {}) {
   char dir_template[] = "/tmp/boticelli-mission-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
   MissionRun run;
   run.trace_path = dir + "/trace.csv";
   const std::string out = dir + "/stdout.txt";
-  const std::string path = std::string(world_dir) + "/" + world + ".sdf";
+  const std::string path = std::string(BOTICELLI_WORLDS_DIR) + "/" + world + ".sdf";
   g_board.settings() = boticelli::boards::sim::make_settings(g_board.config(), 1);
   g_board.settings().physics.base.odometry_noise = odometry_noise;
   // The console on stdio, stdin at end of file and stdout (telemetry, the MISSION line) into
   // a file.
-  const char* argv[] = {
-      "boticelli", "--world", path.c_str(),   "--seed", seed, "--trace", run.trace_path.c_str(),
-      "--console", "stdio",   "--max-cycles", "45"};
+  std::vector<const char*> argv = {"boticelli", "--world",     path.c_str(),           "--seed",
+                                   seed,        "--trace",     run.trace_path.c_str(), "--console",
+                                   "stdio",     "--max-cycles"};
+  argv.push_back("45");
+  for (const char* arg : extra) argv.push_back(arg);
   std::fflush(stdout);
   const int saved = dup(1);
   const int saved_in = dup(0);
@@ -71,8 +73,8 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   FILE* null_in = std::fopen("/dev/null", "r");
   dup2(fileno(f), 1);
   dup2(fileno(null_in), 0);
-  run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(sizeof argv / sizeof argv[0]),
-                                                     argv, g_board, hooks);
+  run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(argv.size()), argv.data(),
+                                                     g_board, hooks);
   std::fflush(stdout);
   dup2(saved, 1);
   dup2(saved_in, 0);
@@ -94,6 +96,18 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   }
   std::remove(out.c_str());
   return run;
+}
+
+// The odometry columns (the mission frame's pose) of a trace's first or last row.
+void trace_odometry(const std::string& trace_path, bool last, double odo[3]) {
+  const std::string text = slurp(trace_path);
+  const std::size_t first_row = text.find('\n') + 1;
+  const std::size_t line = last ? text.rfind('\n', text.size() - 2) + 1 : first_row;
+  std::stringstream fields(text.substr(line, text.find('\n', line) - line));
+  std::string field;
+  for (int i = 0; std::getline(fields, field, ','); ++i) {
+    if (i >= 7 && i <= 9) odo[i - 7] = std::atof(field.c_str());
+  }
 }
 
 void check_found_safely(const MissionRun& r) {
@@ -124,6 +138,7 @@ MISSION_GROUP(MissionThesisRoom);
 MISSION_GROUP(MissionSeeds);
 MISSION_GROUP(MissionRooms);
 MISSION_GROUP(MissionEstop);
+MISSION_GROUP(MissionResume);
 
 TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose) {
   const MissionRun r = run_mission("thesis_room", "2", 0.02F);
@@ -135,14 +150,8 @@ TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose
   const boticelli::core::Pose2 truth = g_board.sim().true_pose();
   DOUBLES_EQUAL(truth.x_m, last.x_m, 0.02);
   DOUBLES_EQUAL(truth.y_m, last.y_m, 0.02);
-  const std::string text = slurp(r.trace_path);
-  const std::size_t line = text.rfind('\n', text.size() - 2) + 1;
-  std::stringstream fields(text.substr(line));
-  std::string field;
   double odo[3] = {0.0, 0.0, 0.0};
-  for (int i = 0; std::getline(fields, field, ','); ++i) {
-    if (i >= 7 && i <= 9) odo[i - 7] = std::atof(field.c_str());
-  }
+  trace_odometry(r.trace_path, true, odo);
   const boticelli::core::Point2 odo_world =
       boticelli::core::to_world({static_cast<float>(first.x_m), static_cast<float>(first.y_m),
                                  static_cast<float>(first.yaw_rad)},
@@ -295,4 +304,45 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsWithinAFrameAndTheMissionCarriesOn
   CHECK(drove_after);
   check_found_safely(r);
   std::remove(r.trace_path.c_str());
+}
+
+// Stopped after three cycles and started again with --resume: the robot is put back where it
+// stopped, the mission carries on in the frame its map was saved in, and ends found.
+TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget) {
+  char dir_template[] = "/tmp/boticelli-resume-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  // Later --max-cycles options win over run_mission's own.
+  const MissionRun first =
+      run_mission("thesis_room", "1", 0.0F, nullptr, {"--state", dir.c_str(), "--max-cycles", "3"});
+  STRCMP_CONTAINS("MISSION result=not_found cycles=3 ", first.mission_line.c_str());
+  UNSIGNED_LONGS_EQUAL_TEXT(0, first.check.collisions, first.mission_line.c_str());
+  const sim::TraceRow stopped = first.trace.back();
+  CHECK_TEXT(std::hypot(stopped.x_m - first.trace.front().x_m,
+                        stopped.y_m - first.trace.front().y_m) > 0.3,
+             "the first run drove somewhere");
+  const MissionRun second =
+      run_mission("thesis_room", "1", 0.0F, nullptr, {"--state", dir.c_str(), "--resume"});
+  check_found_safely(second);
+  const sim::TraceRow& resumed = second.trace.front();
+  DOUBLES_EQUAL(stopped.x_m, resumed.x_m, 0.002);
+  DOUBLES_EQUAL(stopped.y_m, resumed.y_m, 0.002);
+  DOUBLES_EQUAL(0.0, std::remainder(stopped.yaw_rad - resumed.yaw_rad, 2.0 * M_PI), 0.002);
+  // The pose in the mission's frame (the trace's odometry columns) carries on too: the map
+  // and the goal saved in that frame still fit.
+  double before[3] = {0.0, 0.0, 0.0};
+  double after[3] = {1.0, 1.0, 1.0};
+  trace_odometry(first.trace_path, true, before);
+  trace_odometry(second.trace_path, false, after);
+  CHECK_TEXT(std::hypot(before[0], before[1]) > 0.3, "the first run's frame moved with the robot");
+  DOUBLES_EQUAL(before[0], after[0], 0.002);
+  DOUBLES_EQUAL(before[1], after[1], 0.002);
+  DOUBLES_EQUAL(0.0, std::remainder(before[2] - after[2], 2.0 * M_PI), 0.002);
+  // The cycle count carries on from the saved state.
+  const std::size_t c = second.mission_line.find("cycles=");
+  CHECK(c != std::string::npos);
+  CHECK_TEXT(std::atoi(second.mission_line.c_str() + c + 7) > 3, second.mission_line.c_str());
+  std::remove(first.trace_path.c_str());
+  std::remove(second.trace_path.c_str());
+  std::remove((dir + "/mission.state").c_str());
+  rmdir(dir.c_str());
 }

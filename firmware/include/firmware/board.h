@@ -107,6 +107,16 @@ class Board {
   virtual hal::Hal& hal() = 0;
   // Ground truth, or nullptr (hardware).
   virtual const TruthSource* truth() const { return nullptr; }
+  // A resumed mission's saved pose, in the mission's frame (the robot's pose when the mission
+  // first started), called after init() and before the devices start. The sim board puts the
+  // robot there (that frame being the world's start pose) and fails if the pose collides; a
+  // hardware board cannot move the robot and trusts it to stand where it stopped.
+  virtual bool place_robot(const core::Pose2& mission_pose, char* error, std::size_t error_size) {
+    (void)mission_pose;
+    (void)error;
+    (void)error_size;
+    return true;
+  }
 };
 
 }  // namespace boticelli::firmware

@@ -31,9 +31,12 @@ struct MissionState {
 
   std::uint64_t cycle = 0;  // completed cycles
   std::uint64_t seed = 1;   // --seed of the run that started the mission
-  core::Pose2 pose;         // robot pose in the world frame [m, rad]
+  // Robot pose [m, rad] in the mission's frame: the odometry frame of the run that started the
+  // mission (a resumed run carries it on from here).
+  core::Pose2 pose;
   bool has_goal = false;
-  core::Point2 goal;                                              // target position once seen [m]
+  core::Point2 goal;           // target position once confirmed, mission frame [m]
+  float goal_height_m = 0.0F;  // the target's height above the floor [m]
   core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles;  // global obstacle list [m]
   core::FixedVector<core::Point2, kMaxExplorationPoints>
       exploration;                           // global exploration list [m]

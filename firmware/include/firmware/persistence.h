@@ -17,7 +17,7 @@ std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
 //   BOTICELLI-STATE 1 / cycle N / seed N / pose X Y YAW / goal none|goal X Y /
 //   obstacles N + N lines "X Y" / exploration N + N lines / model BYTES + the bytes + "\n" /
 //   log N + N lines "CYCLE TEXT" / end / crc32 XXXXXXXX (over everything before that line).
-inline constexpr std::uint32_t kStateFormatVersion = 1;
+inline constexpr std::uint32_t kStateFormatVersion = 2;  // 2: the goal has a height
 inline constexpr std::size_t kMaxStateFileBytes =
     256 + 40 * (MissionState::kMaxObstaclePoints + MissionState::kMaxExplorationPoints) +
     MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64;

@@ -129,7 +129,12 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   bool next_step_on_look();
   void write_trace(std::uint64_t now_us);
   void write_snapshot();
+  // The robot's pose in the mission's frame: odometry carried on from a resumed state's pose.
   [[nodiscard]] core::Pose2 odometry_pose() const;
+  // Fixes the mission frame against the odometry so that the robot stands at state_.pose.
+  void anchor_frame();
+  // The world pose of the mission frame's origin (sim ground truth only).
+  [[nodiscard]] core::Pose2 frame_origin_in_world() const;
   // The scan's views (pans × rows), then the aimed pair when there is one.
   [[nodiscard]] std::size_t scan_views() const { return params_.pan_positions * params_.row_count; }
   [[nodiscard]] std::size_t view_count() const { return scan_views() + (aimed_ ? 1U : 0U); }
@@ -147,6 +152,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   SnapshotWriter* snapshots_;
   MissionParams params_;
 
+  // Mission frame from odometry frame: identity for a new mission; a resumed one continues
+  // in the frame its lists and goal were saved in, while the odometry restarts at zero.
+  core::Pose2 frame_from_odometry_{};
   Phase phase_ = Phase::kStart;
   Phase held_phase_ = Phase::kStart;
   Result result_ = Result::kRunning;

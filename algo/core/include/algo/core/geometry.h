@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "algo/core/angles.h"
+
 namespace boticelli::core {
 
 // A point on the floor plane [m] (world or robot frame, as the owner says).
@@ -37,6 +39,18 @@ inline Point2 to_robot(const Pose2& pose, Point2 p) {
   const float dx = p.x_m - pose.x_m;
   const float dy = p.y_m - pose.y_m;
   return {c * dx + s * dy, -s * dx + c * dy};
+}
+
+// The pose `b`, given in the frame of pose `a`, in the frame `a` is given in (a ∘ b).
+inline Pose2 compose(const Pose2& a, const Pose2& b) {
+  const Point2 p = to_world(a, {b.x_m, b.y_m});
+  return {p.x_m, p.y_m, wrap_pi(a.yaw_rad + b.yaw_rad)};
+}
+
+// The frame's own origin seen from the pose (a⁻¹): compose(a, inverse(a)) is the identity.
+inline Pose2 inverse(const Pose2& a) {
+  const Point2 p = to_robot(a, {0.0F, 0.0F});
+  return {p.x_m, p.y_m, -a.yaw_rad};
 }
 
 }  // namespace boticelli::core
