@@ -199,15 +199,44 @@ void Console::cmd_help(const Words& w) {
   emit(reply_.view());
 }
 
+namespace {
+
+// " target=none", or " target=seen|confirmed target_x_m=… target_y_m=… target_z_m=… sightings=N".
+void append_target(TextBufferBase& out, const TargetEstimate& t) {
+  out.appendf(" target=%s", target_status_name(t.status));
+  if (t.status == TargetStatus::kNone) return;
+  out.appendf(" target_x_m=%.3f target_y_m=%.3f target_z_m=%.3f sightings=%u",
+              static_cast<double>(t.x_m), static_cast<double>(t.y_m), static_cast<double>(t.z_m),
+              t.sightings);
+}
+
+}  // namespace
+
+const char* target_status_name(TargetStatus status) {
+  switch (status) {
+    case TargetStatus::kNone:
+      return "none";
+    case TargetStatus::kSeen:
+      return "seen";
+    case TargetStatus::kConfirmed:
+      return "confirmed";
+  }
+  return "unknown";
+}
+
 void Console::cmd_status(const Words& w) {
   if (!no_args(w)) return reply_error("status takes no arguments");
   const FrameStats& f = executive_.frame_stats();
+  const MapCounts m = view_.map_counts();
   reply_.appendf(
-      "status state=%s estop=%s paused=%d healthy=%d cycles=%llu frames=%llu uptime_s=%.1f\r\n"
-      "OK\r\n",
+      "status state=%s estop=%s paused=%d healthy=%d cycles=%llu pieces=%u features=%u "
+      "obstacle_points=%u exploration_points=%u",
       view_.state_name(), stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
       executive_.all_healthy() ? 1 : 0, static_cast<unsigned long long>(view_.cycles()),
-      static_cast<unsigned long long>(f.frames), static_cast<double>(now_us_ - start_us_) * 1e-6);
+      view_.pieces(), view_.features(), m.obstacle_points, m.exploration_points);
+  append_target(reply_, view_.target());
+  reply_.appendf(" frames=%llu uptime_s=%.1f\r\nOK\r\n", static_cast<unsigned long long>(f.frames),
+                 static_cast<double>(now_us_ - start_us_) * 1e-6);
   emit(reply_.view());
 }
 
@@ -288,8 +317,10 @@ void Console::stream_model() {
 void Console::cmd_map(const Words& w) {
   if (!no_args(w)) return reply_error("map takes no arguments");
   const MapCounts m = view_.map_counts();
-  reply_.appendf("map polygon_vertices=%u obstacle_points=%u exploration_points=%u\r\nOK\r\n",
+  reply_.appendf("map polygon_vertices=%u obstacle_points=%u exploration_points=%u",
                  m.polygon_vertices, m.obstacle_points, m.exploration_points);
+  append_target(reply_, view_.target());
+  reply_.append("\r\nOK\r\n");
   emit(reply_.view());
 }
 
@@ -393,12 +424,13 @@ void Console::send_telemetry(std::uint64_t now_us) {
   const core::Pose2 p = view_.pose();
   TextBuffer<256> line;
   line.appendf(
-      "TLM t_s=%.2f state=%s pan_rad=%.3f features=%u pieces=%u x_m=%.3f y_m=%.3f "
-      "yaw_rad=%.3f estop=%s\r\n",
+      "TLM t_s=%.2f state=%s cycles=%llu pan_rad=%.3f features=%u pieces=%u x_m=%.3f y_m=%.3f "
+      "yaw_rad=%.3f estop=%s target=%s\r\n",
       static_cast<double>(now_us - start_us_) * 1e-6, view_.state_name(),
-      static_cast<double>(view_.pan_rad()), view_.features(), view_.pieces(),
-      static_cast<double>(p.x_m), static_cast<double>(p.y_m), static_cast<double>(p.yaw_rad),
-      stop_cause_name(safety_.cause()));
+      static_cast<unsigned long long>(view_.cycles()), static_cast<double>(view_.pan_rad()),
+      view_.features(), view_.pieces(), static_cast<double>(p.x_m), static_cast<double>(p.y_m),
+      static_cast<double>(p.yaw_rad), stop_cause_name(safety_.cause()),
+      target_status_name(view_.target().status));
   if (!line.truncated()) emit(line.view());
 }
 

@@ -153,6 +153,18 @@ MapCounts Mission::map_counts() const {
   return m;
 }
 
+TargetEstimate Mission::target() const {
+  TargetEstimate t;
+  t.sightings = static_cast<std::uint32_t>(tracker_.sightings());
+  if (t.sightings == 0) return t;
+  t.status = tracker_.confirmed() ? TargetStatus::kConfirmed : TargetStatus::kSeen;
+  const Eigen::Vector3f& p = tracker_.confirmed() ? tracker_.estimate_m() : tracker_.candidate_m();
+  t.x_m = p.x();
+  t.y_m = p.y();
+  t.z_m = p.z();
+  return t;
+}
+
 float Mission::target_error_m() const {
   if (truth_ == nullptr || !tracker_.confirmed()) return std::numeric_limits<float>::quiet_NaN();
   // The estimate is in the mission frame; the truth knows where the odometry frame lies.

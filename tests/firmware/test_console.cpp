@@ -33,7 +33,9 @@ class FakeView final : public MissionView {
   std::uint64_t cycles() const override { return 4; }
   std::string_view model_text() const override { return model; }
   MapCounts map_counts() const override { return {12, 34, 5}; }
+  TargetEstimate target() const override { return target_value; }
   boticelli::core::Pose2 pose_value{1.25F, -0.5F, 0.75F};
+  TargetEstimate target_value{};
   std::string model;
 };
 
@@ -190,13 +192,31 @@ TEST(Console, ReportsStatusPoseAndMap) {
   auto reply = command("status");
   CHECK_EQUAL(2U, reply.size());
   STRCMP_CONTAINS("state=look estop=none paused=0", reply[0].c_str());
-  STRCMP_CONTAINS("cycles=4", reply[0].c_str());
+  STRCMP_CONTAINS(
+      "cycles=4 pieces=17 features=321 obstacle_points=34 exploration_points=5 target=none "
+      "frames=",
+      reply[0].c_str());
   reply = command("pose");
   STRCMP_EQUAL("pose x_m=1.250 y_m=-0.500 yaw_rad=0.7500", reply.at(0).c_str());
   reply = command("map");
-  STRCMP_EQUAL("map polygon_vertices=12 obstacle_points=34 exploration_points=5",
+  STRCMP_EQUAL("map polygon_vertices=12 obstacle_points=34 exploration_points=5 target=none",
                reply.at(0).c_str());
   CHECK_EQUAL("OK", reply.back());
+}
+
+TEST(Console, ReportsTheTargetEstimateOnceTheMissionHasOne) {
+  view.target_value = {TargetStatus::kSeen, 1, 2.5F, -1.0F, 0.4F};
+  STRCMP_CONTAINS("target=seen target_x_m=2.500 target_y_m=-1.000 target_z_m=0.400 sightings=1 ",
+                  command("status").at(0).c_str());
+  view.target_value = {TargetStatus::kConfirmed, 3, 2.25F, -1.5F, 0.35F};
+  STRCMP_EQUAL(
+      "map polygon_vertices=12 obstacle_points=34 exploration_points=5 target=confirmed "
+      "target_x_m=2.250 target_y_m=-1.500 target_z_m=0.350 sightings=3",
+      command("map").at(0).c_str());
+  CHECK_EQUAL("OK", command("set telemetry_ms 100").at(0));
+  port.clear_written();
+  service(10);
+  STRCMP_CONTAINS("estop=none target=confirmed", port.written().c_str());
 }
 
 TEST(Console, ShowsExecutiveTimingPerTask) {
@@ -324,8 +344,8 @@ TEST(Console, SendsTelemetryAtTheConfiguredPeriod) {
   CHECK_EQUAL(10U, out.size());
   STRCMP_CONTAINS("TLM t_s=", out[0].c_str());
   STRCMP_CONTAINS(
-      "state=look pan_rad=0.500 features=321 pieces=17 x_m=1.250 y_m=-0.500 yaw_rad=0.750 "
-      "estop=none",
+      "state=look cycles=4 pan_rad=0.500 features=321 pieces=17 x_m=1.250 y_m=-0.500 "
+      "yaw_rad=0.750 estop=none target=none",
       out[0].c_str());
   CHECK_EQUAL("OK", command("set telemetry_ms 0").at(0));
   port.clear_written();

@@ -37,6 +37,7 @@ struct MissionRun {
   std::vector<sim::TraceRow> trace;
   sim::TraceCheck check{};
   double target_error_m = -1.0;
+  bool telemetry_confirmed = false;  // a TLM line reported the target confirmed
 };
 
 std::string slurp(const std::string& path) {
@@ -83,6 +84,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   std::fclose(f);
   std::fclose(null_in);
   const std::string text = slurp(out);
+  run.telemetry_confirmed = text.find("target=confirmed\r\n") != std::string::npos;
   const std::size_t at = text.rfind("MISSION ");
   if (at != std::string::npos) run.mission_line = text.substr(at, text.find('\n', at) - at);
   const std::size_t e = run.mission_line.find("target_error_m=");
@@ -118,6 +120,7 @@ void check_found_safely(const MissionRun& r) {
   CHECK_TEXT(r.check.min_clearance_m > 0.0, r.mission_line.c_str());
   CHECK_TEXT(r.check.max_gap_s <= 0.1001, "a trace row at least every 0.1 s");
   CHECK_TEXT(r.target_error_m >= 0.0 && r.target_error_m <= 0.3, r.mission_line.c_str());
+  CHECK_TEXT(r.telemetry_confirmed, "telemetry shows the confirmed target");
 }
 
 }  // namespace

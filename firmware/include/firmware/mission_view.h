@@ -14,13 +14,25 @@ struct MapCounts {
   std::uint32_t exploration_points = 0;  // global exploration list
 };
 
+// The mission's idea of where the target is: none yet, seen once (a candidate not yet
+// confirmed by a second view) or confirmed (the goal).
+enum class TargetStatus : std::uint8_t { kNone, kSeen, kConfirmed };
+struct TargetEstimate {
+  TargetStatus status = TargetStatus::kNone;
+  std::uint32_t sightings = 0;  // views that saw it
+  float x_m = 0.0F;             // mission frame, as pose() [m]
+  float y_m = 0.0F;
+  float z_m = 0.0F;  // height above the floor [m]
+};
+const char* target_status_name(TargetStatus status);
+
 // Read-only view the mission implements; the console calls it from its task, so every call
 // must be quick and must not allocate.
 class MissionView {
  public:
   virtual ~MissionView() = default;
   virtual const char* state_name() const = 0;           // e.g. "look", "think", "drive", "idle"
-  virtual core::Pose2 pose() const = 0;                 // world frame [m, rad]
+  virtual core::Pose2 pose() const = 0;                 // mission frame [m, rad]
   virtual float pan_rad() const = 0;                    // current PTU pan [rad]
   virtual std::uint32_t features() const { return 0; }  // features tracked in the last view
   virtual std::uint32_t pieces() const { return 0; }    // linear pieces of the occupancy ALN
@@ -30,6 +42,7 @@ class MissionView {
   // buffer of its own and swaps buffers only between cycles).
   virtual std::string_view model_text() const { return {}; }
   virtual MapCounts map_counts() const { return {}; }
+  virtual TargetEstimate target() const { return {}; }
 
  protected:
   MissionView() = default;

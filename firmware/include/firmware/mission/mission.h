@@ -94,6 +94,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint64_t cycles() const override { return state_.cycle; }
   std::string_view model_text() const override { return state_.model_text(); }
   MapCounts map_counts() const override;
+  TargetEstimate target() const override;
 
   [[nodiscard]] Result result() const { return result_; }
   [[nodiscard]] bool finished() const { return result_ != Result::kRunning; }

@@ -41,10 +41,18 @@ inline Point2 to_robot(const Pose2& pose, Point2 p) {
   return {c * dx + s * dy, -s * dx + c * dy};
 }
 
-// The pose `b`, given in the frame of pose `a`, in the frame `a` is given in (a ∘ b).
+// The pose `b`, given in the frame of pose `a`, in the frame `a` is given in (a ∘ b); both
+// headings in (−π, π].
 inline Pose2 compose(const Pose2& a, const Pose2& b) {
   const Point2 p = to_world(a, {b.x_m, b.y_m});
-  return {p.x_m, p.y_m, wrap_pi(a.yaw_rad + b.yaw_rad)};
+  // Into (−π, π] by one turn at most: exact when the sum is already in range.
+  float yaw = a.yaw_rad + b.yaw_rad;
+  if (yaw > kPi<float>) {
+    yaw -= kTwoPi<float>;
+  } else if (yaw <= -kPi<float>) {
+    yaw += kTwoPi<float>;
+  }
+  return {p.x_m, p.y_m, yaw};
 }
 
 // The frame's own origin seen from the pose (a⁻¹): compose(a, inverse(a)) is the identity.
