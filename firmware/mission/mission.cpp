@@ -118,6 +118,10 @@ void Mission::start(std::uint64_t now_us) {
   }
   trail_.clear();
   path_.clear();
+  breadcrumbs_.clear();
+  retreating_ = false;
+  snapshot_pending_ = false;
+  look_lists_stale_ = false;
 }
 
 core::Pose2 Mission::odometry_pose() const {
@@ -305,13 +309,12 @@ void Mission::control_hold(std::uint64_t now_us) {
 
 void Mission::begin_look(std::uint64_t now_us) {
   phase_ = Phase::kLook;
-  drive_pending_ = turn_pending_ = turning_round_ = false;  // a planned move not begun is void
+  // A planned move not begun is void.
+  drive_pending_ = turn_pending_ = turning_round_ = retreating_ = false;
   view_ = 0;
   second_frame_ = false;
   look_step_ = LookStep::kMove;
-  features_.clear();
-  floor_obstacles_.clear();
-  floor_free_.clear();
+  look_lists_stale_ = true;  // cleared by the background before the first view
   look_pose_ = odometry_pose();
   aim_at_target();
   step_deadline_us_ = now_us + params_.ptu_timeout_us;
@@ -416,6 +419,7 @@ void Mission::control_drive(std::uint64_t now_us) {
       turning_round_ = true;
       driver_.start_turn(from, core::wrap_pi(from.yaw_rad + core::kPi<float>), now_us);
     } else {
+      if (!retreating_) breadcrumbs_.step_started({from.x_m, from.y_m});
       driver_.start(from, decision_.target, now_us);
     }
   }
@@ -436,6 +440,13 @@ void Mission::control_drive(std::uint64_t now_us) {
       end_cycle("at the target");
       return finish(Result::kFound, "within the stand-off of the target");
     }
+  }
+  if (retreating_) {
+    retreating_ = false;
+    if (ok) breadcrumbs_.reached();
+    end_cycle(ok ? "no safe step, backed off" : driver_.failure());
+    if (phase_ != Phase::kDone) begin_look(now_us);
+    return;
   }
   if (turning_round_) {
     // Only a finished turn counts: an interrupted one is tried again at the next dead end.
@@ -503,7 +514,13 @@ void Mission::end_cycle(const char* what) {
                static_cast<unsigned>(map_.exploration().size()));
   state_.add_log(state_.cycle, line.view());
   if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
-  write_snapshot();
+  if (snapshots_ != nullptr) {
+    snapshot_pending_ = true;
+    snapshot_cycle_ = static_cast<std::uint32_t>(state_.cycle);
+    snapshot_state_ = phase_name(phase_);
+    snapshot_robot_ = state_.pose;
+    snapshot_look_pose_ = look_pose_;
+  }
   if (path_.size() == path_.capacity()) {
     // Keep every other point: the path stays whole at half the resolution.
     std::size_t kept = 0;
@@ -527,10 +544,23 @@ void Mission::write_trace(std::uint64_t now_us) {
 // ---------------------------------------------------------------- background
 
 StepResult Mission::step(SliceBudget& budget) {
+  // The last cycle's picture first: it shows that cycle's readings, model and value function.
+  if (snapshot_pending_) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    write_snapshot();
+    snapshot_pending_ = false;
+    return StepResult::kMore;
+  }
   if (phase_ == Phase::kDone) return StepResult::kMore;
   // The view just grabbed: stereo, target, floor cue (one unit).
   if (phase_ == Phase::kLook && view_ready_) {
     if (!budget.next_unit()) return StepResult::kMore;
+    if (look_lists_stale_) {
+      features_.clear();
+      floor_obstacles_.clear();
+      floor_free_.clear();
+      look_lists_stale_ = false;
+    }
     process_view();
     view_ready_ = false;
     return StepResult::kMore;
@@ -694,14 +724,32 @@ void Mission::after_plan() {
       return;
     }
   }
-  // No safe step: look again (new readings, a new fit), and give up after a few cycles in a
-  // row.
+  // No safe step (an obstacle close by can leave no room in this look's polygon): the place
+  // counts as visited once more, and the robot backs off along the step that brought it here
+  // and looks again; it gives up after a few such cycles in a row.
   ++failed_cycles_;
+  trail_.add({here.x_m, here.y_m});
+  if (failed_cycles_ < params_.max_failed_cycles && back_off()) return;
   end_cycle("no safe step");
   if (failed_cycles_ >= params_.max_failed_cycles) {
     return finish(Result::kNotFound, "no safe step in several looks");
   }
   begin_look(now_us_);
+}
+
+// The step back to the last breadcrumb: the robot's disc swept that segment on the way here, so
+// it is driven without this look's polygon (which may hold no room at all).
+bool Mission::back_off() {
+  const core::Pose2 here = odometry_pose();
+  core::Point2 back{};
+  if (!breadcrumbs_.back_target({here.x_m, here.y_m}, params_.step.min_step_m, back)) return false;
+  decision_ = {};
+  decision_.kind = planning::StepKind::kMove;
+  decision_.target = back;
+  retreating_ = true;
+  drive_pending_ = true;
+  phase_ = Phase::kDrive;
+  return true;
 }
 
 namespace {
@@ -752,19 +800,19 @@ void Mission::write_snapshot() {
   auto add = [&](const evidence::Reading& r) {
     const float d = r.r_m * r.r_m - r.h_m * r.h_m;
     const float rho = d > 0.0F ? std::sqrt(d) : 0.0F;
-    const core::Point2 w =
-        core::to_world(look_pose_, {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)});
+    const core::Point2 w = core::to_world(
+        snapshot_look_pose_, {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)});
     (void)g_snap_readings.push_back({w.x_m, w.y_m, r.m});
   };
   for (const evidence::Reading& r : features_) add(r);
   for (const evidence::Reading& r : floor_obstacles_) add(r);
   const mapping::LocalMap& local = builder_.map();
-  to_world(local.free, look_pose_, g_snap_free);
-  to_world(local.navigable, look_pose_, g_snap_navigable);
+  to_world(local.free, snapshot_look_pose_, g_snap_free);
+  to_world(local.navigable, snapshot_look_pose_, g_snap_navigable);
   SnapshotFrame f;
-  f.cycle = static_cast<std::uint32_t>(state_.cycle);
-  f.state = phase_name(phase_);
-  f.robot = odometry_pose();
+  f.cycle = snapshot_cycle_;
+  f.state = snapshot_state_;
+  f.robot = snapshot_robot_;
   f.robot_radius_m = config_.robot_radius_m;
   // The view: the room so far (path, points) and 3.5 m around the robot.
   float x0 = f.robot.x_m - 3.5F, x1 = f.robot.x_m + 3.5F;
@@ -777,7 +825,7 @@ void Mission::write_snapshot() {
   }
   f.view = {x0, y0, x1, y1};
   f.readings = g_snap_readings.span();
-  const OccupancyView occupancy{&builder_, look_pose_};
+  const OccupancyView occupancy{&builder_, snapshot_look_pose_};
   f.occupancy = &occupancy_at;
   f.occupancy_context = &occupancy;
   f.occupancy_threshold = params_.model.extraction.safe_occupancy;
@@ -818,11 +866,15 @@ void Mission::write_snapshot() {
   if (!snapshots_->write(f, error, sizeof error)) {
     TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
     line.appendf("snapshot: %s", error);
-    state_.add_log(state_.cycle, line.view());
+    state_.add_log(snapshot_cycle_, line.view());
   }
 }
 
 void Mission::finish_saving() {
+  if (snapshot_pending_) {  // the last cycle ended just before the loop did
+    write_snapshot();
+    snapshot_pending_ = false;
+  }
   if (saver_ == nullptr) return;
   while (submit_pending_) submit_pending_ = !saver_->submit(state_);
   saver_->flush();

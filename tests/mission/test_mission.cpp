@@ -213,11 +213,26 @@ TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothing) {
   hooks.loop_started = on_loop_started;
   hooks.loop_ended = on_loop_ended;
   hooks.context = &count;
-  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks);
+  // With --snapshots: the pictures are drawn and encoded on the same allocation-free path.
+  char dir_template[] = "/tmp/boticelli-snapshots-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks, {"--snapshots", dir.c_str()});
   check_found_safely(r);
   CHECK(count.ended);
   CHECK(count.frames > 10000);
   UNSIGNED_LONGS_EQUAL_TEXT(0, count.allocations, "heap allocations after init");
+  // One PNG per cycle, the last one included.
+  const std::size_t c = r.mission_line.find("cycles=");
+  const int cycles = std::atoi(r.mission_line.c_str() + c + 7);
+  CHECK(cycles > 1);
+  for (int i = 1; i <= cycles; ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/cycle-%06d.png", i);
+    const std::string png = slurp(dir + name);
+    CHECK_TEXT(png.size() > 1000 && png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0, name);
+    std::remove((dir + name).c_str());
+  }
+  CHECK_TEXT(rmdir(dir.c_str()) == 0, "nothing else in the snapshot folder");
   std::remove(r.trace_path.c_str());
 }
 

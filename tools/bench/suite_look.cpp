@@ -27,6 +27,7 @@
 #include "board_config.h"
 #include "firmware/mission/mission.h"
 #include "firmware/mission/mission_params.h"
+#include "firmware/snapshot.h"
 #include "hal/sim/renderer.h"
 #include "hal/sim/sim_world.h"
 #include "hal/sim/textures.h"
@@ -59,6 +60,60 @@ Readings g_features;
 FloorObstacles g_floor_obstacles;
 FloorFree g_floor_free;
 mapping::LocalModelBuilder g_builder;
+
+firmware::SnapshotWriter g_snapshots;
+const char* g_snapshot_dir = nullptr;
+std::uint32_t g_look_number = 0;
+
+// BOTICELLI_LOOK_SNAPSHOTS=DIR: a picture of every look whose free polygon is not wholly free
+// or whose navigable polygon's disc touches an obstacle (readings, polygons, the true walls),
+// named by the look's number in the run.
+void snapshot_look(std::uint32_t number, const core::Pose2& pose, const mapping::LocalMap& map,
+                   float radius_m) {
+  static std::vector<firmware::SnapshotReading> readings;
+  static std::vector<core::Point2> free_poly, nav_poly;
+  static std::vector<std::span<const core::Point2>> outlines;
+  static std::vector<firmware::SnapshotCircle> circles;
+  readings.clear();
+  auto add = [&](const evidence::Reading& r) {
+    const float d = r.r_m * r.r_m - r.h_m * r.h_m;
+    const float rho = d > 0.0F ? std::sqrt(d) : 0.0F;
+    const core::Point2 w =
+        core::to_world(pose, {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)});
+    readings.push_back({w.x_m, w.y_m, r.m});
+  };
+  for (const evidence::Reading& r : g_features) add(r);
+  for (const evidence::Reading& r : g_floor_obstacles) add(r);
+  free_poly.clear();
+  nav_poly.clear();
+  for (std::size_t k = 0; k < map.free.vertex_count(); ++k)
+    free_poly.push_back(core::to_world(pose, map.free.vertex(k)));
+  for (std::size_t k = 0; k < map.navigable.vertex_count(); ++k)
+    nav_poly.push_back(core::to_world(pose, map.navigable.vertex(k)));
+  outlines.clear();
+  circles.clear();
+  for (std::size_t i = 0; i < g_world.collider_count; ++i) {
+    const hal::sim::Collider& c = g_world.colliders[i];
+    if (c.circle) {
+      circles.push_back({{c.centre_x_m, c.centre_y_m}, c.radius_m});
+    } else {
+      outlines.push_back({c.hull, c.hull_size});
+    }
+  }
+  firmware::SnapshotFrame f;
+  f.cycle = number;
+  f.state = "look";
+  f.robot = pose;
+  f.robot_radius_m = radius_m;
+  f.view = {pose.x_m - 3.5F, pose.y_m - 3.5F, pose.x_m + 3.5F, pose.y_m + 3.5F};
+  f.readings = {readings.data(), readings.size()};
+  f.free_polygon = {free_poly.data(), free_poly.size()};
+  f.navigable_polygon = {nav_poly.data(), nav_poly.size()};
+  f.truth_polygons = {outlines.data(), outlines.size()};
+  f.truth_circles = {circles.data(), circles.size()};
+  char error[200] = "";
+  if (!g_snapshots.write(f, error, sizeof error)) std::fprintf(stderr, "look: %s\n", error);
+}
 
 std::int64_t cpu_ns() {
   timespec ts{};
@@ -458,6 +513,14 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     const Quality q =
         quality(pose, g_builder.map(),
                 static_cast<double>(params.model.extraction.bounding_radius_m), radius, height);
+    if (g_snapshot_dir != nullptr && (q.nav_safety < 1.0 || q.safety < 0.99)) {
+      std::fprintf(stderr, "look: %s look %u at (%.2f, %.2f, %.2f): safety %.4f nav safety %.4f\n",
+                   name.c_str(), g_look_number, static_cast<double>(pose.x_m),
+                   static_cast<double>(pose.y_m), static_cast<double>(pose.yaw_rad), q.safety,
+                   q.nav_safety);
+      snapshot_look(g_look_number, pose, g_builder.map(), radius);
+    }
+    ++g_look_number;
     st.safety.push_back(q.safety);
     st.coverage.push_back(q.coverage);
     st.nav_safety.push_back(q.nav_safety);
@@ -520,6 +583,14 @@ int run() {
   const double clearance = env_double("BOTICELLI_LOOK_CLEARANCE_M", 0.35);
   int status = 0;
   const std::string dir = worlds_dir("BOTICELLI_LOOK_WORLDS_DIR", BOTICELLI_WORLDS_DIR);
+  g_snapshot_dir = std::getenv("BOTICELLI_LOOK_SNAPSHOTS");
+  if (g_snapshot_dir != nullptr) {
+    char error[200] = "";
+    if (!g_snapshots.open(g_snapshot_dir, error, sizeof error)) {
+      std::fprintf(stderr, "look: %s\n", error);
+      return 1;
+    }
+  }
   for (const std::string& name : world_names(dir, "BOTICELLI_LOOK_WORLDS", kSuite)) {
     if (run_world(dir, name, poses, clearance) != 0) status = 1;
   }

@@ -19,6 +19,7 @@
 #include "firmware/board.h"
 #include "firmware/device_tasks.h"
 #include "firmware/executive.h"
+#include "firmware/mission/breadcrumbs.h"
 #include "firmware/mission/drive_controller.h"
 #include "firmware/mission/mission_params.h"
 #include "firmware/mission/target_tracker.h"
@@ -128,6 +129,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   void begin_plan();
   void after_plan();
   bool next_step_on_look();
+  bool back_off();
   void write_trace(std::uint64_t now_us);
   void write_snapshot();
   // The robot's pose in the mission's frame: odometry carried on from a resumed state's pose.
@@ -222,6 +224,18 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint32_t steps_this_look_ = 0;
   mapping::StarPolygon from_here_{};  // the look's navigable polygon seen from the robot now
   core::FixedVector<core::Point2, 1024> path_;  // where the robot has been (snapshots)
+  // When a look finds no safe step the robot backs off along the way it came.
+  Breadcrumbs breadcrumbs_;
+  bool retreating_ = false;  // the drive under way backs off to the last breadcrumb
+
+  // The cycle's picture (--snapshots) is drawn in a background unit of its own, before the
+  // next look's first view is processed: what it shows is kept until then.
+  bool snapshot_pending_ = false;
+  bool look_lists_stale_ = false;  // the last look's readings wait for the picture
+  std::uint32_t snapshot_cycle_ = 0;
+  const char* snapshot_state_ = "";
+  core::Pose2 snapshot_robot_{};
+  core::Pose2 snapshot_look_pose_{};
 
   double cpu_s_[3] = {0.0, 0.0, 0.0};
 };
