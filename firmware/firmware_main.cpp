@@ -22,6 +22,7 @@
 #include "firmware/snapshot.h"
 #include "firmware/state_saver.h"
 #include "firmware/task_table.h"
+#include "firmware/text_buffer.h"
 
 namespace boticelli::firmware {
 namespace {
@@ -255,6 +256,17 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
   console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
               mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
+  {
+    // The longest unit of each kind [ms of host thread CPU]: what a slice or the mission
+    // task's budget must hold on the robot.
+    TextBuffer<256> line;
+    line.append("mission longest_ms");
+    for (std::size_t u = 0; u < static_cast<std::size_t>(mission::Unit::kCount); ++u) {
+      const auto unit = static_cast<mission::Unit>(u);
+      line.appendf(" %s=%.2f", mission::unit_name(unit), mission.longest_unit_s(unit) * 1e3);
+    }
+    console.log(LogLevel::kInfo, "%s", line.c_str());
+  }
   for (int i = 0; i < 50 && console.pending_output() > 0 && console.healthy(); ++i) {
     console.drain();
     hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);

@@ -22,16 +22,22 @@ double thread_cpu_s() {
   return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
 }
 
-// Adds the CPU time of a scope to one of the mission's stage counters.
+// Adds the CPU time of one unit of work to a stage counter (if any) and keeps the longest.
 class CpuScope {
  public:
-  explicit CpuScope(double& total) : total_(total), start_(thread_cpu_s()) {}
-  ~CpuScope() { total_ += thread_cpu_s() - start_; }
+  CpuScope(double* total, double& longest)
+      : total_(total), longest_(longest), start_(thread_cpu_s()) {}
+  ~CpuScope() {
+    const double d = thread_cpu_s() - start_;
+    if (total_ != nullptr) *total_ += d;
+    longest_ = std::max(longest_, d);
+  }
   CpuScope(const CpuScope&) = delete;
   CpuScope& operator=(const CpuScope&) = delete;
 
  private:
-  double& total_;
+  double* total_;
+  double& longest_;
   double start_;
 };
 
@@ -50,6 +56,30 @@ const char* result_name(Result result) {
       return "not_found";
     case Result::kAborted:
       return "aborted";
+  }
+  return "unknown";
+}
+
+const char* unit_name(Unit unit) {
+  switch (unit) {
+    case Unit::kView:
+      return "view";
+    case Unit::kModel:
+      return "model";
+    case Unit::kMap:
+      return "map";
+    case Unit::kPlanStart:
+      return "plan_start";
+    case Unit::kValue:
+      return "value";
+    case Unit::kStep:
+      return "step";
+    case Unit::kSnapshot:
+      return "snapshot";
+    case Unit::kTask:
+      return "task";
+    case Unit::kCount:
+      break;
   }
   return "unknown";
 }
@@ -226,6 +256,7 @@ bool Mission::hold_needed() {
 }
 
 void Mission::control(std::uint64_t now_us) {
+  CpuScope cpu(nullptr, longest_s_[static_cast<std::size_t>(Unit::kTask)]);
   now_us_ = now_us;
   write_trace(now_us);
   if (submit_pending_ && saver_ != nullptr && saver_->submit(state_)) submit_pending_ = false;
@@ -310,11 +341,14 @@ void Mission::control_hold(std::uint64_t now_us) {
 void Mission::begin_look(std::uint64_t now_us) {
   phase_ = Phase::kLook;
   // A planned move not begun is void.
-  drive_pending_ = turn_pending_ = turning_round_ = retreating_ = false;
+  drive_pending_ = turn_pending_ = turning_round_ = retreating_ = next_step_pending_ = false;
+  choosing_ = false;
   view_ = 0;
   second_frame_ = false;
   look_step_ = LookStep::kMove;
   look_lists_stale_ = true;  // cleared by the background before the first view
+  view_ready_ = false;
+  view_part_ = 0;
   look_pose_ = odometry_pose();
   aim_at_target();
   step_deadline_us_ = now_us + params_.ptu_timeout_us;
@@ -459,14 +493,19 @@ void Mission::control_drive(std::uint64_t now_us) {
     if (phase_ != Phase::kDone) begin_look(now_us);
     return;
   }
-  if (ok && ++steps_this_look_ < params_.steps_per_look && next_step_on_look()) return;
+  if (ok && ++steps_this_look_ < params_.steps_per_look) {
+    // Another step on the same look is worked out by the background (a unit of its own).
+    next_step_pending_ = true;
+    phase_ = Phase::kPlan;
+    return;
+  }
   end_cycle(ok ? "step done" : driver_.failure());
   if (phase_ != Phase::kDone) begin_look(now_us);
 }
 
 // Another step on the same look: the look's navigable polygon as seen from where the robot
 // is now (each ray as far as the straight move stays inside it), and the same value function.
-bool Mission::next_step_on_look() {
+bool Mission::start_next_step_on_look() {
   const core::Pose2 here = odometry_pose();
   const mapping::StarPolygon& nav = builder_.map().navigable;
   if (!nav.contains(core::to_robot(look_pose_, {here.x_m, here.y_m}))) return false;
@@ -484,10 +523,18 @@ bool Mission::next_step_on_look() {
     }
     from_here_.set_rho_m(k, rho);
   }
-  decision_ = planning::choose_step(value_, from_here_, here, params_.step);
-  if (decision_.kind != planning::StepKind::kMove) return false;
-  drive_pending_ = true;
+  chooser_.start(value_, from_here_, here, params_.step);
   return true;
+}
+
+void Mission::finish_next_step_on_look() {
+  if (decision_.kind == planning::StepKind::kMove) {
+    drive_pending_ = true;
+    phase_ = Phase::kDrive;
+    return;
+  }
+  end_cycle("step done");
+  if (phase_ != Phase::kDone) begin_look(now_us_);
 }
 
 void Mission::end_cycle(const char* what) {
@@ -547,12 +594,13 @@ StepResult Mission::step(SliceBudget& budget) {
   // The last cycle's picture first: it shows that cycle's readings, model and value function.
   if (snapshot_pending_) {
     if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(nullptr, longest_s_[static_cast<std::size_t>(Unit::kSnapshot)]);
     write_snapshot();
     snapshot_pending_ = false;
     return StepResult::kMore;
   }
   if (phase_ == Phase::kDone) return StepResult::kMore;
-  // The view just grabbed: stereo, target, floor cue (one unit).
+  // The view just grabbed: stereo, target, floor cue on each frame (a unit each).
   if (phase_ == Phase::kLook && view_ready_) {
     if (!budget.next_unit()) return StepResult::kMore;
     if (look_lists_stale_) {
@@ -561,64 +609,120 @@ StepResult Mission::step(SliceBudget& budget) {
       floor_free_.clear();
       look_lists_stale_ = false;
     }
-    process_view();
-    view_ready_ = false;
+    if (process_view(view_part_++)) {
+      view_part_ = 0;
+      view_ready_ = false;
+    }
     return StepResult::kMore;
   }
+  double* const think_cpu = &cpu_s_[1];
+  double* const plan_cpu = &cpu_s_[2];
   if (phase_ == Phase::kThink) {
     if (!think_started_) {
       if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(think_cpu, longest(Unit::kModel));
       begin_think();
     }
-    CpuScope cpu(cpu_s_[1]);
     while (!builder_.done()) {
       if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(think_cpu, longest(Unit::kModel));
       (void)builder_.step();
     }
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(think_cpu, longest(Unit::kMap));
     after_think();
     return StepResult::kMore;
   }
+  if (phase_ == Phase::kPlan && choosing_) {
+    // The step on the value function, one action per unit.
+    while (!chooser_.done()) {
+      if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(plan_cpu, longest(Unit::kStep));
+      (void)chooser_.step();
+    }
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(plan_cpu, longest(Unit::kStep));
+    choosing_ = false;
+    decision_ = chooser_.decision();
+    if (choosing_on_look_) {
+      finish_next_step_on_look();
+    } else {
+      after_step_choice();
+    }
+    return StepResult::kDone;
+  }
+  if (phase_ == Phase::kPlan && next_step_pending_) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(plan_cpu, longest(Unit::kStep));
+    next_step_pending_ = false;
+    if (start_next_step_on_look()) {
+      choosing_ = true;
+      choosing_on_look_ = true;
+      return StepResult::kMore;
+    }
+    end_cycle("step done");
+    if (phase_ != Phase::kDone) begin_look(now_us_);
+    return StepResult::kDone;
+  }
   if (phase_ == Phase::kPlan) {
-    CpuScope cpu(cpu_s_[2]);
     if (!plan_started_) {
       if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(plan_cpu, longest(Unit::kPlanStart));
       begin_plan();
     }
     while (!value_.done()) {
       if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(plan_cpu, longest(Unit::kValue));
       (void)value_.step(params_.vi_work_per_unit);
     }
     if (!budget.next_unit()) return StepResult::kMore;
-    after_plan();
+    CpuScope cpu(plan_cpu, longest(Unit::kStep));
+    if (start_step_choice()) {
+      choosing_ = true;
+      choosing_on_look_ = false;
+      return StepResult::kMore;
+    }
     return StepResult::kDone;
   }
   return StepResult::kMore;
 }
 
-void Mission::process_view() {
-  CpuScope cpu(cpu_s_[0]);
-  if (view_pair_) {
-    (void)stereo_.process(first_, second_, pair_pose_, features_);
-    last_features_ = static_cast<std::uint32_t>(stereo_.points().size());
-    const stereo::TargetFix fix = stereo_.locate_target(first_, second_, pair_pose_);
-    if (fix.found) {
-      // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
-      const core::Point2 w = core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
-      const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
-      tracker_.add(world, fix.confidence, static_cast<std::uint32_t>(state_.cycle * 256U + view_),
-                   fix.point_ptu_m.norm());
-    }
-  }
-  if (view_ >= scan_views()) return;  // the aimed pair looks up at the target, not the floor
-  // The floor cue: learn from the frames that see the floor close in front, then walk the
-  // columns; a low pair's second frame sees nearer floor than its first.
-  (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
-  (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad, floor_obstacles_,
-                           floor_free_);
-  if (view_pair_ && pair_pose_.second_tilt_rad < -0.3F) {
-    (void)floor_cue_.learn(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad);
-    (void)floor_cue_.process(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad,
-                             floor_obstacles_, floor_free_);
+bool Mission::process_view(std::uint8_t part) {
+  CpuScope cpu(&cpu_s_[0], longest(Unit::kView));
+  switch (part) {
+    case 0:
+      if (view_pair_) {
+        (void)stereo_.process(first_, second_, pair_pose_, features_);
+        last_features_ = static_cast<std::uint32_t>(stereo_.points().size());
+      }
+      return false;
+    case 1:
+      if (view_pair_) {
+        const stereo::TargetFix fix = stereo_.locate_target(first_, second_, pair_pose_);
+        if (fix.found) {
+          // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
+          const core::Point2 w =
+              core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
+          const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
+          tracker_.add(world, fix.confidence,
+                       static_cast<std::uint32_t>(state_.cycle * 256U + view_),
+                       fix.point_ptu_m.norm());
+        }
+      }
+      // The aimed pair looks up at the target, not at the floor.
+      return view_ >= scan_views();
+    case 2:
+      // The floor cue: learn from the frames that see the floor close in front, then walk
+      // the columns; a low pair's second frame sees nearer floor than its first.
+      (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
+      (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad,
+                               floor_obstacles_, floor_free_);
+      return !(view_pair_ && pair_pose_.second_tilt_rad < -0.3F);
+    default:
+      (void)floor_cue_.learn(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad);
+      (void)floor_cue_.process(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad,
+                               floor_obstacles_, floor_free_);
+      return true;
   }
 }
 
@@ -681,7 +785,7 @@ void Mission::begin_plan() {
   value_.start(vp, params_.rewards, sources, {look_pose_.x_m, look_pose_.y_m});
 }
 
-void Mission::after_plan() {
+bool Mission::start_step_choice() {
   const core::Pose2 here = odometry_pose();
   if (map_.exploration().size() == 0 && !tracker_.confirmed()) {
     // The sector behind the robot that the PTU cannot pan to was never seen here: turn
@@ -694,14 +798,20 @@ void Mission::after_plan() {
         turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
     if (!blind || turned_here) {
       end_cycle("nothing left to explore");
-      return finish(Result::kNotFound, "nothing left to explore");
+      finish(Result::kNotFound, "nothing left to explore");
+      return false;
     }
     turn_pending_ = true;
     drive_pending_ = true;
     phase_ = Phase::kDrive;
-    return;
+    return false;
   }
-  decision_ = planning::choose_step(value_, builder_.map().navigable, here, params_.step);
+  chooser_.start(value_, builder_.map().navigable, here, params_.step);
+  return true;
+}
+
+void Mission::after_step_choice() {
+  const core::Pose2 here = odometry_pose();
   if (decision_.kind == planning::StepKind::kAtGoal) {
     end_cycle("at the target");
     return finish(Result::kFound, "within the stand-off of the target");
@@ -724,12 +834,16 @@ void Mission::after_plan() {
       return;
     }
   }
-  // No safe step (an obstacle close by can leave no room in this look's polygon): the place
-  // counts as visited once more, and the robot backs off along the step that brought it here
-  // and looks again; it gives up after a few such cycles in a row.
+  // No safe step (an obstacle close by, or a poor fit, can leave no room in this look's
+  // polygon): the place counts as visited once more and the robot looks again; from the
+  // second such cycle in a row it first backs off along the step that brought it here. It
+  // gives up after a few such cycles in a row.
   ++failed_cycles_;
   trail_.add({here.x_m, here.y_m});
-  if (failed_cycles_ < params_.max_failed_cycles && back_off()) return;
+  if (failed_cycles_ >= params_.back_off_after_failed_cycles &&
+      failed_cycles_ < params_.max_failed_cycles && back_off()) {
+    return;
+  }
   end_cycle("no safe step");
   if (failed_cycles_ >= params_.max_failed_cycles) {
     return finish(Result::kNotFound, "no safe step in several looks");

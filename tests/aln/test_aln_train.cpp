@@ -247,6 +247,30 @@ TEST(AlnTrain, PieceCapAndIterationCapAreHonoured) {
   CHECK(g_model3.pieces_within_bounds());
 }
 
+TEST(AlnTrain, AnUndoneSplitRoundDoesNotEndTheTraining) {
+  // Noisy room samples at a tight epsilon: some rounds' splits do not lower the error.
+  const std::size_t n = fill_room(3000, 0.3, 77);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.02;
+  cfg.max_iterations = 12;
+  cfg.max_failed_rounds = 0;  // the first undone round ends it
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const aln::TrainerStats stopped = g_trainer3.stats();
+  CHECK_EQUAL(1U, stopped.failed_rounds);
+  CHECK(stopped.iterations < cfg.max_iterations);
+  cfg.max_failed_rounds = 8;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  const aln::TrainerStats went_on = g_trainer3.stats();
+  CHECK(went_on.failed_rounds >= 1);
+  CHECK(went_on.iterations > stopped.iterations);  // it split again after the undone round
+  CHECK(went_on.rms < stopped.rms);
+  CHECK(g_model3b.pieces_within_bounds());
+}
+
 TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   const std::size_t n = fill_room(3000, 0.02, 3);
   set_room_ranges(g_model3);

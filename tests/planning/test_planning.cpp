@@ -275,6 +275,43 @@ TEST(Planner, CutsTheStepToTheNavigationPolygon) {
   DOUBLES_EQUAL(0.3, planning::cut_step_m(nav, pose, 0.5F + 1.5F, 0.3F), 1e-6);
 }
 
+TEST(Planner, TheStepChooserTakesOneActionPerUnitAndEndsOnTheWholeDecision) {
+  TestWorld& w = world();
+  w.reset({0.0F, 0.0F, 0.3F});
+  w.add_room(4.0F);
+  w.add_thick_wall(1.2F, -1.2F, 1.2F);
+  w.has_goal = true;
+  w.goal = {2.5F, 0.0F};
+  w.observe();
+  w.value.start(w.vi_params, w.reward_params, w.sources(), {w.pose.x_m, w.pose.y_m});
+  while (!w.value.step(4096)) {
+  }
+  planning::StepChooser chooser;
+  chooser.start(w.value, w.navigable, w.pose, w.step_params);
+  std::size_t units = 0;
+  float best_q = -1e30F;
+  while (!chooser.done()) {
+    ++units;
+    (void)chooser.step();
+    // The running best never gets worse as more actions are evaluated.
+    if (chooser.decision().kind == planning::StepKind::kMove) {
+      CHECK(chooser.decision().q_value >= best_q);
+      best_q = chooser.decision().q_value;
+    }
+  }
+  CHECK_EQUAL(planning::kActionCount, units);
+  CHECK(chooser.step());  // done stays done
+  const planning::StepDecision& d = chooser.decision();
+  CHECK(d.kind == planning::StepKind::kMove);
+  // With the wall ahead the best move goes round it, not into it.
+  CHECK(std::fabs(d.target.y_m - w.pose.y_m) > 0.05F);
+  // At the goal's stand-off nothing is left to evaluate.
+  w.pose = {2.5F - w.reward_params.goal_standoff_m, 0.0F, 0.0F};
+  chooser.start(w.value, w.navigable, w.pose, w.step_params);
+  CHECK(chooser.done());
+  CHECK(chooser.decision().kind == planning::StepKind::kAtGoal);
+}
+
 TEST(Planner, SlicedValueIterationEqualsOneShot) {
   static planning::ValueIteration sliced;
   static planning::ValueIteration whole;

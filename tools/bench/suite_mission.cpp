@@ -50,7 +50,12 @@ struct MissionLine {
   double look_s = std::numeric_limits<double>::quiet_NaN();
   double think_s = std::numeric_limits<double>::quiet_NaN();
   double plan_s = std::numeric_limits<double>::quiet_NaN();
+  std::string longest_line;  // "LOG info mission longest_ms view=… task=…"
 };
+
+// The longest unit of each kind, as the firmware names them (mission::unit_name).
+constexpr const char* kUnitNames[] = {"view",  "model",    "map",  "plan_start",
+                                      "value", "step", "snapshot", "task"};
 
 // The whole file ("" when it cannot be read).
 std::string read_file(const std::string& path) {
@@ -100,6 +105,8 @@ MissionLine parse_output(const std::string& path) {
     } else if (const std::size_t at = line.find("LOG info stopping: "); at != std::string::npos) {
       m.end_reason = line.substr(at + 19);
       std::replace(m.end_reason.begin(), m.end_reason.end(), '"', '\'');
+    } else if (line.find("LOG info mission longest_ms ") != std::string::npos) {
+      m.longest_line = line;
     } else if (line.find("LOG info mission cpu ") != std::string::npos) {
       m.found_cpu = true;
       m.look_s = field(line, "look_s");
@@ -390,6 +397,9 @@ int run() {
           .integer("map_points_bytes", static_cast<std::int64_t>(size.points_bytes));
     }
     line.integer("grid_0_1m_bytes", static_cast<std::int64_t>(grid_bytes(g_world)));
+    for (const char* unit : kUnitNames) {
+      line.num((std::string("longest_") + unit + "_ms").c_str(), field(m.longest_line, unit));
+    }
     line.emit();
     if (!m.found_line || !m.found_cpu) {
       std::fprintf(stderr, "mission: %s: %s%s (console output in %s)\n", name.c_str(),

@@ -1,6 +1,8 @@
 // Feature guard: which unexplained features are corroborated by their neighbours.
 #include "algo/mapping/feature_guard.h"
 
+#include <algorithm>
+
 #include <cmath>
 
 namespace boticelli::mapping {
@@ -17,8 +19,13 @@ bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuard
 
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
                          GuardPoints& out) {
+  return corroborated_points(candidates, 0, candidates.size(), g, out);
+}
+
+bool corroborated_points(std::span<const GuardPoint> candidates, std::size_t first,
+                         std::size_t last, const FeatureGuardParams& g, GuardPoints& out) {
   bool ok = true;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
+  for (std::size_t i = first; i < std::min(last, candidates.size()); ++i) {
     const GuardPoint& a = candidates[i];
     const std::size_t required = a.m < g.min_evidence ? g.min_weak_neighbours : g.min_neighbours;
     std::size_t neighbours = 0;

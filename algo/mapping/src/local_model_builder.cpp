@@ -116,18 +116,34 @@ bool LocalModelBuilder::step() {
         phase_ = Phase::kGuard;
       }
       return false;
-    case Phase::kGuard: {
+    case Phase::kGuard:
+      // The inverted model, then the feature guard (§5.4.3) in three units: the features the
+      // model leaves unexplained, the floor obstacles, and their corroboration.
       stats_.model_valid =
           samples_.size() > 0 && free_range_.set_model(model_, params_.extraction.safe_occupancy);
+      phase_ = Phase::kGuardFeatures;
+      return false;
+    case Phase::kGuardFeatures:
+    case Phase::kGuardObstacles: {
       const auto occupancy = [this](float a, float h, float r) { return this->occupancy(a, h, r); };
-      (void)collect_unexplained_features(features_, occupancy, params_.extraction, params_.guard,
-                                         candidates_);
-      (void)collect_unexplained_features(obstacles_, occupancy, params_.extraction, params_.guard,
-                                         candidates_);
-      stats_.guard_candidates = candidates_.size();
-      (void)corroborated_points(candidates_.span(), params_.guard, guard_);
-      stats_.guard_points = guard_.size();
-      phase_ = Phase::kExtract;
+      const bool features = phase_ == Phase::kGuardFeatures;
+      (void)collect_unexplained_features(features ? features_ : obstacles_, occupancy,
+                                         params_.extraction, params_.guard, candidates_);
+      phase_ = features ? Phase::kGuardObstacles : Phase::kGuardPoints;
+      guard_cursor_ = 0;
+      return false;
+    }
+    case Phase::kGuardPoints: {
+      // O(n²) over the candidates: a bounded slice of them per unit.
+      const std::size_t end =
+          std::min(candidates_.size(), guard_cursor_ + params_.guard_candidates_per_unit);
+      (void)corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_);
+      guard_cursor_ = end;
+      if (guard_cursor_ == candidates_.size()) {
+        stats_.guard_candidates = candidates_.size();
+        stats_.guard_points = guard_.size();
+        phase_ = Phase::kExtract;
+      }
       return false;
     }
     case Phase::kExtract:

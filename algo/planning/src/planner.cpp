@@ -40,53 +40,72 @@ float cut_step_m(const mapping::StarPolygon& navigable, const core::Pose2& pose,
 
 StepDecision choose_step(const ValueIteration& value, const mapping::StarPolygon& navigable,
                          const core::Pose2& pose, const StepParams& params) {
-  StepDecision best;
+  StepChooser chooser;
+  chooser.start(value, navigable, pose, params);
+  while (!chooser.step()) {
+  }
+  return chooser.decision();
+}
+
+void StepChooser::start(const ValueIteration& value, const mapping::StarPolygon& navigable,
+                        const core::Pose2& pose, const StepParams& params) {
+  value_ = &value;
+  navigable_ = &navigable;
+  pose_ = pose;
+  params_ = params;
+  best_ = StepDecision{};
+  best_q_ = -std::numeric_limits<float>::infinity();
+  next_action_ = 0;
+  const RewardSources& sources = value.sources();
+  if (sources.has_goal && core::distance_m({pose.x_m, pose.y_m}, sources.goal) <=
+                              value.rewards().goal_standoff_m + params.arrival_tolerance_m) {
+    best_.kind = StepKind::kAtGoal;
+    next_action_ = kActionCount;
+  }
+}
+
+bool StepChooser::step() {
+  if (done()) return true;
+  const std::size_t a = next_action_++;
+  const ValueIteration& value = *value_;
   const RewardSources& sources = value.sources();
   const RewardParams& rewards = value.rewards();
-  const core::Point2 here{pose.x_m, pose.y_m};
+  const core::Point2 here{pose_.x_m, pose_.y_m};
   const float standoff = rewards.goal_standoff_m;
-  if (sources.has_goal &&
-      core::distance_m(here, sources.goal) <= standoff + params.arrival_tolerance_m) {
-    best.kind = StepKind::kAtGoal;
-    return best;
-  }
-  float best_q = -std::numeric_limits<float>::infinity();
-  for (std::size_t a = 0; a < kActionCount; ++a) {
-    const float heading = action_heading_rad(a);
-    const float ux = std::cos(heading);
-    const float uy = std::sin(heading);
-    float step = cut_step_m(navigable, pose, heading, value.params().step_m);
-    if (sources.has_goal) {
-      // Stop at the stand-off: the first t with ‖here + t·u − g‖ = stand-off.
-      const float dx = sources.goal.x_m - here.x_m;
-      const float dy = sources.goal.y_m - here.y_m;
-      const float ud = ux * dx + uy * dy;
-      const float disc = ud * ud - (dx * dx + dy * dy) + standoff * standoff;
-      if (disc > 0.0F) {
-        const float t = ud - std::sqrt(disc);
-        if (t >= 0.0F) {
-          step = std::min(step, t);
-        }
+  const float heading = action_heading_rad(a);
+  const float ux = std::cos(heading);
+  const float uy = std::sin(heading);
+  float step = cut_step_m(*navigable_, pose_, heading, value.params().step_m);
+  if (sources.has_goal) {
+    // Stop at the stand-off: the first t with ‖here + t·u − g‖ = stand-off.
+    const float dx = sources.goal.x_m - here.x_m;
+    const float dy = sources.goal.y_m - here.y_m;
+    const float ud = ux * dx + uy * dy;
+    const float disc = ud * ud - (dx * dx + dy * dy) + standoff * standoff;
+    if (disc > 0.0F) {
+      const float t = ud - std::sqrt(disc);
+      if (t >= 0.0F) {
+        step = std::min(step, t);
       }
     }
-    if (step < params.min_step_m) {
-      continue;  // unsafe: the polygon (or the stand-off) leaves no room this way
-    }
-    const core::Point2 next{here.x_m + step * ux, here.y_m + step * uy};
-    const std::size_t depth = params.lookahead_depth > 0 ? params.lookahead_depth - 1 : 0;
-    const float q = reward_at(rewards, sources, next) +
-                    value.params().discount * backed_up_value(value, next, depth);
-    if (q > best_q) {
-      best_q = q;
-      best.kind = StepKind::kMove;
-      best.action = a;
-      best.heading_rad = heading;
-      best.distance_m = step;
-      best.target = next;
-      best.q_value = q;
-    }
   }
-  return best;
+  if (step < params_.min_step_m) {
+    return done();  // unsafe: the polygon (or the stand-off) leaves no room this way
+  }
+  const core::Point2 next{here.x_m + step * ux, here.y_m + step * uy};
+  const std::size_t depth = params_.lookahead_depth > 0 ? params_.lookahead_depth - 1 : 0;
+  const float q = reward_at(rewards, sources, next) +
+                  value.params().discount * backed_up_value(value, next, depth);
+  if (q > best_q_) {
+    best_q_ = q;
+    best_.kind = StepKind::kMove;
+    best_.action = a;
+    best_.heading_rad = heading;
+    best_.distance_m = step;
+    best_.target = next;
+    best_.q_value = q;
+  }
+  return done();
 }
 
 }  // namespace boticelli::planning

@@ -38,6 +38,21 @@ namespace boticelli::firmware::mission {
 enum class Result : std::uint8_t { kRunning, kFound, kNotFound, kAborted };
 const char* result_name(Result result);
 
+// The mission's units of work, for the longest-unit measurement (host thread CPU): a
+// background unit must fit one slice and the mission task its budget on the robot.
+enum class Unit : std::uint8_t {
+  kView,       // stereo, target and floor cue of one view
+  kModel,      // one step of the local model (samples, training, guard, polygon)
+  kMap,        // the map points of a look merged into the global lists
+  kPlanStart,  // the value iteration set up on the global lists
+  kValue,      // one slice of value iteration work
+  kStep,       // the step chosen on the value function and checked against the polygon
+  kSnapshot,   // one cycle's picture drawn and written
+  kTask,       // the mission task's body in one frame (PTU, frames, driving)
+  kCount,
+};
+const char* unit_name(Unit unit);
+
 class TraceWriter;
 
 // The stages' phases, as the console and the trace name them.
@@ -112,6 +127,10 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] double look_cpu_s() const { return cpu_s_[0]; }
   [[nodiscard]] double think_cpu_s() const { return cpu_s_[1]; }
   [[nodiscard]] double plan_cpu_s() const { return cpu_s_[2]; }
+  // The longest single unit of each kind so far [s of host thread CPU].
+  [[nodiscard]] double longest_unit_s(Unit unit) const {
+    return longest_s_[static_cast<std::size_t>(unit)];
+  }
 
  private:
   enum class LookStep : std::uint8_t { kMove, kSettle, kGrab, kProcess };
@@ -123,12 +142,19 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   void control_hold(std::uint64_t now_us);
   void finish(Result result, const char* why);
   void end_cycle(const char* what);
-  void process_view();
+  // One part of the grabbed view's processing: 0 stereo, 1 target, 2 and 3 the floor cue on
+  // the first and second frame. True when the view is done.
+  bool process_view(std::uint8_t part);
   void begin_think();
   void after_think();
   void begin_plan();
-  void after_plan();
-  bool next_step_on_look();
+  // After the value iteration: gives up or turns round when nothing is left to explore, else
+  // starts choosing the step (true).
+  bool start_step_choice();
+  void after_step_choice();
+  // Another step on the same look's polygon, as seen from where the robot is now.
+  bool start_next_step_on_look();
+  void finish_next_step_on_look();
   bool back_off();
   void write_trace(std::uint64_t now_us);
   void write_snapshot();
@@ -142,6 +168,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] std::size_t scan_views() const { return params_.pan_positions * params_.row_count; }
   [[nodiscard]] std::size_t view_count() const { return scan_views() + (aimed_ ? 1U : 0U); }
   void aim_at_target();
+  double& longest(Unit unit) { return longest_s_[static_cast<std::size_t>(unit)]; }
   void view_angles(std::size_t view, float& pan_rad, float& tilt_rad, bool& pair) const;
 
   hal::Hal& hal_;
@@ -196,7 +223,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint64_t settle_until_us_ = 0;
   bool want_frame_ = false;
   bool frame_ready_ = false;
-  bool view_ready_ = false;  // both frames in; the background's turn
+  bool view_ready_ = false;     // both frames in; the background's turn
+  std::uint8_t view_part_ = 0;  // the next part of its processing
   image::LowResFrame first_{};
   image::LowResFrame second_{};
   core::Pose2 look_pose_{};
@@ -220,7 +248,11 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
 
   // Drive.
   DriveController driver_;
-  bool drive_pending_ = false;  // a step was chosen; control starts it
+  bool drive_pending_ = false;      // a step was chosen; control starts it
+  bool next_step_pending_ = false;  // the background chooses another step on this look
+  planning::StepChooser chooser_;
+  bool choosing_ = false;          // the chooser is under way ...
+  bool choosing_on_look_ = false;  // ... for another step on this look (not after a plan)
   std::uint32_t steps_this_look_ = 0;
   mapping::StarPolygon from_here_{};  // the look's navigable polygon seen from the robot now
   core::FixedVector<core::Point2, 1024> path_;  // where the robot has been (snapshots)
@@ -238,6 +270,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   core::Pose2 snapshot_look_pose_{};
 
   double cpu_s_[3] = {0.0, 0.0, 0.0};
+  double longest_s_[static_cast<std::size_t>(Unit::kCount)] = {};
 };
 
 // The executive's mission task: calls Mission::control every frame; unhealthy when the

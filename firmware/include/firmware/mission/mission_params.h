@@ -45,7 +45,10 @@ struct MissionParams {
   std::uint32_t trace_period_us = 100000;    // one trace row per this much time [µs]
   std::uint32_t vi_work_per_unit = 256;      // value-iteration work per background unit
   std::size_t max_failed_cycles = 4;         // cycles in a row with no safe step → not_found
-  std::uint32_t steps_per_look = 3;          // steps on one look's navigable polygon
+  // From this many such cycles in a row the robot backs off along its last step before the
+  // next look (a fresh look on the spot first: the fit of one look can leave no room).
+  std::size_t back_off_after_failed_cycles = 2;
+  std::uint32_t steps_per_look = 3;  // steps on one look's navigable polygon
 };
 
 // The camera rig the stereo and the sim renderer both use, from the board's declaration.

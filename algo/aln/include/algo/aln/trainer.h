@@ -38,13 +38,17 @@ struct TrainerConfig {
                                      // uses max(s, its own robust RMS): Huber k = 1.345 s,
                                      // Tukey c = 4.685 s.
   std::size_t max_refit_passes = 8;  // assign/refit (Lloyd) passes per split round
-  std::uint32_t seed = 1;            // jitter of the split tilt; same seed, same model
+  // Rounds whose splits were undone (they did not lower the error) before training gives up;
+  // each such round tries other pieces than the last.
+  std::size_t max_failed_rounds = 8;
+  std::uint32_t seed = 1;  // jitter of the split tilt; same seed, same model
 };
 
 struct TrainerStats {
   std::size_t pieces = 0;
-  std::size_t iterations = 0;  // split rounds done
-  std::size_t passes = 0;      // passes over the samples
+  std::size_t iterations = 0;     // split rounds done
+  std::size_t failed_rounds = 0;  // split rounds undone (they did not lower the error)
+  std::size_t passes = 0;         // passes over the samples
   std::uint64_t sample_visits = 0;
   double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
   double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
@@ -109,6 +113,8 @@ class Trainer {
     stall_ = 0;
     split_limit_ = 0;
     last_made_ = 0;
+    failed_rounds_ = 0;
+    tried_.fill(0);
     begin_pass();
     stats_.pieces = 1;
     return true;
@@ -300,20 +306,30 @@ class Trainer {
     double objective = 0.0;
     for (std::size_t p = 0; p < model_->piece_count(); ++p) objective += (*current_)[p].sse;
     if (split_limit_ > 0 && objective >= saved_objective_ * (1.0 - 1e-4)) {
-      // The last round's splits did not lower the error: undo them and try fewer (the
-      // worst pieces first), so the error never rises from one round to the next.
+      // The last round's splits did not lower the error: undo them, so the error never rises
+      // from one round to the next, and split half as many of the worst pieces; once a single
+      // split fails, that piece is left and the next worst tried. Training ends when every
+      // candidate has been tried on this model or after max_failed_rounds such rounds.
       *model_ = saved_model_;
       *current_ = saved_acc_;
       scale_ = saved_scale_;
       objective = saved_objective_;
-      split_limit_ = last_made_ / 2;
-      if (split_limit_ == 0) {
+      if (last_made_ > 1) {
+        split_limit_ = last_made_ / 2;  // fewer of the worst pieces
+      } else {
+        // One piece's split did not help either: leave it and try the next worst.
+        for (std::size_t i = 0; i < last_split_count_; ++i) tried_[last_split_[i]] = 1;
+        split_limit_ = 1;
+      }
+      stats_.failed_rounds = ++failed_rounds_;
+      if (failed_rounds_ > config_.max_failed_rounds) {
         finish_stats(*current_);
         stats_.done = true;
         return;
       }
     } else {
       split_limit_ = MaxPieces;
+      tried_.fill(0);  // a new model: its pieces are new candidates
       prune(*current_);
     }
     Accumulators& acc = *current_;
@@ -332,7 +348,7 @@ class Trainer {
     };
     if (config_.split_rule == SplitRule::kPieceRms) {
       for (std::size_t p = 0; p < pieces; ++p) {
-        if (enough(acc[p]) && acc[p].sse > eps2 * acc[p].sw) {
+        if (tried_[p] == 0 && enough(acc[p]) && acc[p].sse > eps2 * acc[p].sw) {
           want[p] = 1;
           ++wanted;
         }
@@ -340,7 +356,7 @@ class Trainer {
     } else if (stats_.robust_rms > config_.epsilon) {
       const double mean_sse = objective / static_cast<double>(pieces);
       for (std::size_t p = 0; p < pieces; ++p) {
-        if (enough(acc[p]) && acc[p].sse >= mean_sse) {
+        if (tried_[p] == 0 && enough(acc[p]) && acc[p].sse >= mean_sse) {
           want[p] = 1;
           ++wanted;
         }
@@ -357,6 +373,7 @@ class Trainer {
     saved_objective_ = objective;
     // Split the worst first until the cap or the limit.
     std::size_t made = 0;
+    last_split_count_ = 0;
     while (model_->piece_count() < cap_ && made < split_limit_) {
       std::size_t best = MaxPieces;
       for (std::size_t p = 0; p < pieces; ++p) {
@@ -364,6 +381,7 @@ class Trainer {
       }
       if (best == MaxPieces) break;
       want[best] = 0;
+      last_split_[last_split_count_++] = static_cast<std::uint16_t>(best);
       if (split(best, acc[best])) ++made;
     }
     if (made == 0) {
@@ -526,6 +544,12 @@ class Trainer {
   double saved_objective_ = 0.0;
   std::size_t split_limit_ = 0;  // 0: no split to judge yet
   std::size_t last_made_ = 0;
+  // Pieces of the current model whose split did not lower the error (not tried again), the
+  // pieces the last round split, and the failed rounds so far.
+  std::array<std::uint8_t, MaxPieces> tried_{};
+  std::array<std::uint16_t, MaxPieces> last_split_{};
+  std::size_t last_split_count_ = 0;
+  std::size_t failed_rounds_ = 0;
   std::uint32_t rng_ = 1;
   Accumulators acc_a_{};
   Accumulators acc_b_{};

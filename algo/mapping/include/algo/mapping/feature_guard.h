@@ -108,6 +108,10 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
 // if `out` was full.
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
                          GuardPoints& out);
+// The same for candidates [first, last) only (each still against all of them), so the
+// O(n²) work can be cut into bounded units; consecutive ranges give the same points.
+bool corroborated_points(std::span<const GuardPoint> candidates, std::size_t first,
+                         std::size_t last, const FeatureGuardParams& g, GuardPoints& out);
 
 // Whether candidates a and b corroborate each other (the rule above).
 bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuardParams& g);

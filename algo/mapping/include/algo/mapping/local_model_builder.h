@@ -48,8 +48,9 @@ struct LocalModelParams {
   bool clamp_to_seen_free = true;
   // A floor-cue obstacle base cuts the polygon's vertex ray this much in front of it [m].
   float base_margin_m = 0.05F;
-  std::size_t readings_per_unit = 64;  // work per unit while building samples
-  std::size_t visits_per_unit = 1024;  // trainer sample visits per unit
+  std::size_t readings_per_unit = 64;           // work per unit while building samples
+  std::size_t visits_per_unit = 1024;           // trainer sample visits per unit
+  std::size_t guard_candidates_per_unit = 256;  // guard candidates corroborated per unit
 };
 
 struct LocalModelStats {
@@ -108,7 +109,18 @@ class LocalModelBuilder {
   [[nodiscard]] float occupancy(float alpha_rad, float h_m, float r_m) const;
 
  private:
-  enum class Phase : std::uint8_t { kIdle, kSamples, kSeam, kTrain, kGuard, kExtract, kDone };
+  enum class Phase : std::uint8_t {
+    kIdle,
+    kSamples,
+    kSeam,
+    kTrain,
+    kGuard,
+    kGuardFeatures,
+    kGuardObstacles,
+    kGuardPoints,
+    kExtract,
+    kDone
+  };
 
   void add_reading_samples(const evidence::Reading& reading);
   void add_free_samples(const evidence::Reading& reading);
@@ -121,6 +133,7 @@ class LocalModelBuilder {
   std::span<const evidence::Reading> obstacles_{};
   std::span<const evidence::Reading> free_{};
   std::size_t cursor_ = 0;
+  std::size_t guard_cursor_ = 0;  // next guard candidate to corroborate
   core::FixedVector<evidence::RaySample, kLookMaxSamples> ray_samples_;
   core::FixedVector<OccupancySample, kLookMaxSamples> samples_;
   OccupancyModel model_{};

@@ -47,4 +47,27 @@ float cut_step_m(const mapping::StarPolygon& navigable, const core::Pose2& pose,
 StepDecision choose_step(const ValueIteration& value, const mapping::StarPolygon& navigable,
                          const core::Pose2& pose, const StepParams& params);
 
+// choose_step cut into units of one action each (an action costs 8^(lookahead − 1) backups,
+// each over the obstacle points), so a background slice never has to hold all eight. The
+// value function and the polygon must stay unchanged until done(); the decision is the one
+// choose_step returns.
+class StepChooser {
+ public:
+  void start(const ValueIteration& value, const mapping::StarPolygon& navigable,
+             const core::Pose2& pose, const StepParams& params);
+  // Evaluates the next action; true once every action has been (decision() is then final).
+  bool step();
+  [[nodiscard]] bool done() const { return next_action_ >= kActionCount; }
+  [[nodiscard]] const StepDecision& decision() const { return best_; }
+
+ private:
+  const ValueIteration* value_ = nullptr;
+  const mapping::StarPolygon* navigable_ = nullptr;
+  core::Pose2 pose_{};
+  StepParams params_{};
+  std::size_t next_action_ = kActionCount;
+  float best_q_ = 0.0F;
+  StepDecision best_{};
+};
+
 }  // namespace boticelli::planning
