@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdarg>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -425,9 +426,11 @@ void draw_robot_outline(Canvas& c, const PanelMap& m, const SnapshotFrame& f, Rg
 }
 
 // Samples a field once per kFieldCellPx x kFieldCellPx block (at the block's centre).
-void sample_field(const PanelMap& m, SnapshotField fn, const void* context, float* out) {
+// Field rows [j0, j1) of the panel's kFieldCells × kFieldCells samples.
+void sample_field(const PanelMap& m, SnapshotField fn, const void* context, float* out, int j0,
+                  int j1) {
   constexpr int kCell = SnapshotWriter::kFieldCellPx;
-  for (int j = 0; j < SnapshotWriter::kFieldCells; ++j) {
+  for (int j = j0; j < j1; ++j) {
     const float y = m.y_at(static_cast<float>(j * kCell) + 0.5F * (kCell - 1));
     for (int i = 0; i < SnapshotWriter::kFieldCells; ++i) {
       const float x = m.x_at(static_cast<float>(i * kCell) + 0.5F * (kCell - 1));
@@ -493,14 +496,14 @@ void draw_readings(Canvas& c, const PanelMap& m, const SnapshotFrame& f) {
   legend.item(kRobot, "ROBOT");
 }
 
-void draw_occupancy(Canvas& c, const PanelMap& m, const SnapshotFrame& f, float* field) {
+// `field` holds the panel's samples of f.occupancy already (sample_field).
+void draw_occupancy(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const float* field) {
   constexpr int kN = SnapshotWriter::kFieldCells;
   panel_title(c, m, "2 OCCUPANCY, MAX OVER HEIGHTS");
   c.set_clip(m.plot());
   if (f.occupancy == nullptr) {
     c.fill(m.plot(), kNoData);
   } else {
-    sample_field(m, f.occupancy, f.occupancy_context, field);
     const float th = f.occupancy_threshold;
     for (int j = 0; j < kN; ++j) {
       for (int i = 0; i < kN; ++i) {
@@ -569,7 +572,8 @@ void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f) {
   legend.item(kPath, "PATH");
 }
 
-void draw_value(Canvas& c, const PanelMap& m, const SnapshotFrame& f, float* field) {
+// `field` holds the panel's samples of f.value already (sample_field).
+void draw_value(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const float* field) {
   constexpr int kN = SnapshotWriter::kFieldCells;
   panel_title(c, m, "4 VALUE FUNCTION V(X,Y)");
   c.set_clip(m.plot());
@@ -578,7 +582,6 @@ void draw_value(Canvas& c, const PanelMap& m, const SnapshotFrame& f, float* fie
   if (f.value == nullptr) {
     c.fill(m.plot(), kNoData);
   } else {
-    sample_field(m, f.value, f.value_context, field);
     bool any = false;
     for (int k = 0; k < kN * kN; ++k) {
       if (!std::isfinite(field[k])) continue;
@@ -646,9 +649,9 @@ void on_png_write(png_structp png, png_bytep data, size_t length) {
 }
 void on_png_flush(png_structp /*png*/) {}
 
-// The part that libpng may longjmp out of: nothing with a destructor lives between here and the
-// callbacks above (libpng's frames are C), and no local changes after setjmp.
-bool write_png(png_structp png, png_infop info, SnapshotWriter* writer, const std::uint8_t* rgb) {
+// The parts that libpng may longjmp out of: nothing with a destructor lives between here and
+// the callbacks above (libpng's frames are C), and no local changes after setjmp.
+bool png_start(png_structp png, png_infop info, SnapshotWriter* writer) {
   if (setjmp(png_jmpbuf(png)) != 0) return false;
   png_set_write_fn(png, writer, on_png_write, on_png_flush);
   // Level 3 and the Up filter: flat colours and smooth colour maps compress well enough,
@@ -659,11 +662,21 @@ bool write_png(png_structp png, png_infop info, SnapshotWriter* writer, const st
                PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
+  return true;
+}
+
+bool png_rows(png_structp png, const std::uint8_t* rgb, int first, int last) {
+  if (setjmp(png_jmpbuf(png)) != 0) return false;
   constexpr std::size_t kRowBytes = static_cast<std::size_t>(SnapshotWriter::kWidthPx) * 3U;
-  for (int y = 0; y < SnapshotWriter::kHeightPx; ++y) {
+  for (int y = first; y < last; ++y) {
     // libpng 1.6 takes png_const_bytep rows: the canvas is only read.
     png_write_row(png, rgb + static_cast<std::size_t>(y) * kRowBytes);
   }
+  return true;
+}
+
+bool png_finish(png_structp png) {
+  if (setjmp(png_jmpbuf(png)) != 0) return false;
   png_write_end(png, nullptr);
   return true;
 }
@@ -677,6 +690,7 @@ SnapshotPixel SnapshotWriter::pixel_of(const SnapshotExtent& view, int panel, co
 }
 
 SnapshotWriter::~SnapshotWriter() {
+  if (busy()) fail("abandoned");  // no half-written file left behind
   if (dir_fd_ >= 0) ::close(dir_fd_);
 }
 
@@ -773,115 +787,240 @@ bool SnapshotWriter::append_output(const std::uint8_t* data, std::size_t bytes) 
   return true;
 }
 
-void SnapshotWriter::render(const SnapshotFrame& f) {
+void SnapshotWriter::draw(Stage stage) {
+  const SnapshotFrame& f = frame_;
   Canvas c(canvas_, kWidthPx, kHeightPx);
   c.clear_clip();
-  c.fill({0, 0, kWidthPx, kHeightPx}, kPaper);
-  char title[160];
-  std::snprintf(title, sizeof title, "CYCLE %u  STATE %s  ROBOT X=%.2f Y=%.2f YAW=%.0f DEG",
-                static_cast<unsigned>(f.cycle), f.state != nullptr ? f.state : "?",
-                static_cast<double>(f.robot.x_m), static_cast<double>(f.robot.y_m),
-                static_cast<double>(f.robot.yaw_rad * 57.29578F));
-  c.text(kCellLeftPx, 7, title, kInk);
+  switch (stage) {
+    case Stage::kTitle: {
+      c.fill({0, 0, kWidthPx, kHeightPx}, kPaper);
+      char title[160];
+      std::snprintf(title, sizeof title, "CYCLE %u  STATE %s  ROBOT X=%.2f Y=%.2f YAW=%.0f DEG",
+                    static_cast<unsigned>(f.cycle), f.state != nullptr ? f.state : "?",
+                    static_cast<double>(f.robot.x_m), static_cast<double>(f.robot.y_m),
+                    static_cast<double>(f.robot.yaw_rad * 57.29578F));
+      c.text(kCellLeftPx, 7, title, kInk);
+      return;
+    }
+    case Stage::kReadings:
+      draw_readings(c, panel_map(f.view, 0), f);
+      return;
+    case Stage::kOccupancyField:
+      if (f.occupancy != nullptr) {
+        sample_field(panel_map(f.view, 1), f.occupancy, f.occupancy_context, field_, field_row_,
+                     std::min(kFieldCells, field_row_ + kFieldBandRows));
+      }
+      return;
+    case Stage::kValueField:
+      if (f.value != nullptr) {
+        sample_field(panel_map(f.view, 3), f.value, f.value_context, field_, field_row_,
+                     std::min(kFieldCells, field_row_ + kFieldBandRows));
+      }
+      return;
+    case Stage::kOccupancy:
+      draw_occupancy(c, panel_map(f.view, 1), f, field_);
+      return;
+    case Stage::kNavigation:
+      draw_navigation(c, panel_map(f.view, 2), f);
+      return;
+    case Stage::kValue:
+      draw_value(c, panel_map(f.view, 3), f, field_);
+      return;
+    case Stage::kAxes:
+      for (int k = 0; k < 4; ++k) draw_axes(c, panel_map(f.view, k));
+      return;
+    default:
+      return;
+  }
+}
 
-  std::array<PanelMap, 4> maps{};
-  for (int k = 0; k < 4; ++k) maps[static_cast<std::size_t>(k)] = panel_map(f.view, k);
-  draw_readings(c, maps[0], f);
-  draw_occupancy(c, maps[1], f, field_);
-  draw_navigation(c, maps[2], f);
-  draw_value(c, maps[3], f, field_);
-  for (const PanelMap& m : maps) draw_axes(c, m);
+void SnapshotWriter::fail(const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(error_, sizeof error_, format, args);
+  va_end(args);
+  release_png();
+  if (tmp_fd_ >= 0) {
+    ::close(tmp_fd_);
+    tmp_fd_ = -1;
+    ::unlinkat(dir_fd_, tmp_name_, 0);
+  }
+  ok_ = false;
+  stage_ = Stage::kIdle;
+}
+
+void SnapshotWriter::begin(const SnapshotFrame& frame) {
+  if (busy()) fail("abandoned");
+  frame_ = frame;
+  ok_ = false;
+  error_[0] = '\0';
+  field_row_ = 0;
+  stage_ = Stage::kTitle;
+#ifndef BOTICELLI_HAVE_PNG
+  fail("snapshots need libpng (this build has none)");
+#else
+  if (dir_fd_ < 0) fail("snapshot writer not opened");
+#endif
+}
+
+bool SnapshotWriter::step() {
+  switch (stage_) {
+    case Stage::kIdle:
+      return true;
+    case Stage::kOccupancyField:
+    case Stage::kValueField:
+      // The sampled fields (the model, the value function) a band of rows at a time.
+      draw(stage_);
+      field_row_ += kFieldBandRows;
+      if (field_row_ >= kFieldCells) {
+        field_row_ = 0;
+        stage_ = static_cast<Stage>(static_cast<std::uint8_t>(stage_) + 1);
+      }
+      return false;
+    case Stage::kTitle:
+    case Stage::kReadings:
+    case Stage::kOccupancy:
+    case Stage::kNavigation:
+    case Stage::kValue:
+    case Stage::kAxes:
+      draw(stage_);
+      stage_ = static_cast<Stage>(static_cast<std::uint8_t>(stage_) + 1);
+      return false;
+    case Stage::kOpen:
+      if (open_file()) stage_ = Stage::kRows;
+      return stage_ == Stage::kIdle;
+    case Stage::kRows: {
+#ifdef BOTICELLI_HAVE_PNG
+      const int last = std::min(kHeightPx, next_row_ + kBandRows);
+      if (!png_rows(static_cast<png_structp>(png_), canvas_, next_row_, last)) {
+        encode_error();
+        return true;
+      }
+      next_row_ = last;
+      if (next_row_ == kHeightPx) stage_ = Stage::kFinish;
+#endif
+      return false;
+    }
+    case Stage::kFinish:
+      if (finish_file()) {
+        ok_ = true;
+        stage_ = Stage::kIdle;
+      }
+      return true;
+  }
+  return true;
 }
 
 bool SnapshotWriter::write(const SnapshotFrame& frame, char* error, std::size_t error_size) {
-#ifndef BOTICELLI_HAVE_PNG
-  (void)frame;
-  std::snprintf(error, error_size, "snapshots need libpng (this build has none)");
-  return false;
-#else
-  if (dir_fd_ < 0) {
-    std::snprintf(error, error_size, "snapshot writer not opened");
-    return false;
+  begin(frame);
+  while (!step()) {
   }
-  render(frame);
+  if (!ok_) std::snprintf(error, error_size, "%s", error_);
+  return ok_;
+}
 
-  char name[48];
-  char tmp[56];
-  std::snprintf(name, sizeof name, "cycle-%06u.png", static_cast<unsigned>(frame.cycle));
-  std::snprintf(tmp, sizeof tmp, "%s.tmp", name);
-  const int fd = ::openat(dir_fd_, tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    std::snprintf(error, error_size, "cannot create %s/%s: %s", dir_, tmp, errno_text(errno));
+#ifdef BOTICELLI_HAVE_PNG
+bool SnapshotWriter::open_file() {
+  std::snprintf(name_, sizeof name_, "cycle-%06u.png", static_cast<unsigned>(frame_.cycle));
+  std::snprintf(tmp_name_, sizeof tmp_name_, "%s.tmp", name_);
+  tmp_fd_ = ::openat(dir_fd_, tmp_name_, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (tmp_fd_ < 0) {
+    const int e = errno;
+    fail("cannot create %s/%s: %s", dir_, tmp_name_, errno_text(e));
     return false;
   }
-  bool ok = encode(fd, error, error_size);
-  if (ok && ::fsync(fd) != 0) {
-    std::snprintf(error, error_size, "cannot sync %s/%s: %s", dir_, tmp, errno_text(errno));
-    ok = false;
+  arena_used_ = 0;
+  arena_calls_ = 0;
+  arena_exhausted_ = false;
+  out_fd_ = tmp_fd_;
+  out_used_ = 0;
+  out_errno_ = 0;
+  file_bytes_ = 0;
+  png_message_[0] = '\0';
+  next_row_ = 0;
+  png_structp png = png_create_write_struct_2(PNG_LIBPNG_VER_STRING, png_message_, on_png_error,
+                                              on_png_warning, this, arena_malloc, arena_free);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  png_ = png;
+  info_ = info;
+  if (png == nullptr || info == nullptr || !png_start(png, info, this)) {
+    encode_error();
+    return false;
   }
-  if (::close(fd) != 0 && ok) {
-    std::snprintf(error, error_size, "cannot close %s/%s: %s", dir_, tmp, errno_text(errno));
-    ok = false;
+  return true;
+}
+
+bool SnapshotWriter::finish_file() {
+  if (!png_finish(static_cast<png_structp>(png_))) {
+    encode_error();
+    return false;
   }
-  if (ok && ::renameat(dir_fd_, tmp, dir_fd_, name) != 0) {
-    std::snprintf(error, error_size, "cannot rename %s/%s: %s", dir_, tmp, errno_text(errno));
-    ok = false;
+  if (!flush_output()) {
+    std::snprintf(png_message_, sizeof png_message_, "write failed");
+    encode_error();
+    return false;
   }
-  if (!ok) {
-    ::unlinkat(dir_fd_, tmp, 0);
+  release_png();
+  if (::fsync(tmp_fd_) != 0) {
+    const int e = errno;
+    fail("cannot sync %s/%s: %s", dir_, tmp_name_, errno_text(e));
+    return false;
+  }
+  const int fd = tmp_fd_;
+  tmp_fd_ = -1;
+  if (::close(fd) != 0) {
+    const int e = errno;
+    ::unlinkat(dir_fd_, tmp_name_, 0);
+    fail("cannot close %s/%s: %s", dir_, tmp_name_, errno_text(e));
+    return false;
+  }
+  if (::renameat(dir_fd_, tmp_name_, dir_fd_, name_) != 0) {
+    const int e = errno;
+    ::unlinkat(dir_fd_, tmp_name_, 0);
+    fail("cannot rename %s/%s: %s", dir_, tmp_name_, errno_text(e));
     return false;
   }
   ::fsync(dir_fd_);  // the rename itself survives a power cut
   file_bytes_last_ = file_bytes_;
   return true;
-#endif
 }
 
-#ifdef BOTICELLI_HAVE_PNG
-bool SnapshotWriter::encode(int fd, char* error, std::size_t error_size) {
-  arena_used_ = 0;
-  arena_calls_ = 0;
-  arena_exhausted_ = false;
-  out_fd_ = fd;
-  out_used_ = 0;
-  out_errno_ = 0;
-  file_bytes_ = 0;
-  png_message_[0] = '\0';
-  bool ok = false;
-  png_structp png = png_create_write_struct_2(PNG_LIBPNG_VER_STRING, png_message_, on_png_error,
-                                              on_png_warning, this, arena_malloc, arena_free);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  if (png != nullptr && info != nullptr) {
-    ok = write_png(png, info, this, canvas_);
-    if (ok) {
-      ok = flush_output();
-      if (!ok) std::snprintf(png_message_, sizeof png_message_, "write failed");
-    }
-  }
+void SnapshotWriter::release_png() {
+  if (png_ == nullptr && info_ == nullptr) return;
+  auto* png = static_cast<png_structp>(png_);
+  auto* info = static_cast<png_infop>(info_);
   png_destroy_write_struct(png != nullptr ? &png : nullptr, info != nullptr ? &info : nullptr);
+  png_ = nullptr;
+  info_ = nullptr;
   arena_used_last_ = arena_used_;
   arena_calls_last_ = arena_calls_;
   arena_peak_ = std::max(arena_peak_, arena_used_);
   out_fd_ = -1;
-  if (ok) return true;
+}
+
+// The encoder stopped: say why (arena, file or libpng) and leave nothing behind.
+void SnapshotWriter::encode_error() {
   if (arena_exhausted_) {
-    std::snprintf(error, error_size, "snapshot arena of %zu bytes exhausted (libpng: %s)",
-                  arena_limit_ != 0 && arena_limit_ < kArenaBytes ? arena_limit_ : kArenaBytes,
-                  png_message_[0] != '\0' ? png_message_ : "out of memory");
+    fail("snapshot arena of %zu bytes exhausted (libpng: %s)",
+         arena_limit_ != 0 && arena_limit_ < kArenaBytes ? arena_limit_ : kArenaBytes,
+         png_message_[0] != '\0' ? png_message_ : "out of memory");
   } else if (out_errno_ != 0) {
-    std::snprintf(error, error_size, "cannot write snapshot to %s: %s", dir_,
-                  errno_text(out_errno_));
+    fail("cannot write snapshot to %s: %s", dir_, errno_text(out_errno_));
   } else {
-    std::snprintf(error, error_size, "PNG encoding failed: %s",
-                  png_message_[0] != '\0' ? png_message_ : "libpng could not start");
+    fail("PNG encoding failed: %s",
+         png_message_[0] != '\0' ? png_message_ : "libpng could not start");
   }
-  return false;
 }
 #else
-bool SnapshotWriter::encode(int /*fd*/, char* error, std::size_t error_size) {
-  std::snprintf(error, error_size, "snapshots need libpng (this build has none)");
+bool SnapshotWriter::open_file() {
+  fail("snapshots need libpng (this build has none)");
   return false;
 }
+bool SnapshotWriter::finish_file() {
+  return false;
+}
+void SnapshotWriter::release_png() {}
+void SnapshotWriter::encode_error() {}
 #endif
 
 }  // namespace boticelli::firmware

@@ -151,6 +151,7 @@ void Mission::start(std::uint64_t now_us) {
   breadcrumbs_.clear();
   retreating_ = false;
   snapshot_pending_ = false;
+  snapshot_writing_ = false;
   look_lists_stale_ = false;
 }
 
@@ -592,11 +593,10 @@ void Mission::write_trace(std::uint64_t now_us) {
 
 StepResult Mission::step(SliceBudget& budget) {
   // The last cycle's picture first: it shows that cycle's readings, model and value function.
-  if (snapshot_pending_) {
+  if (snapshot_pending_ || snapshot_writing_) {
     if (!budget.next_unit()) return StepResult::kMore;
-    CpuScope cpu(nullptr, longest_s_[static_cast<std::size_t>(Unit::kSnapshot)]);
-    write_snapshot();
-    snapshot_pending_ = false;
+    CpuScope cpu(nullptr, longest(Unit::kSnapshot));
+    snapshot_step();
     return StepResult::kMore;
   }
   if (phase_ == Phase::kDone) return StepResult::kMore;
@@ -880,6 +880,7 @@ struct OccupancyView {
   const mapping::LocalModelBuilder* builder;
   core::Pose2 pose;
 };
+OccupancyView g_snap_occupancy{};  // the picture's occupancy field, read until it is done
 
 // The occupancy model sliced at the robot's heights: the highest occupancy over the slices.
 float occupancy_at(const void* context, float x_m, float y_m) {
@@ -908,7 +909,7 @@ void to_world(const mapping::StarPolygon& poly, const core::Pose2& pose,
 
 }  // namespace
 
-void Mission::write_snapshot() {
+void Mission::begin_snapshot() {
   if (snapshots_ == nullptr) return;
   g_snap_readings.clear();
   auto add = [&](const evidence::Reading& r) {
@@ -939,9 +940,9 @@ void Mission::write_snapshot() {
   }
   f.view = {x0, y0, x1, y1};
   f.readings = g_snap_readings.span();
-  const OccupancyView occupancy{&builder_, snapshot_look_pose_};
+  g_snap_occupancy = {&builder_, snapshot_look_pose_};
   f.occupancy = &occupancy_at;
-  f.occupancy_context = &occupancy;
+  f.occupancy_context = &g_snap_occupancy;
   f.occupancy_threshold = params_.model.extraction.safe_occupancy;
   f.free_polygon = {g_snap_free.data(), local.free.vertex_count()};
   f.navigable_polygon = {g_snap_navigable.data(), local.navigable.vertex_count()};
@@ -976,19 +977,28 @@ void Mission::write_snapshot() {
     f.truth_polygons = {g_snap_outlines.data(), count};
     f.truth_circles = {g_snap_circles.data(), circles};
   }
-  char error[160] = "";
-  if (!snapshots_->write(f, error, sizeof error)) {
+  snapshots_->begin(f);
+}
+
+// One unit of the cycle's picture: set it up (the first), then a panel or a band of rows.
+void Mission::snapshot_step() {
+  if (snapshot_pending_) {
+    begin_snapshot();
+    snapshot_pending_ = false;
+    snapshot_writing_ = true;
+    return;
+  }
+  if (!snapshots_->step()) return;
+  snapshot_writing_ = false;
+  if (!snapshots_->ok()) {
     TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
-    line.appendf("snapshot: %s", error);
+    line.appendf("snapshot: %s", snapshots_->error());
     state_.add_log(snapshot_cycle_, line.view());
   }
 }
 
 void Mission::finish_saving() {
-  if (snapshot_pending_) {  // the last cycle ended just before the loop did
-    write_snapshot();
-    snapshot_pending_ = false;
-  }
+  while (snapshot_pending_ || snapshot_writing_) snapshot_step();  // the last cycle's picture
   if (saver_ == nullptr) return;
   while (submit_pending_) submit_pending_ = !saver_->submit(state_);
   saver_->flush();

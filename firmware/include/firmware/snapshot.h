@@ -112,6 +112,18 @@ class SnapshotWriter {
   // fsync of the directory). On failure nothing is left behind and `error` says why.
   bool write(const SnapshotFrame& frame, char* error, std::size_t error_size);
 
+  // The same in bounded steps, for a background slice: begin() takes the frame (its spans and
+  // the fields' contexts must stay valid and unchanged until the picture is done), then each
+  // step() draws one panel or encodes kBandRows rows; it returns true when the picture is
+  // written or has failed (ok(), error()). A begin() while busy abandons the picture before.
+  static constexpr int kBandRows = 96;
+  static constexpr int kFieldBandRows = 10;  // field rows sampled per step
+  void begin(const SnapshotFrame& frame);
+  bool step();
+  [[nodiscard]] bool busy() const { return stage_ != Stage::kIdle; }
+  [[nodiscard]] bool ok() const { return ok_; }
+  [[nodiscard]] const char* error() const { return error_; }
+
   // Arena use of the last write [bytes, calls] and the most any write needed [bytes].
   std::size_t arena_bytes_last() const { return arena_used_last_; }
   std::size_t arena_allocations_last() const { return arena_calls_last_; }
@@ -134,8 +146,38 @@ class SnapshotWriter {
   bool append_output(const std::uint8_t* data, std::size_t bytes);
 
  private:
-  void render(const SnapshotFrame& frame);
-  bool encode(int fd, char* error, std::size_t error_size);
+  enum class Stage : std::uint8_t {
+    kIdle,
+    kTitle,
+    kReadings,
+    kOccupancyField,
+    kOccupancy,
+    kNavigation,
+    kValueField,
+    kValue,
+    kAxes,
+    kOpen,
+    kRows,
+    kFinish
+  };
+  void draw(Stage stage);
+  bool open_file();
+  bool finish_file();
+  void fail(const char* format, ...) __attribute__((format(printf, 2, 3)));
+  void release_png();
+  void encode_error();
+
+  SnapshotFrame frame_{};
+  Stage stage_ = Stage::kIdle;
+  bool ok_ = false;
+  char error_[200] = {};
+  int tmp_fd_ = -1;
+  char name_[48] = {};
+  char tmp_name_[56] = {};
+  int next_row_ = 0;
+  int field_row_ = 0;
+  void* png_ = nullptr;   // png_structp while encoding
+  void* info_ = nullptr;  // png_infop
 
   int dir_fd_ = -1;
   char dir_[kDirMax] = {};

@@ -157,7 +157,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   void finish_next_step_on_look();
   bool back_off();
   void write_trace(std::uint64_t now_us);
-  void write_snapshot();
+  void begin_snapshot();
+  void snapshot_step();
   // The robot's pose in the mission's frame: odometry carried on from a resumed state's pose.
   [[nodiscard]] core::Pose2 odometry_pose() const;
   // Fixes the mission frame against the odometry so that the robot stands at state_.pose.
@@ -263,6 +264,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // The cycle's picture (--snapshots) is drawn in a background unit of its own, before the
   // next look's first view is processed: what it shows is kept until then.
   bool snapshot_pending_ = false;
+  bool snapshot_writing_ = false;  // the writer is drawing or encoding it, a unit at a time
   bool look_lists_stale_ = false;  // the last look's readings wait for the picture
   std::uint32_t snapshot_cycle_ = 0;
   const char* snapshot_state_ = "";
