@@ -237,6 +237,35 @@ TEST(SnapshotWriter, AnExhaustedArenaFailsCleanlyAndKeepsThePreviousFileWhole) {
   CHECK(both == list_dir(dir));
 }
 
+TEST(SnapshotWriter, WrittenInStepsThePictureIsTheSameAndNoFileShowsBeforeTheLastStep) {
+  CHECK_TRUE_TEXT(g_writer.open(dir.c_str(), error, sizeof error), error);
+  CHECK_TRUE_TEXT(g_writer.write(synthetic_frame(4), error, sizeof error), error);
+  Image whole;
+  CHECK_TRUE(read_png(dir + "/cycle-000004.png", whole));
+  CHECK_EQUAL(0, std::remove((dir + "/cycle-000004.png").c_str()));
+  g_writer.begin(synthetic_frame(4));
+  CHECK(g_writer.busy());
+  std::size_t steps = 1;
+  while (!g_writer.step()) {
+    ++steps;
+    // Until the last step at most the temporary file exists.
+    for (const std::string& name : list_dir(dir)) CHECK(name != "cycle-000004.png");
+  }
+  CHECK_TRUE_TEXT(g_writer.ok(), g_writer.error());
+  CHECK_FALSE(g_writer.busy());
+  // Title, readings, ten field bands, occupancy, navigation, ten bands, value, axes, open,
+  // the rows in bands of kBandRows, finish.
+  const auto field_bands =
+      static_cast<std::size_t>((SnapshotWriter::kFieldCells + SnapshotWriter::kFieldBandRows - 1) /
+                               SnapshotWriter::kFieldBandRows);
+  const auto row_bands = static_cast<std::size_t>(
+      (SnapshotWriter::kHeightPx + SnapshotWriter::kBandRows - 1) / SnapshotWriter::kBandRows);
+  CHECK_EQUAL(2U + field_bands + 2U + field_bands + 3U + row_bands + 1U, steps);
+  Image stepped;
+  CHECK_TRUE(read_png(dir + "/cycle-000004.png", stepped));
+  CHECK(whole.rgb == stepped.rgb);
+}
+
 TEST(SnapshotWriter, AMissingDirectoryIsCreatedWithItsParents) {
   const std::string nested = dir + "/runs/seed-7";
   CHECK_TRUE_TEXT(g_writer.open(nested.c_str(), error, sizeof error), error);
