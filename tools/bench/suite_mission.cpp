@@ -54,8 +54,8 @@ struct MissionLine {
 };
 
 // The longest unit of each kind, as the firmware names them (mission::unit_name).
-constexpr const char* kUnitNames[] = {"view",  "model",    "map",  "plan_start",
-                                      "value", "step", "snapshot", "task"};
+constexpr const char* kUnitNames[] = {"view",  "model", "map",      "plan_start",
+                                      "value", "step",  "snapshot", "task"};
 
 // The whole file ("" when it cannot be read).
 std::string read_file(const std::string& path) {
