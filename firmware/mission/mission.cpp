@@ -120,10 +120,6 @@ Mission::Mission(const MissionContext& c)
       floor_cue_(rig_) {
   tracker_.configure(params_.target);
   driver_.configure(params_.drive);
-  // The lowest row first: it teaches the floor cue what the floor looks like before the
-  // higher rows, which see less floor, are walked.
-  std::sort(params_.rows, params_.rows + params_.row_count,
-            [](const LookRow& a, const LookRow& b) { return a.tilt_rad < b.tilt_rad; });
 }
 
 void Mission::start(std::uint64_t now_us) {
@@ -217,19 +213,10 @@ void Mission::view_angles(std::size_t view, float& pan_rad, float& tilt_rad, boo
     pair = true;
     return;
   }
-  const std::size_t row = view / params_.pan_positions;
-  std::size_t i = view % params_.pan_positions;
-  if (row % 2 == 1) i = params_.pan_positions - 1 - i;  // sweep back on odd rows
-  const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
-  const float t = params_.pan_positions == 1
-                      ? 0.5F
-                      : static_cast<float>(i) / static_cast<float>(params_.pan_positions - 1);
-  pan_rad = lim.pan_min_rad + t * (lim.pan_max_rad - lim.pan_min_rad);
-  tilt_rad = std::clamp(params_.rows[row].tilt_rad, lim.tilt_min_rad, lim.tilt_max_rad);
-  pair = params_.rows[row].pair;
-  if (pair && tilt_rad - params_.rig.tilt_step_rad < lim.tilt_min_rad) {
-    tilt_rad = lim.tilt_min_rad + params_.rig.tilt_step_rad;  // room for the second frame
-  }
+  const LookView v = scan_view(params_, hal_.pan_tilt.limits(), view);
+  pan_rad = v.pan_rad;
+  tilt_rad = v.tilt_rad;
+  pair = v.pair;
 }
 
 void Mission::finish(Result result, const char* why) {
@@ -913,10 +900,7 @@ void Mission::begin_snapshot() {
   if (snapshots_ == nullptr) return;
   g_snap_readings.clear();
   auto add = [&](const evidence::Reading& r) {
-    const float d = r.r_m * r.r_m - r.h_m * r.h_m;
-    const float rho = d > 0.0F ? std::sqrt(d) : 0.0F;
-    const core::Point2 w = core::to_world(
-        snapshot_look_pose_, {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)});
+    const core::Point2 w = core::to_world(snapshot_look_pose_, evidence::floor_point_m(r));
     (void)g_snap_readings.push_back({w.x_m, w.y_m, r.m});
   };
   for (const evidence::Reading& r : features_) add(r);

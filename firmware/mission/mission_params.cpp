@@ -68,9 +68,29 @@ MissionParams make_mission_params(const BoardConfig& c) {
   for (std::size_t i = 0; i < p.row_count; ++i) {
     p.rows[i] = {c.look_tilt_rad[i], c.look_tilt_is_pair[i]};
   }
+  std::stable_sort(p.rows, p.rows + p.row_count,
+                   [](const LookRow& a, const LookRow& b) { return a.tilt_rad < b.tilt_rad; });
   p.settle_us = c.camera_settle_ms * 1000U;
   p.steps_per_look = std::max<std::uint32_t>(c.steps_per_look, 1);
   return p;
+}
+
+LookView scan_view(const MissionParams& params, const hal::PanTiltLimits& lim, std::size_t view) {
+  LookView v;
+  if (params.pan_positions == 0 || params.row_count == 0) return v;
+  const std::size_t row = std::min(view / params.pan_positions, params.row_count - 1);
+  std::size_t i = view % params.pan_positions;
+  if (row % 2 == 1) i = params.pan_positions - 1 - i;  // sweep back on odd rows
+  const float t = params.pan_positions == 1
+                      ? 0.5F
+                      : static_cast<float>(i) / static_cast<float>(params.pan_positions - 1);
+  v.pan_rad = lim.pan_min_rad + t * (lim.pan_max_rad - lim.pan_min_rad);
+  v.tilt_rad = std::clamp(params.rows[row].tilt_rad, lim.tilt_min_rad, lim.tilt_max_rad);
+  v.pair = params.rows[row].pair;
+  if (v.pair && v.tilt_rad - params.rig.tilt_step_rad < lim.tilt_min_rad) {
+    v.tilt_rad = lim.tilt_min_rad + params.rig.tilt_step_rad;  // room for the second frame
+  }
+  return v;
 }
 
 }  // namespace boticelli::firmware::mission

@@ -76,10 +76,7 @@ void snapshot_look(std::uint32_t number, const core::Pose2& pose, const mapping:
   static std::vector<firmware::SnapshotCircle> circles;
   readings.clear();
   auto add = [&](const evidence::Reading& r) {
-    const float d = r.r_m * r.r_m - r.h_m * r.h_m;
-    const float rho = d > 0.0F ? std::sqrt(d) : 0.0F;
-    const core::Point2 w =
-        core::to_world(pose, {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)});
+    const core::Point2 w = core::to_world(pose, evidence::floor_point_m(r));
     readings.push_back({w.x_m, w.y_m, r.m});
   };
   for (const evidence::Reading& r : g_features) add(r);
@@ -125,33 +122,12 @@ float quantise(float rad, float resolution_rad) {
   return resolution_rad > 0.0F ? std::round(rad / resolution_rad) * resolution_rad : rad;
 }
 
-// The views of one look, as Mission::view_angles: pans spread over the PTU's pan range, rows
-// lowest tilt first, every other row swept back; a pair's tilt leaves room for the second frame.
-struct View {
-  float pan_rad;
-  float tilt_rad;
-  bool pair;
-};
-
-std::vector<View> look_views(const firmware::mission::MissionParams& params,
-                             const hal::PanTiltLimits& lim) {
-  std::vector<firmware::mission::LookRow> rows(params.rows, params.rows + params.row_count);
-  std::sort(rows.begin(), rows.end(),
-            [](const auto& a, const auto& b) { return a.tilt_rad < b.tilt_rad; });
-  std::vector<View> views;
-  for (std::size_t row = 0; row < rows.size(); ++row) {
-    for (std::size_t k = 0; k < params.pan_positions; ++k) {
-      const std::size_t i = row % 2 == 1 ? params.pan_positions - 1 - k : k;
-      const float t = params.pan_positions == 1
-                          ? 0.5F
-                          : static_cast<float>(i) / static_cast<float>(params.pan_positions - 1);
-      View v{lim.pan_min_rad + t * (lim.pan_max_rad - lim.pan_min_rad),
-             std::clamp(rows[row].tilt_rad, lim.tilt_min_rad, lim.tilt_max_rad), rows[row].pair};
-      if (v.pair && v.tilt_rad - params.rig.tilt_step_rad < lim.tilt_min_rad) {
-        v.tilt_rad = lim.tilt_min_rad + params.rig.tilt_step_rad;
-      }
-      views.push_back(v);
-    }
+// The views of one look, as the mission's scan (firmware::mission::scan_view).
+std::vector<firmware::mission::LookView> look_views(const firmware::mission::MissionParams& params,
+                                                    const hal::PanTiltLimits& lim) {
+  std::vector<firmware::mission::LookView> views;
+  for (std::size_t v = 0; v < params.pan_positions * params.row_count; ++v) {
+    views.push_back(firmware::mission::scan_view(params, lim, v));
   }
   return views;
 }
@@ -372,7 +348,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     return 1;
   }
   const hal::PanTiltLimits lim = settings.physics.ptu.limits;
-  const std::vector<View> views = look_views(params, lim);
+  const std::vector<firmware::mission::LookView> views = look_views(params, lim);
   const stereo::CameraIntrinsics& cam = rig.camera();
   const std::size_t stride = 2U * cam.width_px;
   std::vector<std::uint8_t> first_yuyv(stride * cam.height_px);
@@ -408,7 +384,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     g_floor_free.clear();
     floor_cue.reset();  // the mission's first look: nothing known about the floor yet
     double render_ns = 0, stereo_ns = 0, target_ns = 0, floor_ns = 0;
-    for (const View& view : views) {
+    for (const firmware::mission::LookView& view : views) {
       stereo::PairPose pp;
       pp.pan_rad = quantise(view.pan_rad, lim.pan_resolution_rad);
       pp.first_tilt_rad = quantise(view.tilt_rad, lim.tilt_resolution_rad);

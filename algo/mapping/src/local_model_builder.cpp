@@ -13,10 +13,7 @@
 namespace boticelli::mapping {
 namespace {
 
-float horizontal_m(const evidence::Reading& r) {
-  const float d = r.r_m * r.r_m - r.h_m * r.h_m;
-  return d > 0.0F ? std::sqrt(d) : 0.0F;
-}
+using evidence::horizontal_m;
 
 // Vertex index whose sector (centred on the vertex ray) holds pan angle α.
 std::size_t vertex_of(const StarPolygon& p, float alpha_rad) {

@@ -16,6 +16,7 @@
 #include "firmware/board.h"
 #include "firmware/mission/drive_controller.h"
 #include "firmware/mission/target_tracker.h"
+#include "hal/pan_tilt.h"
 
 namespace boticelli::firmware::mission {
 
@@ -54,7 +55,19 @@ struct MissionParams {
 // The camera rig the stereo and the sim renderer both use, from the board's declaration.
 stereo::RigParams make_rig_params(const BoardConfig& config);
 
-// Every stage's settings from the board (robot size, PTU height, camera, look, limits).
+// Every stage's settings from the board (robot size, PTU height, camera, look, limits). The
+// look's rows come lowest tilt first: the lowest teaches the floor cue what the floor looks
+// like before the higher rows, which see less floor.
 MissionParams make_mission_params(const BoardConfig& config);
+
+// One view of the look's scan: `view` counts pans within a row (spread over the PTU's pan
+// limits, every other row swept back), then rows; a pair's tilt leaves room for its second
+// frame, tilt − Φ, above the tilt limit.
+struct LookView {
+  float pan_rad = 0.0F;
+  float tilt_rad = 0.0F;
+  bool pair = true;
+};
+LookView scan_view(const MissionParams& params, const hal::PanTiltLimits& limits, std::size_t view);
 
 }  // namespace boticelli::firmware::mission

@@ -1,6 +1,10 @@
 // Reading: one evidence point from stereo, in quasi-cylindrical coordinates about the PTU centre.
 #pragma once
 
+#include <cmath>
+
+#include "algo/core/geometry.h"
+
 namespace boticelli::evidence {
 
 // Thesis §4.5.2 (quasi-cylindrical coordinates; the thesis uses dm, we use SI).
@@ -10,5 +14,17 @@ struct Reading {
   float r_m = 0.0F;        // distance from the PTU centre to the point [m]
   float m = 0.0F;          // evidence in [0, 1] (Eq 3.8)
 };
+
+// ρ = √(r² − h²): the point's distance from the PTU's vertical axis [m] (0 when |h| ≥ r).
+inline float horizontal_m(const Reading& r) {
+  const float d = r.r_m * r.r_m - r.h_m * r.h_m;
+  return d > 0.0F ? std::sqrt(d) : 0.0F;
+}
+
+// The point's foot on the floor plane in the robot frame [m] (the PTU axis is the robot's).
+inline core::Point2 floor_point_m(const Reading& r) {
+  const float rho = horizontal_m(r);
+  return {rho * std::cos(r.alpha_rad), rho * std::sin(r.alpha_rad)};
+}
 
 }  // namespace boticelli::evidence

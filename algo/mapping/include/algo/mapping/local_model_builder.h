@@ -86,15 +86,9 @@ class LocalModelBuilder {
   [[nodiscard]] bool done() const { return phase_ == Phase::kDone; }
 
   [[nodiscard]] const LocalMap& map() const { return map_; }
-  // The fit's polygon cut in front of the guard points, before the seen-free cut: where the
-  // model and the guard put obstacles (the belief side of §7.2.3's gap).
-  [[nodiscard]] const StarPolygon& obstacle_polygon() const { return obstacle_polygon_; }
   // The farthest free floor seen along each vertex ray [m] (robot frame).
   [[nodiscard]] const StarPolygon& seen_free() const { return seen_free_; }
   [[nodiscard]] const OccupancyModel& model() const { return model_; }
-  [[nodiscard]] std::span<const core::Point2> guard_points() const {
-    return {guard_.data(), guard_.size()};
-  }
   [[nodiscard]] const LocalModelStats& stats() const { return stats_; }
   [[nodiscard]] const LocalModelParams& params() const { return params_; }
   // §5.4.4 map points of this look (robot frame), appended: obstacle points where the free
