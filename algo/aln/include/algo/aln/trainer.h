@@ -329,7 +329,7 @@ class Trainer {
       }
     } else {
       split_limit_ = MaxPieces;
-      tried_.fill(0);  // a new model: its pieces are new candidates
+      tried_.fill(0);  // another model now: every piece is a candidate again
       prune(*current_);
     }
     Accumulators& acc = *current_;
