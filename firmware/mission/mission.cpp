@@ -551,9 +551,7 @@ void Mission::end_cycle(const char* what) {
   if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
   if (snapshots_ != nullptr) {
     snapshot_pending_ = true;
-    snapshot_cycle_ = static_cast<std::uint32_t>(state_.cycle);
     snapshot_state_ = phase_name(phase_);
-    snapshot_robot_ = state_.pose;
     snapshot_look_pose_ = look_pose_;
   }
   if (path_.size() == path_.capacity()) {
@@ -909,9 +907,10 @@ void Mission::begin_snapshot() {
   to_world(local.free, snapshot_look_pose_, g_snap_free);
   to_world(local.navigable, snapshot_look_pose_, g_snap_navigable);
   SnapshotFrame f;
-  f.cycle = snapshot_cycle_;
+  // The cycle's count and pose stand until the next cycle ends, after this picture.
+  f.cycle = static_cast<std::uint32_t>(state_.cycle);
   f.state = snapshot_state_;
-  f.robot = snapshot_robot_;
+  f.robot = state_.pose;
   f.robot_radius_m = config_.robot_radius_m;
   // The view: the room so far (path, points) and 3.5 m around the robot.
   float x0 = f.robot.x_m - 3.5F, x1 = f.robot.x_m + 3.5F;
@@ -977,7 +976,7 @@ void Mission::snapshot_step() {
   if (!snapshots_->ok()) {
     TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
     line.appendf("snapshot: %s", snapshots_->error());
-    state_.add_log(snapshot_cycle_, line.view());
+    state_.add_log(state_.cycle, line.view());
   }
 }
 

@@ -110,3 +110,24 @@ TEST(SimBoard, TheHalBagDrivesOneWorldInLockstep) {
   for (int i = 0; i < 3; ++i) minor_frame();
   CHECK_FALSE(h.estop.read());
 }
+
+// A resumed mission's pose is in the mission frame, whose origin is the world's start pose.
+TEST(SimBoard, APlacedRobotStandsAtTheSavedPoseFromTheWorldsStartAndACollidingOneIsRefused) {
+  const std::string path = world_path("thesis_room");
+  boticelli::firmware::Options options;
+  options.world_file = path.c_str();
+  board->settings().camera_fps = 5.0F;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  const boticelli::core::Pose2 start = board->world().start;
+  const boticelli::core::Pose2 saved{0.5F, 0.2F, 0.3F};  // 0.5 m ahead, 0.2 m to the left
+  CHECK_TEXT(board->place_robot(saved, g_error, sizeof g_error), g_error);
+  const boticelli::core::Pose2 p = board->sim().true_pose();
+  const boticelli::core::Point2 expected = boticelli::core::to_world(start, {0.5F, 0.2F});
+  DOUBLES_EQUAL(expected.x_m, p.x_m, 1e-5);
+  DOUBLES_EQUAL(expected.y_m, p.y_m, 1e-5);
+  DOUBLES_EQUAL(std::remainder(start.yaw_rad + 0.3F, 6.2831853F), p.yaw_rad, 1e-5);
+  // 1.2 m behind the start: on the south wall, refused with a reason; the robot stays.
+  CHECK_FALSE(board->place_robot({-1.2F, 0.0F, 0.0F}, g_error, sizeof g_error));
+  CHECK(std::strstr(g_error, "collides") != nullptr);
+  DOUBLES_EQUAL(expected.x_m, board->sim().true_pose().x_m, 1e-5);
+}

@@ -266,9 +266,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   bool snapshot_pending_ = false;
   bool snapshot_writing_ = false;  // the writer is drawing or encoding it, a unit at a time
   bool look_lists_stale_ = false;  // the last look's readings wait for the picture
-  std::uint32_t snapshot_cycle_ = 0;
   const char* snapshot_state_ = "";
-  core::Pose2 snapshot_robot_{};
   core::Pose2 snapshot_look_pose_{};
 
   double cpu_s_[3] = {0.0, 0.0, 0.0};
