@@ -179,8 +179,7 @@ TEST(FeatureGuard, NoisyReadingsOfABoxAreKeptWhereAFixedRadiusKeepsFew) {
     CHECK_TRUE(q.x_m > 2.05F && q.x_m < 2.95F && std::fabs(q.y_m) < 0.35F);
   }
   mapping::FeatureGuardParams fixed;
-  fixed.neighbour_delta_r_factor = 0.0F;  // the old rule: a 0.1 m ball whatever the range
-  fixed.lateral_radius_m = 0.0F;
+  fixed.neighbour_delta_r_factor = 0.0F;  // the old rule: 0.1 m whatever the range
   CHECK_TRUE(kept_by(candidates, fixed, kept) <= 5);
 }
 
@@ -204,22 +203,8 @@ TEST(FeatureGuard, IsolatedOutliersAreNotKeptThoughTheRadiusGrowsWithRange) {
   }
 }
 
-TEST(FeatureGuard, NeighboursAreFoundAlongTheLineOfSightWithinTheSummedRangeError) {
-  const mapping::FeatureGuardParams g;  // δr = 0.1 r, 0.25 m across the line of sight
-  // Along the line of sight (x axis) at 2 m and 2.4 m: 0.4 ≤ 0.2 + 0.24 m.
-  const mapping::GuardPoint a{2.0F, 0.0F, 0.0F, 2.0F};
-  CHECK_TRUE(mapping::are_neighbours(a, {2.4F, 0.0F, 0.0F, 2.4F}, g));
-  CHECK_FALSE(mapping::are_neighbours(a, {2.6F, 0.0F, 0.0F, 2.6F}, g));  // 0.6 > 0.46 m
-  // Across it the range error does not count: 0.24 m is near, 0.3 m is not, though both are
-  // well within 0.5 m.
-  CHECK_TRUE(mapping::are_neighbours(a, {2.0F, 0.24F, 0.0F, 2.01F}, g));
-  CHECK_FALSE(mapping::are_neighbours(a, {2.0F, 0.3F, 0.0F, 2.02F}, g));
-  CHECK_FALSE(mapping::are_neighbours(a, {2.0F, 0.0F, 0.3F, 2.02F}, g));  // above, too
-}
-
 TEST(FeatureGuard, NeighboursAreFoundWithinTheSummedRangeErrorOfThePair) {
   mapping::FeatureGuardParams g;  // δr = 0.1 r
-  g.lateral_radius_m = 0.0F;      // a ball of that radius
   // Two readings at 2 m and 3 m: 0.2 + 0.3 = 0.5 m.
   const mapping::GuardPoint a{2.0F, 0.0F, 0.0F, 2.0F};
   CHECK_TRUE(mapping::are_neighbours(a, {2.0F, 0.49F, 0.0F, 3.0F}, g));

@@ -11,22 +11,10 @@ bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuard
   // δr_a + δr_b (§3.7.3): see FeatureGuardParams for why the sum.
   const float delta_r = g.delta_r_fraction * (std::fabs(a.r_m) + std::fabs(b.r_m));
   const float radius = std::fmax(g.neighbour_radius_m, g.neighbour_delta_r_factor * delta_r);
-  const float dx = b.x_m - a.x_m;
-  const float dy = b.y_m - a.y_m;
-  const float dh = b.h_m - a.h_m;
-  const float d2 = dx * dx + dy * dy + dh * dh;
-  if (!(g.lateral_radius_m > 0.0F)) {
-    return d2 <= radius * radius;
-  }
-  // Along and across the mean line of sight from the PTU centre: the range error lies along
-  // it; across it a reading is off by a pixel or two.
-  const float sx = a.x_m + b.x_m;
-  const float sy = a.y_m + b.y_m;
-  const float sh = a.h_m + b.h_m;
-  const float s2 = sx * sx + sy * sy + sh * sh;
-  const float along = s2 > 1e-12F ? (dx * sx + dy * sy + dh * sh) / std::sqrt(s2) : 0.0F;
-  const float across2 = std::fmax(d2 - along * along, 0.0F);
-  return std::fabs(along) <= radius && across2 <= g.lateral_radius_m * g.lateral_radius_m;
+  const float dx = a.x_m - b.x_m;
+  const float dy = a.y_m - b.y_m;
+  const float dh = a.h_m - b.h_m;
+  return dx * dx + dy * dy + dh * dh <= radius * radius;
 }
 
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
@@ -57,11 +45,9 @@ bool corroborated_points(std::span<const GuardPoint> candidates, std::size_t fir
     const std::size_t required = a.m < g.min_evidence ? g.min_weak_neighbours : g.min_neighbours;
     std::size_t neighbours = 0;
     if (sorted) {
-      // |Δx| ≤ |b − a| ≤ along + across bound.
       const float reach =
           std::fmax(g.neighbour_radius_m,
-                    g.neighbour_delta_r_factor * g.delta_r_fraction * (std::fabs(a.r_m) + r_max)) +
-          std::fmax(g.lateral_radius_m, 0.0F);
+                    g.neighbour_delta_r_factor * g.delta_r_fraction * (std::fabs(a.r_m) + r_max));
       for (std::size_t j = i + 1; j < n && neighbours < required; ++j) {
         if (candidates[j].x_m - a.x_m > reach) break;
         neighbours += are_neighbours(a, candidates[j], g) ? 1U : 0U;

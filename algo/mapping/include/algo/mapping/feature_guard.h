@@ -42,11 +42,6 @@ struct FeatureGuardParams {
   float delta_r_fraction = evidence::RaySampleParams{}.delta_r_fraction;
   // Neighbour radius in units of the pair's summed range error δr_a + δr_b (0: fixed radius).
   float neighbour_delta_r_factor = 1.0F;
-  // If > 0, that radius holds only along the pair's mean line of sight (where the range error
-  // lies) and across it they must be within lateral_radius_m [m]. With a ball of the range
-  // error's radius (0.6 m at 3 m), thousands of unexplained readings of a coarse fit find
-  // four stray mismatches anywhere in free space to corroborate them.
-  float lateral_radius_m = 0.25F;
   // Weak features, min_weak_evidence ≤ m < min_evidence: their ray samples (§4.5) plateau at
   // m, so the fit cannot raise F to m_safe (0.6) on them however many there are, and only
   // the guard can keep such a surface. Being more likely mismatches (Eq 3.8: m = 0.4 is a
