@@ -62,9 +62,7 @@ MissionParams make_mission_params(const BoardConfig& c) {
   p.target.agree_radius_m = 0.5F;
   p.target.refine_radius_m = 1.0F;
 
-  // Look: features down to the image's bottom border (see FeatureParams).
-  p.stereo.features.band_half_height_below_at_f150_px = 60.0F;
-  p.stereo.tracking.window_shift_px = 2;  // half the window: one side of an occlusion edge
+  // Look.
   p.pan_positions = std::max<std::uint32_t>(c.look_pan_positions, 1);
   p.row_count = std::min<std::size_t>(c.look_tilt_rows, BoardConfig::kMaxTiltRows);
   for (std::size_t i = 0; i < p.row_count; ++i) {

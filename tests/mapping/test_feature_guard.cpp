@@ -1,6 +1,5 @@
 // Tests of the feature guard: unexplained features, their corroboration, and the polygon kept
 // clear of them.
-#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -294,53 +293,4 @@ TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
     mapping::extract_local_map(free_range, p, map, scratch, guard);
   });
   LONGS_EQUAL(35, guard.size());
-}
-
-// More candidates than the first wave's list held (2,048; looks on rendered frames have up to
-// 6,700): clusters and strays over a 5 m square, ranges 0.5–5 m. Sorted by x, the windowed
-// search must keep exactly the points the all-pairs search keeps.
-TEST(FeatureGuard, SortedCandidatesKeepTheSamePointsAsTheAllPairsSearch) {
-  static GuardCandidatesFor<mapping::kMaxGuardCandidates> candidates;
-  candidates.clear();
-  std::uint32_t state = 12345U;
-  const auto next = [&state]() {  // uniform in [0, 1)
-    state = state * 1664525U + 1013904223U;
-    return static_cast<float>(state >> 8) / 16777216.0F;
-  };
-  for (int c = 0; c < 700; ++c) {
-    const float cx = -2.5F + 5.0F * next();
-    const float cy = -2.5F + 5.0F * next();
-    const int members = c % 3 == 0 ? 1 : 2 + c % 9;  // a third are strays
-    for (int k = 0; k < members; ++k) {
-      const float x = cx + 0.15F * (next() - 0.5F);
-      const float y = cy + 0.15F * (next() - 0.5F);
-      const float h = -0.5F + 0.6F * next();
-      (void)candidates.push_back({x, y, h, std::hypot(x, y), next() < 0.3F ? 0.5F : 0.9F});
-    }
-  }
-  CHECK(candidates.size() > 2048U);
-  static FixedVector<Point2, mapping::kMaxGuardPoints> all_pairs;
-  static FixedVector<Point2, mapping::kMaxGuardPoints> windowed;
-  all_pairs.clear();
-  windowed.clear();
-  CHECK_TRUE(
-      mapping::corroborated_points(candidates.span(), mapping::FeatureGuardParams{}, all_pairs));
-  CHECK_NO_ALLOCATION(mapping::sort_guard_candidates(candidates.span()));
-  // In bounded slices, as the local model builder runs it.
-  for (std::size_t first = 0; first < candidates.size(); first += 256) {
-    CHECK_TRUE(mapping::corroborated_points(candidates.span(), first, first + 256,
-                                            mapping::FeatureGuardParams{}, windowed));
-  }
-  CHECK(all_pairs.size() > 1000U);
-  CHECK(all_pairs.size() < candidates.size());  // the strays are not kept
-  LONGS_EQUAL(all_pairs.size(), windowed.size());
-  const auto by_xy = [](const Point2& a, const Point2& b) {
-    return a.x_m < b.x_m || (a.x_m == b.x_m && a.y_m < b.y_m);
-  };
-  std::sort(all_pairs.begin(), all_pairs.end(), by_xy);
-  std::sort(windowed.begin(), windowed.end(), by_xy);
-  for (std::size_t i = 0; i < all_pairs.size(); ++i) {
-    CHECK_EQUAL(all_pairs[i].x_m, windowed[i].x_m);
-    CHECK_EQUAL(all_pairs[i].y_m, windowed[i].y_m);
-  }
 }

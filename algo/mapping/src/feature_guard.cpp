@@ -22,45 +22,16 @@ bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGu
   return corroborated_points(candidates, 0, candidates.size(), g, out);
 }
 
-void sort_guard_candidates(std::span<GuardPoint> candidates) {
-  std::sort(candidates.begin(), candidates.end(),
-            [](const GuardPoint& a, const GuardPoint& b) { return a.x_m < b.x_m; });
-}
-
 bool corroborated_points(std::span<const GuardPoint> candidates, std::size_t first,
                          std::size_t last, const FeatureGuardParams& g, GuardPoints& out) {
-  // Sorted by x (sort_guard_candidates): only candidates within the largest radius a pair
-  // with this one can have, along x, can be neighbours; else every pair is tried.
-  const bool sorted =
-      std::is_sorted(candidates.begin(), candidates.end(),
-                     [](const GuardPoint& a, const GuardPoint& b) { return a.x_m < b.x_m; });
-  float r_max = 0.0F;
-  for (const GuardPoint& c : candidates) {
-    r_max = std::fmax(r_max, std::fabs(c.r_m));
-  }
   bool ok = true;
-  const std::size_t n = candidates.size();
-  for (std::size_t i = first; i < std::min(last, n); ++i) {
+  for (std::size_t i = first; i < std::min(last, candidates.size()); ++i) {
     const GuardPoint& a = candidates[i];
     const std::size_t required = a.m < g.min_evidence ? g.min_weak_neighbours : g.min_neighbours;
     std::size_t neighbours = 0;
-    if (sorted) {
-      const float reach =
-          std::fmax(g.neighbour_radius_m,
-                    g.neighbour_delta_r_factor * g.delta_r_fraction * (std::fabs(a.r_m) + r_max));
-      for (std::size_t j = i + 1; j < n && neighbours < required; ++j) {
-        if (candidates[j].x_m - a.x_m > reach) break;
-        neighbours += are_neighbours(a, candidates[j], g) ? 1U : 0U;
-      }
-      for (std::size_t j = i; j-- > 0 && neighbours < required;) {
-        if (a.x_m - candidates[j].x_m > reach) break;
-        neighbours += are_neighbours(a, candidates[j], g) ? 1U : 0U;
-      }
-    } else {
-      for (std::size_t j = 0; j < n && neighbours < required; ++j) {
-        if (j != i && are_neighbours(a, candidates[j], g)) {
-          ++neighbours;
-        }
+    for (std::size_t j = 0; j < candidates.size() && neighbours < required; ++j) {
+      if (j != i && are_neighbours(a, candidates[j], g)) {
+        ++neighbours;
       }
     }
     if (neighbours >= required && !out.push_back({a.x_m, a.y_m})) {

@@ -124,24 +124,17 @@ bool LocalModelBuilder::step() {
     case Phase::kGuardObstacles: {
       const auto occupancy = [this](float a, float h, float r) { return this->occupancy(a, h, r); };
       const bool features = phase_ == Phase::kGuardFeatures;
-      const std::size_t lost =
-          collect_unexplained_features(features ? features_ : obstacles_, occupancy,
-                                       params_.extraction, params_.guard, candidates_);
-      stats_.guard_dropped += lost;
-      if (!features) {
-        sort_guard_candidates(candidates_.span());
-      }
+      (void)collect_unexplained_features(features ? features_ : obstacles_, occupancy,
+                                         params_.extraction, params_.guard, candidates_);
       phase_ = features ? Phase::kGuardObstacles : Phase::kGuardPoints;
       guard_cursor_ = 0;
       return false;
     }
     case Phase::kGuardPoints: {
-      // A bounded slice of the candidates (sorted by x) per unit, each against its reach.
+      // O(n²) over the candidates: a bounded slice of them per unit.
       const std::size_t end =
           std::min(candidates_.size(), guard_cursor_ + params_.guard_candidates_per_unit);
-      if (!corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_)) {
-        stats_.guard_points_full = true;
-      }
+      (void)corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_);
       guard_cursor_ = end;
       if (guard_cursor_ == candidates_.size()) {
         stats_.guard_candidates = candidates_.size();

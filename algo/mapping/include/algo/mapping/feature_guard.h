@@ -62,11 +62,8 @@ struct GuardPoint {
   float m = 1.0F;
 };
 
-// A look's stereo features and floor-cue bases in the robot's height band: thousands of them
-// are unexplained when the fit is coarse (1,000–6,700 a look on rendered frames), and every
-// one dropped is a surface left unguarded.
-inline constexpr std::size_t kMaxGuardCandidates = 16384;
-inline constexpr std::size_t kMaxGuardPoints = 16384;
+inline constexpr std::size_t kMaxGuardCandidates = 2048;
+inline constexpr std::size_t kMaxGuardPoints = 1024;
 
 using GuardCandidates = core::FixedVectorBase<GuardPoint>;
 using GuardPoints = core::FixedVectorBase<core::Point2>;
@@ -104,15 +101,11 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
   return lost;
 }
 
-// Orders candidates by x, so corroborated_points looks only at those within reach along x.
-void sort_guard_candidates(std::span<GuardPoint> candidates);
-
 // Appends the candidates (robot frame, as x, y) with at least min_neighbours other
 // candidates (min_weak_neighbours for a weak one, m < min_evidence) within the pair's
-// neighbour radius (FeatureGuardParams). Neighbours of either kind count. Sorted by x
-// (sort_guard_candidates), each candidate is compared only with those whose x is within the
-// largest radius it can have with any of them; unsorted, with all (O(n²)); the points are the
-// same either way. Returns false if `out` was full.
+// neighbour radius (FeatureGuardParams). Neighbours of either kind count. O(n²) over the
+// candidates, which are few: the features the model explains never get here. Returns false
+// if `out` was full.
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
                          GuardPoints& out);
 // The same for candidates [first, last) only (each still against all of them), so the
