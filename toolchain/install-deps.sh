@@ -26,7 +26,7 @@ for arg in "$@"; do
 done
 
 host_pkgs=(
-  g++ make cmake pkg-config clang-format file
+  g++ make cmake pkg-config clang-format file systemd
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
 )
 cross_pkgs=(
