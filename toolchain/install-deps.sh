@@ -25,9 +25,12 @@ for arg in "$@"; do
   esac
 done
 
+# systemd: systemd-analyze for the unit's rating; libsdformat-dev: the test that loads every
+# world with SDFormat (tests only, never linked into the firmware).
 host_pkgs=(
   g++ make cmake pkg-config clang-format file systemd
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
+  libsdformat-dev
 )
 cross_pkgs=(
   g++-aarch64-linux-gnu qemu-user
