@@ -32,9 +32,11 @@ host_pkgs=(
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
   libsdformat-dev
 )
+# lintian: the rpi4 preset's test of the .deb (tests/packaging).
 cross_pkgs=(
   g++-aarch64-linux-gnu qemu-user
   libcpputest-dev:arm64 libgpiod-dev:arm64 libtinyxml2-dev:arm64 libpng-dev:arm64
+  lintian
 )
 armhf_pkgs=(
   g++-arm-linux-gnueabihf
