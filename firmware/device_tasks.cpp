@@ -67,7 +67,7 @@ void WatchdogTask::run(std::uint64_t) {
   } else {
     pattern_ = LedPattern::kOk;
   }
-  led_.write(((led_pattern_bits(pattern_) >> step_) & 1U) != 0U);
+  led_.write(((static_cast<std::uint32_t>(led_pattern_bits(pattern_)) >> step_) & 1U) != 0U);
   if (step_ == 0) report_status(healthy);
   step_ = (step_ + 1) % kStepsPerSecond;
 }
