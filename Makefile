@@ -75,8 +75,9 @@ format-check:
 .PHONY: package-rpi4 deploy
 package-rpi4: rpi4
 	cd build/rpi4 && cpack -G DEB
-deploy: package-rpi4
+deploy:
 	@test -n "$(HOST)" || { echo "usage: make deploy HOST=user@robot" >&2; exit 2; }
+	@$(MAKE) package-rpi4
 	deb=$$(ls -t build/rpi4/boticelli_*_arm64.deb | head -n1) && \
 	  scp "$$deb" $(HOST):/tmp/ && \
 	  ssh $(HOST) "sudo apt-get install -y --allow-downgrades /tmp/$$(basename $$deb)"

@@ -1,6 +1,7 @@
 // Console: command execution, telemetry and output buffering (see console.h, docs/console.md).
 #include "firmware/console.h"
 
+#include <cmath>
 #include <cstdarg>
 #include <cstring>
 
@@ -8,32 +9,9 @@ namespace boticelli::firmware {
 namespace {
 
 constexpr std::string_view kEol = "\r\n";
+static_assert(LogRing::kLines == 64, "the `log show N` error message names the ring's size");
 
 }  // namespace
-
-const char* log_level_name(LogLevel level) {
-  switch (level) {
-    case LogLevel::kError:
-      return "error";
-    case LogLevel::kWarn:
-      return "warn";
-    case LogLevel::kInfo:
-      return "info";
-    case LogLevel::kDebug:
-      return "debug";
-  }
-  return "?";
-}
-
-bool parse_log_level(std::string_view text, LogLevel& out) {
-  for (const LogLevel l : {LogLevel::kError, LogLevel::kWarn, LogLevel::kInfo, LogLevel::kDebug}) {
-    if (text == log_level_name(l)) {
-      out = l;
-      return true;
-    }
-  }
-  return false;
-}
 
 const Console::Command Console::kCommands[] = {
     {"help", "", "list the commands", &Console::cmd_help},
@@ -50,7 +28,9 @@ const Console::Command Console::kCommands[] = {
      &Console::cmd_clear_estop},
     {"get", "[NAME]", "show one or every parameter", &Console::cmd_get},
     {"set", "NAME VALUE", "set a parameter (range checked)", &Console::cmd_set},
-    {"log", "[error|warn|info|debug]", "show or set the log level", &Console::cmd_log},
+    {"log", "[LEVEL|show [N]]", "log level (error|warn|info|debug), or the last N log lines",
+     &Console::cmd_log},
+    {"ver", "", "firmware version and board", &Console::cmd_ver},
     {"shutdown", "", "stop the firmware in an orderly way", &Console::cmd_shutdown},
     {"quit", "", "same as shutdown", &Console::cmd_shutdown},
 };
@@ -104,18 +84,41 @@ void Console::reply_error(const char* reason) {
   emit(reply_.view());
 }
 
+bool Console::emit_unsolicited(std::string_view line) {
+  if (streaming()) return false;  // never inside a reply
+  const std::string_view typed = echo_ != 0.0F ? line_.typed() : std::string_view{};
+  if (typed.empty()) return emit(line);
+  // Carriage return and erase to the end of the line (VT100, what picocom's terminal
+  // understands), the line, then the half-typed command again.
+  constexpr std::string_view kClearLine = "\r\x1b[K";
+  if (kClearLine.size() + line.size() + typed.size() > tx_free()) {
+    dropped_bytes_ += line.size();
+    return false;
+  }
+  emit(kClearLine);
+  emit(line);
+  emit(typed);
+  return true;
+}
+
 void Console::log(LogLevel level, const char* format, ...) {
-  if (level > log_level_) return;
+  // The ring keeps info and above whatever the console's level (debug only when shown).
+  const bool keep = ring_ != nullptr && (level <= LogLevel::kInfo || level <= log_level_);
+  if (level > log_level_ && !keep) return;
   TextBuffer<256> text;
   text.appendf("LOG %s ", log_level_name(level));
+  const std::size_t prefix = text.size();
   std::va_list args;
   va_start(args, format);
   text.vappendf(format, args);
   va_end(args);
-  if (text.size() > 256 - 3) text.clear();  // never cut a line in the middle of the protocol
-  if (text.size() == 0) return;
+  if (keep) {
+    ring_->add(clock_ != nullptr ? clock_->now_us() : now_us_, level, text.view().substr(prefix));
+  }
+  if (level > log_level_) return;
+  if (text.size() > 256 - 3) return;  // never cut a line in the middle of the protocol
   text.append(kEol);
-  emit(text.view());
+  emit_unsolicited(text.view());
 }
 
 void Console::service(std::uint64_t now_us) {
@@ -128,9 +131,11 @@ void Console::service(std::uint64_t now_us) {
   }
   flush();
   stream_model();
+  stream_log();
+  line_.set_recall(echo_ != 0.0F);
   // Input is taken only while a full reply fits, so replies are never cut (the serial
   // driver keeps the bytes meanwhile).
-  while (model_pending_.empty() && tx_free() >= kReplyBytes + 8) {
+  while (!streaming() && tx_free() >= kReplyBytes + 8) {
     if (rx_pos_ == rx_len_) {
       if (port_fault_) break;
       const std::ptrdiff_t n = port_.read(rx_.data(), rx_.size());
@@ -148,6 +153,10 @@ void Console::service(std::uint64_t now_us) {
       case LineEvent::kNone:
       case LineEvent::kCancelled:
         break;
+      case LineEvent::kOlder:
+      case LineEvent::kNewer:
+        recall(event == LineEvent::kOlder);
+        break;
       case LineEvent::kTooLong:
         reply_error("line too long");
         break;
@@ -155,14 +164,28 @@ void Console::service(std::uint64_t now_us) {
         reply_error("bad character in line");
         break;
       case LineEvent::kLine:
+        history_.add(line_.line());
         execute(line_.line());
         stream_model();
+        stream_log();
         break;
     }
   }
   check_executive(now_us);
   send_telemetry(now_us);
   flush();
+}
+
+void Console::recall(bool older) {
+  std::string_view text;
+  if (!(older ? history_.older(text) : history_.newer(text))) return;
+  line_.replace(text);
+  // Show the recalled line in place of the one typed (CR, erase to end of line, the text).
+  constexpr std::string_view kClearLine = "\r\x1b[K";
+  if (kClearLine.size() + text.size() <= tx_free()) {
+    emit(kClearLine);
+    emit(text);
+  }
 }
 
 void Console::execute(std::string_view line) {
@@ -379,8 +402,56 @@ void Console::cmd_set(const Words& w) {
   emit("OK\r\n");
 }
 
+void Console::cmd_ver(const Words& w) {
+  if (!no_args(w)) return reply_error("ver takes no arguments");
+  reply_.appendf("ver version=%s board=%s\r\nOK\r\n", BOTICELLI_VERSION, board_name_);
+  emit(reply_.view());
+}
+
+void Console::stream_log() {
+  if (!log_streaming_) return;
+  // One whole line at a time as the output ring drains; lines overwritten in the log ring
+  // since the command are skipped.
+  while (log_next_ < log_end_) {
+    const LogRing::Entry* e = ring_->find(log_next_);
+    if (e == nullptr) {
+      ++log_next_;
+      continue;
+    }
+    TextBuffer<LogRing::kTextBytes + 48> line;
+    const auto since_start_us = static_cast<double>(static_cast<std::int64_t>(e->t_us - start_us_));
+    line.appendf("log t_s=%.3f %s ", since_start_us * 1e-6, log_level_name(e->level));
+    line.append(e->view());
+    line.append(kEol);
+    if (line.size() + 8 > tx_free()) return;
+    emit(line.view());
+    ++log_next_;
+  }
+  if (tx_free() < 8) return;
+  emit("OK\r\n");
+  log_streaming_ = false;
+}
+
 void Console::cmd_log(const Words& w) {
-  if (w.count > 2) return reply_error("usage: log [error|warn|info|debug]");
+  if (w.count >= 2 && w.word[1] == "show") {
+    if (ring_ == nullptr) return reply_error("no log ring");
+    std::uint64_t n = LogRing::kLines;
+    if (w.count > 3) return reply_error("usage: log show [N]");
+    if (w.count == 3) {
+      float value = 0.0F;
+      if (!parse_number(w.word[2], value) || !(value >= 1.0F) ||
+          value > static_cast<float>(LogRing::kLines) || std::nearbyint(value) != value) {
+        return reply_error("N must be a whole number from 1 to 64");
+      }
+      n = static_cast<std::uint64_t>(value);
+    }
+    log_end_ = ring_->end_sequence();
+    const std::uint64_t kept = ring_->size();
+    log_next_ = log_end_ - (n < kept ? n : kept);
+    log_streaming_ = true;
+    return;
+  }
+  if (w.count > 2) return reply_error("usage: log [error|warn|info|debug] or log show [N]");
   if (w.count == 2) {
     LogLevel level = LogLevel::kInfo;
     if (!parse_log_level(w.word[1], level)) return reply_error("unknown log level");
@@ -431,7 +502,7 @@ void Console::send_telemetry(std::uint64_t now_us) {
       view_.features(), view_.pieces(), static_cast<double>(p.x_m), static_cast<double>(p.y_m),
       static_cast<double>(p.yaw_rad), stop_cause_name(safety_.cause()),
       target_status_name(view_.target().status));
-  if (!line.truncated()) emit(line.view());
+  if (!line.truncated()) emit_unsolicited(line.view());
 }
 
 }  // namespace boticelli::firmware

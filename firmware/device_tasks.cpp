@@ -1,4 +1,5 @@
-// Device tasks: camera polling and the watchdog kick (see device_tasks.h).
+// Device tasks: camera polling, the watchdog kick, status LED and service status (see
+// device_tasks.h).
 #include "firmware/device_tasks.h"
 
 namespace boticelli::firmware {
@@ -34,17 +35,55 @@ void CameraTask::run(std::uint64_t now_us) {
   }
 }
 
+const char* led_pattern_name(LedPattern pattern) {
+  switch (pattern) {
+    case LedPattern::kFault:
+      return "fault";
+    case LedPattern::kEstop:
+      return "estop";
+    case LedPattern::kTargetFound:
+      return "target";
+    case LedPattern::kOk:
+      return "ok";
+  }
+  return "?";
+}
+
 void WatchdogTask::run(std::uint64_t) {
-  if (executive_.all_healthy()) {
+  const bool healthy = executive_.all_healthy();
+  if (healthy) {
     watchdog_.kick();
     notifier_.watchdog();
     ++kicks_;
-    led_on_ = !led_on_;
   } else {
     ++withheld_;
-    led_on_ = false;
   }
-  led_.write(led_on_);
+  if (!healthy) {
+    pattern_ = LedPattern::kFault;
+  } else if (safety_ != nullptr && safety_->engaged()) {
+    pattern_ = LedPattern::kEstop;
+  } else if (view_ != nullptr && view_->target().status == TargetStatus::kConfirmed) {
+    pattern_ = LedPattern::kTargetFound;
+  } else {
+    pattern_ = LedPattern::kOk;
+  }
+  led_.write(((static_cast<std::uint32_t>(led_pattern_bits(pattern_)) >> step_) & 1U) != 0U);
+  if (step_ == 0) report_status(healthy);
+  step_ = (step_ + 1) % kStepsPerSecond;
+}
+
+void WatchdogTask::report_status(bool healthy) {
+  TextBuffer<160> text;
+  text.appendf("STATUS=state=%s cycle=%llu healthy=%d estop=%s target=%s",
+               view_ != nullptr ? view_->state_name() : "running",
+               static_cast<unsigned long long>(view_ != nullptr ? view_->cycles() : 0U),
+               healthy ? 1 : 0,
+               stop_cause_name(safety_ != nullptr ? safety_->cause() : StopCause::kNone),
+               target_status_name(view_ != nullptr ? view_->target().status : TargetStatus::kNone));
+  if (text.view() == status_.view()) return;
+  if (!notifier_.send(text.c_str())) return;  // tried again next second
+  status_.clear();
+  status_.append(text.view());
 }
 
 }  // namespace boticelli::firmware

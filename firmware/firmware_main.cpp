@@ -10,6 +10,7 @@
 #include "firmware/console.h"
 #include "firmware/device_tasks.h"
 #include "firmware/executive.h"
+#include "firmware/log.h"
 #include "firmware/mission/mission.h"
 #include "firmware/mission/trace_writer.h"
 #include "firmware/mission_state.h"
@@ -46,6 +47,7 @@ StateStore g_store;
 ParameterTable g_parameters;
 mission::TraceWriter g_trace;
 SnapshotWriter g_snapshots;
+LogRing g_log_ring;
 
 // Everything that is bound to the board's devices, rebuilt in place for each run (static
 // storage, no heap; firmware_main may be called again, e.g. by tests).
@@ -66,6 +68,7 @@ struct Runtime {
         console_task(console),
         watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {
     camera_task.set_consumer(&mission);
+    watchdog_task.set_status_sources(&safety, &mission);
   }
 
   ServiceNotifier notifier;
@@ -85,7 +88,7 @@ struct Runtime {
 std::optional<Runtime> g_runtime;
 
 int fail(const char* what, const char* why) {
-  std::fprintf(stderr, "boticelli: %s%s%s\n", what, why[0] != '\0' ? ": " : "", why);
+  service_log().log(LogLevel::kError, "%s%s%s", what, why[0] != '\0' ? ": " : "", why);
   return 1;
 }
 
@@ -95,9 +98,14 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   const double wall_start_s = wall_seconds();
   const BoardInfo& info = board.info();
   Options options;
+  ServiceLog& slog = service_log();
+  slog.open();
+  g_log_ring.clear();
+  slog.attach(&g_log_ring, nullptr);
   const ParseResult parsed = parse_options(argc, argv, info.simulated, options);
   if (!parsed.ok) {
-    std::fprintf(stderr, "boticelli: %s\n%s", parsed.error, usage_text());
+    slog.log(LogLevel::kError, "%s", parsed.error);
+    std::fputs(usage_text(), stderr);
     return 2;
   }
   if (options.show_help) {
@@ -112,6 +120,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   if (!board.init(options, error, sizeof error)) return fail(error, "");
   const BoardConfig& config = board.config();
   hal::Hal& hal = board.hal();
+  slog.attach(&g_log_ring, &hal.clock);
 
   // Mission state: fresh, or resumed from --state DIR.
   StateStore* store = nullptr;
@@ -128,14 +137,14 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     if (loaded == LoadResult::kMissing) {
       g_state.clear();
       g_state.seed = options.seed;
-      std::fprintf(stderr, "boticelli: %s: starting a new mission\n", error);
+      slog.log(LogLevel::kInfo, "%s: starting a new mission", error);
     } else if (loaded != LoadResult::kLoaded) {
       return fail("cannot resume", error);
     } else {
       if (!board.place_robot(g_state.pose, error, sizeof error))
         return fail("cannot resume", error);
-      std::fprintf(stderr, "boticelli: resumed from %s at cycle %llu\n", g_store.path(),
-                   static_cast<unsigned long long>(g_state.cycle));
+      slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.path(),
+               static_cast<unsigned long long>(g_state.cycle));
     }
   }
 
@@ -148,7 +157,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   if (config.watchdog_timeout_ms != 0) {
     watchdog_armed = hal.watchdog.start(config.watchdog_timeout_ms);
     if (!watchdog_armed) {
-      std::fprintf(stderr, "boticelli: watchdog not armed (%s)\n", hal.watchdog.error());
+      slog.log(LogLevel::kWarn, "watchdog not armed (%s)", hal.watchdog.error());
     }
   }
   if (options.trace_file != nullptr && !g_trace.open(options.trace_file, error, sizeof error)) {
@@ -167,11 +176,13 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   // of milliseconds on an SD card); on the simulation it is written in the background slot.
   if (store != nullptr && config.realtime) rt.saver.start();
   ServiceNotifier& notifier = rt.notifier;
-  if (!notifier.open()) std::fprintf(stderr, "boticelli: %s\n", notifier.error());
+  if (!notifier.open()) slog.log(LogLevel::kWarn, "%s", notifier.error());
   Executive& executive = rt.executive;
   Safety& safety = rt.safety;
   mission::Mission& mission = rt.mission;
   Console& console = rt.console;
+  console.set_log_ring(&g_log_ring, &hal.clock);
+  console.set_board_name(info.name);
 
   // The executive and its tasks.
   Task* const tasks[kTaskCount] = {&rt.estop_task,   &rt.base_task,    &rt.ptu_task,
@@ -195,7 +206,8 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     RealtimeConfig realtime;
     realtime.fifo_priority = config.fifo_priority;
     const RealtimeReport report = prepare_realtime(realtime);
-    std::fprintf(stderr, "boticelli: %s\n", report.message);
+    slog.log(report.fifo && report.memory_locked ? LogLevel::kInfo : LogLevel::kWarn, "%s",
+             report.message);
   }
 
   struct sigaction action {};
@@ -253,6 +265,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   hal.base.stop();
   hal.pan_tilt.halt();
   if (watchdog_armed) hal.watchdog.stop();
+  hal.status_led.write(false);  // off: the firmware is not running
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
   console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
               mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
@@ -274,11 +287,11 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   mission.finish_saving();
   if (rt.saver.failures() > 0) {
     rt.saver.last_error(error, sizeof error);
-    std::fprintf(stderr, "boticelli: %llu state saves failed, last: %s\n",
-                 static_cast<unsigned long long>(rt.saver.failures()), error);
+    slog.log(LogLevel::kError, "%llu state saves failed, last: %s",
+             static_cast<unsigned long long>(rt.saver.failures()), error);
   }
   if (g_trace.is_open() && !g_trace.close(error, sizeof error)) {
-    std::fprintf(stderr, "boticelli: %s\n", error);
+    slog.log(LogLevel::kError, "%s", error);
   }
   const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
   const mission::Result result = mission.result();

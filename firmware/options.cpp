@@ -32,11 +32,30 @@ bool parse_u64(const char* text, std::uint64_t& out) {
   return true;
 }
 
+// A plain non-negative decimal number (strtod's syntax without inf, nan or hex), at most
+// `max`.
+bool parse_speed(const char* text, double max, double& out) {
+  if (text == nullptr || *text == '\0' || *text == '-' || *text == '+') return false;
+  for (const char* c = text; *c != '\0'; ++c) {
+    if ((*c < '0' || *c > '9') && *c != '.' && *c != 'e' && *c != 'E' && *c != '-' && *c != '+') {
+      return false;
+    }
+  }
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (errno != 0 || end == text || *end != '\0' || !(v >= 0.0) || v > max) return false;
+  out = v;
+  return true;
+}
+
 }  // namespace
 
 const char* usage_text() {
   return "usage: boticelli [options]\n"
          "  --world FILE        world to simulate (SDF subset; sim board only)\n"
+         "  --speed X           simulated time per wall time: 1 = real time, 0 = as fast\n"
+         "                      as possible (default; sim board only)\n"
          "  --seed N            random seed for the simulation and training (default 1)\n"
          "  --max-cycles N      stop after N Look-Think-Drive cycles (default: no limit)\n"
          "  --snapshots DIR     write a picture of the map after each cycle into DIR\n"
@@ -68,6 +87,11 @@ ParseResult parse_options(int argc, const char* const* argv, bool simulated, Opt
       out.resume = true;
     } else if (std::strcmp(arg, "--world") == 0) {
       if (!value(out.world_file)) return fail("option ", arg, " needs a FILE");
+      if (!simulated) return fail("option ", arg, " is only for the sim board");
+    } else if (std::strcmp(arg, "--speed") == 0) {
+      if (!value(v) || !parse_speed(v, 1000.0, out.speed)) {
+        return fail("option ", arg, " needs a number from 0 to 1000 (1 = real time)");
+      }
       if (!simulated) return fail("option ", arg, " is only for the sim board");
     } else if (std::strcmp(arg, "--seed") == 0) {
       if (!value(v) || !parse_u64(v, out.seed))

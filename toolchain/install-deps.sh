@@ -25,13 +25,18 @@ for arg in "$@"; do
   esac
 done
 
+# systemd: systemd-analyze for the unit's rating; libsdformat-dev: the test that loads every
+# world with SDFormat (tests only, never linked into the firmware).
 host_pkgs=(
-  g++ make cmake pkg-config clang-format file
+  g++ make cmake pkg-config clang-format file systemd
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
+  libsdformat-dev
 )
+# lintian: the rpi4 preset's test of the .deb (tests/packaging).
 cross_pkgs=(
   g++-aarch64-linux-gnu qemu-user
   libcpputest-dev:arm64 libgpiod-dev:arm64 libtinyxml2-dev:arm64 libpng-dev:arm64
+  lintian
 )
 armhf_pkgs=(
   g++-arm-linux-gnueabihf

@@ -2,6 +2,7 @@
 #include "rpi4_board.h"
 
 #include "../console_mode.h"
+#include "firmware/log.h"
 
 #include <cstdio>
 
@@ -65,7 +66,8 @@ bool Rpi4Board::init(const firmware::Options& options, char* error, std::size_t 
   }
   if (!status_led_.init()) {
     // The LED is only a signal: run without it.
-    std::fprintf(stderr, "boticelli: status LED unavailable (%s)\n", status_led_.error());
+    firmware::service_log().log(firmware::LogLevel::kWarn, "status LED unavailable (%s)",
+                                status_led_.error());
   }
   return true;
 }

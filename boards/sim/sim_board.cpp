@@ -43,6 +43,7 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   }
   if (!camera_.setup(settings_.camera_fps, error, error_size)) return false;
   console_.select(console_mode(options.console), options.console_path);
+  clock_.set_speed(options.speed);
   outline_count_ = circle_count_ = 0;
   for (std::size_t i = 0; i < world_.collider_count; ++i) {
     const hal::sim::Collider& c = world_.colliders[i];

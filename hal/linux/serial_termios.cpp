@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 
 #include "hal/linux/error_text.h"
 
@@ -79,11 +80,16 @@ bool SerialTermios::open() {
   }
   fd_ = ::open(config_.device, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) {
-    set_error(error_, "serial: open failed", errno);
+    // Name the device: the message is what an operator sees in the journal.
+    char what[160];
+    std::snprintf(what, sizeof what, "serial %s: open failed", config_.device);
+    set_error(error_, what, errno);
     return false;
   }
   if (::tcgetattr(fd_, &saved_) != 0) {
-    set_error(error_, "serial: not a terminal", errno);
+    char what[160];
+    std::snprintf(what, sizeof what, "serial %s: not a terminal", config_.device);
+    set_error(error_, what, errno);
     close();
     return false;
   }

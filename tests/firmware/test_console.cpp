@@ -126,6 +126,77 @@ TEST(ConsoleParser, SplitsWordsOnSpacesAndRefusesTooMany) {
   CHECK_FALSE(split_words("a b c d e", w));
 }
 
+TEST(LineAssembler, ReadsArrowKeysAsRecallWhenRecallIsOnAndIgnoresOtherSequences) {
+  a.set_recall(true);
+  feed("st\x1b[A\x1bOB\x1b[D\x1b[1;5Catus\r");
+  CHECK_EQUAL(3U, events.size());
+  CHECK(events[0] == LineEvent::kOlder);
+  CHECK(events[1] == LineEvent::kNewer);
+  CHECK(events[2] == LineEvent::kLine);
+  STRCMP_EQUAL("status", lines.at(0).c_str());
+  a.set_recall(false);
+  events.clear();
+  feed("st\x1b[Aatus\r");  // without recall an arrow key spoils the line, as before
+  CHECK_EQUAL(1U, events.size());
+  CHECK(events[0] == LineEvent::kBadByte);
+}
+
+TEST(LineAssembler, ShowsWhatIsTypedAndTakesAReplacement) {
+  feed("sta");
+  CHECK(a.typed() == "sta");
+  a.replace("pose");
+  CHECK(a.typed() == "pose");
+  feed("\r");
+  CHECK(a.typed().empty());
+  STRCMP_EQUAL("pose", lines.at(0).c_str());
+}
+
+TEST_GROUP(CommandHistory){};
+
+TEST(CommandHistory, RecallsOlderAndNewerLinesWithinItsCapacity) {
+  CommandHistory h;
+  std::string_view out = "unchanged";
+  CHECK_FALSE(h.older(out));
+  CHECK(out == "unchanged");
+  for (int i = 0; i < 20; ++i) h.add("cmd " + std::to_string(i));
+  h.add("cmd 19");  // a repeat of the newest is kept once
+  h.add("");
+  CHECK_EQUAL(CommandHistory::kEntries, h.size());
+  CHECK(h.older(out));
+  CHECK(out == "cmd 19");
+  CHECK(h.older(out));
+  CHECK(out == "cmd 18");
+  CHECK(h.newer(out));
+  CHECK(out == "cmd 19");
+  CHECK(h.newer(out));
+  CHECK(out.empty());
+  CHECK_FALSE(h.newer(out));
+  for (std::size_t i = 0; i < CommandHistory::kEntries; ++i) CHECK(h.older(out));
+  CHECK(out == "cmd 4");
+  CHECK_FALSE(h.older(out));
+}
+
+TEST_GROUP(LogRing) {
+  LogRing ring;
+};
+
+TEST(LogRing, KeepsTheLastLinesAndForgetsOverwrittenOnes) {
+  CHECK(ring.find(0) == nullptr);
+  for (int i = 0; i < 70; ++i) {
+    ring.add(static_cast<std::uint64_t>(i), LogLevel::kWarn, "line " + std::to_string(i));
+  }
+  CHECK_EQUAL(LogRing::kLines, ring.size());
+  CHECK_EQUAL(70U, ring.end_sequence());
+  CHECK(ring.find(5) == nullptr);
+  CHECK(ring.find(70) == nullptr);
+  const LogRing::Entry* e = ring.find(6);
+  CHECK(e != nullptr);
+  CHECK(e->view() == "line 6");
+  CHECK_EQUAL(6U, e->t_us);
+  ring.add(0, LogLevel::kInfo, std::string(300, 'x') + "\n");  // cut, one printable line
+  CHECK_EQUAL(LogRing::kTextBytes, ring.find(70)->view().size());
+}
+
 TEST(ConsoleParser, ReadsOnlyPlainDecimalNumbers) {
   float v = 0.0F;
   CHECK(parse_number("-1.5", v));
@@ -180,8 +251,9 @@ TEST_GROUP(Console) {
 TEST(Console, AnswersHelpWithEveryCommand) {
   const auto reply = command("help");
   CHECK_EQUAL("OK", reply.back());
-  for (const char* name : {"help", "status", "stats", "pose", "model", "map", "pause", "resume",
-                           "estop", "clear-estop", "get", "set", "log", "shutdown", "quit"}) {
+  for (const char* name :
+       {"help", "status", "stats", "pose", "model", "map", "pause", "resume", "estop",
+        "clear-estop", "get", "set", "log", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);
@@ -336,6 +408,99 @@ TEST(Console, EchoesTypedCharactersWhenAsked) {
   CHECK(port.written().rfind("poz\b \bse\r\npose x_m=", 0) == 0);
 }
 
+TEST(Console, RecallsTheLastCommandsWithUpAndDownWhenEchoIsOn) {
+  CHECK_EQUAL("OK", command("set echo 1").back());
+  command("pose");
+  port.clear_written();
+  port.feed("\x1b[A\x1b[A");  // up twice: "pose", then "set echo 1"
+  service(2);
+  CHECK_EQUAL(std::string("\r\x1b[Kpose\r\x1b[Kset echo 1"), port.written());
+  port.clear_written();
+  port.feed("\x1b[B\r");  // down: back to "pose", and run it
+  service(2);
+  CHECK(port.written().rfind("\r\x1b[Kpose\r\npose x_m=1.250", 0) == 0);
+}
+
+TEST(Console, IgnoresArrowKeysWithoutEchoAsBadCharacters) {
+  command("pose");
+  const auto reply = command("\x1b[A");
+  CHECK_EQUAL(1U, reply.size());
+  STRCMP_EQUAL("ERR bad character in line", reply[0].c_str());
+}
+
+TEST(Console, RedrawsAHalfTypedLineAfterTelemetryWhenEchoIsOn) {
+  CHECK_EQUAL("OK", command("set telemetry_ms 100").at(0));
+  CHECK_EQUAL("OK", command("set echo 1").at(0));
+  service(10);  // the telemetry line after the command, on a line of its own
+  port.clear_written();
+  port.feed("sta");
+  service(12);
+  const std::string out = port.written();
+  // The typed text first, then each telemetry line on a line of its own with the typed text
+  // after it again: never "staTLM ...".
+  CHECK(out.rfind("sta\r\x1b[KTLM t_s=", 0) == 0);
+  CHECK(out.find("staTLM") == std::string::npos);
+  CHECK(out.size() > 3 && out.substr(out.size() - 5) == "\r\nsta");
+  port.clear_written();
+  port.feed("tus\r");
+  service(1);
+  STRCMP_CONTAINS("tus\r\nstatus state=look", port.written().c_str());
+}
+
+TEST(Console, ShowsTheLastLogLinesFromItsRing) {
+  LogRing ring;
+  console.set_log_ring(&ring, &clock);
+  service(1);
+  console.log(LogLevel::kWarn, "first %d", 1);
+  clock.advance_us(1500000);
+  console.log(LogLevel::kInfo, "second %d", 2);
+  console.log(LogLevel::kDebug, "not kept at level info");
+  CHECK_EQUAL(2U, ring.size());
+  service(1);  // the LOG lines themselves go out first
+  auto reply = command("log show");
+  CHECK_EQUAL(3U, reply.size());
+  STRCMP_EQUAL("log t_s=0.000 warn first 1", reply[0].c_str());
+  STRCMP_EQUAL("log t_s=1.500 info second 2", reply[1].c_str());
+  CHECK_EQUAL("OK", reply[2]);
+  reply = command("log show 1");
+  CHECK_EQUAL(2U, reply.size());
+  STRCMP_EQUAL("log t_s=1.500 info second 2", reply[0].c_str());
+  for (const char* bad :
+       {"log show 0", "log show 65", "log show 1.5", "log show x", "log show 1 2"}) {
+    reply = command(bad);
+    CHECK_EQUAL_TEXT(1U, reply.size(), bad);
+    CHECK_TEXT(reply[0].rfind("ERR ", 0) == 0, bad);
+  }
+  // A full ring through a slow line: every line whole, then OK, and no LOG line inside. At
+  // level warn the info lines are not sent but still kept.
+  CHECK_EQUAL("log level=warn", command("log warn").at(0));
+  for (int i = 0; i < 100; ++i) {
+    console.log(LogLevel::kInfo, "line %03d %s", i, std::string(110, 'y').c_str());
+  }
+  port.set_write_limit(100);
+  port.clear_written();
+  port.feed("log show\r");
+  service(1);
+  console.log(LogLevel::kError, "during the reply");
+  service(400);
+  reply = lines_of(port.written());
+  // The reply's lines, its OK, and only then the LOG line logged while it was queued.
+  CHECK(reply.size() >= LogRing::kLines + 1);
+  STRCMP_CONTAINS("info line 036 yyy", reply[0].c_str());
+  STRCMP_CONTAINS("line 099", reply[LogRing::kLines - 1].c_str());
+  CHECK_EQUAL("OK", reply[LogRing::kLines]);
+  for (std::size_t i = 0; i < LogRing::kLines; ++i) CHECK(reply[i].rfind("log t_s=", 0) == 0);
+}
+
+TEST(Console, ReportsTheVersionAndTheBoard) {
+  console.set_board_name("sim");
+  const auto reply = command("ver");
+  CHECK_EQUAL(2U, reply.size());
+  STRCMP_CONTAINS("ver version=", reply[0].c_str());
+  STRCMP_CONTAINS(" board=sim", reply[0].c_str());
+  STRCMP_EQUAL("ERR ver takes no arguments", command("ver x").at(0).c_str());
+}
+
 TEST(Console, SendsTelemetryAtTheConfiguredPeriod) {
   CHECK_EQUAL("OK", command("set telemetry_ms 500").at(0));
   port.clear_written();
@@ -388,7 +553,12 @@ TEST(Console, HandlesBytesAndLinesWithoutAllocating) {
   port.clear_written();
   port.feed("status\rstats\rpose\rset gain 3\rget gain\rbogus\rlog debug\r");
   port.feed(std::string(300, 'z') + "\r\x1b[A\rhelp\r");
+  LogRing ring;
+  console.set_log_ring(&ring, &clock);
+  console.log(LogLevel::kWarn, "a line for log show");
+  port.feed("set echo 1\rver\rlog show\rlog show 3\r\x1b[A\x1b[A\x1b[B\rsta");
   CHECK_NO_ALLOCATION(service(50));
+  STRCMP_CONTAINS("warn a line for log show", port.written().c_str());
   CHECK(port.written().size() > 1000U);
   DOUBLES_EQUAL(3.0, gain, 0.0);
 }

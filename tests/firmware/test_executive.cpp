@@ -6,6 +6,7 @@
 #include "fake_clock.h"
 #include "firmware/device_tasks.h"
 #include "firmware/executive.h"
+#include "firmware/mission_view.h"
 #include "firmware/safety.h"
 #include "firmware/task_table.h"
 #include "firmware_fakes.h"
@@ -447,6 +448,63 @@ TEST(WatchdogTask, KicksOnlyWhileEveryTaskIsHealthy) {
   device.healthy_flag = true;
   for (int i = 0; i < 50; ++i) exec.run_frame();
   CHECK_EQUAL(10, watchdog.kicks);
+}
+
+namespace {
+class StateView final : public MissionView {
+ public:
+  const char* state_name() const override { return "drive"; }
+  boticelli::core::Pose2 pose() const override { return {}; }
+  float pan_rad() const override { return 0.0F; }
+  std::uint64_t cycles() const override { return 7; }
+  TargetEstimate target() const override { return {status, 2, 1.0F, 2.0F, 0.3F}; }
+  TargetStatus status = TargetStatus::kNone;
+};
+}  // namespace
+
+// The LED levels of the next second (ten watchdog runs, 100 frames), bit i = run i.
+static unsigned led_second(Executive& exec, const FakeOutput& led) {
+  unsigned bits = 0;
+  for (unsigned run = 0; run < 10; ++run) {
+    for (int f = 0; f < 10; ++f) exec.run_frame();
+    if (led.level) bits |= 1U << run;
+  }
+  return bits;
+}
+
+TEST(WatchdogTask, ShowsOkEstopFaultAndTargetFoundAsDistinctLedPatterns) {
+  FakeInput button, bumper;
+  FakeBase base;
+  Safety safety{button, bumper, base};
+  StateView view;
+  task.set_status_sources(&safety, &view);
+  TimedTask device(clock, 10);
+  CHECK(exec.add_task({"device", 10000, 500}, device, &error));
+  CHECK(exec.add_task({"watchdog", 100000, 200}, task, &error));
+  CHECK(exec.start(ExecutiveConfig{}, &error));
+  // The patterns differ from each other, and each is what the LED shows.
+  const LedPattern all[] = {LedPattern::kOk, LedPattern::kEstop, LedPattern::kFault,
+                            LedPattern::kTargetFound};
+  for (const LedPattern a : all) {
+    for (const LedPattern b : all) {
+      if (a != b) CHECK(led_pattern_bits(a) != led_pattern_bits(b));
+    }
+  }
+  CHECK_EQUAL(led_pattern_bits(LedPattern::kOk), led_second(exec, led));
+  CHECK(task.pattern() == LedPattern::kOk);
+  STRCMP_EQUAL("state=drive cycle=7 healthy=1 estop=none target=none", task.status_text());
+  view.status = TargetStatus::kSeen;  // one view is not yet the target found
+  CHECK_EQUAL(led_pattern_bits(LedPattern::kOk), led_second(exec, led));
+  view.status = TargetStatus::kConfirmed;
+  CHECK_EQUAL(led_pattern_bits(LedPattern::kTargetFound), led_second(exec, led));
+  STRCMP_EQUAL("state=drive cycle=7 healthy=1 estop=none target=confirmed", task.status_text());
+  safety.engage(StopCause::kConsole);  // the e-stop outranks the target
+  CHECK_EQUAL(led_pattern_bits(LedPattern::kEstop), led_second(exec, led));
+  STRCMP_EQUAL("state=drive cycle=7 healthy=1 estop=console target=confirmed", task.status_text());
+  device.healthy_flag = false;  // and a fault outranks everything
+  CHECK_EQUAL(led_pattern_bits(LedPattern::kFault), led_second(exec, led));
+  STRCMP_EQUAL("state=drive cycle=7 healthy=0 estop=console target=confirmed", task.status_text());
+  CHECK_EQUAL(10U, task.withheld());
 }
 
 TEST_GROUP(CameraTask) {

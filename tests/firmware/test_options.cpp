@@ -63,3 +63,22 @@ TEST(Options, ResumeNeedsAStateDirectory) {
   CHECK(parse_options(4, good, true, options).ok);
   CHECK(options.resume);
 }
+
+TEST(Options, TakesASpeedOnlyOnTheSimBoardAndOnlyFromZeroUp) {
+  CHECK(options.speed == 0.0);  // as fast as possible unless asked
+  const char* real_time[] = {"boticelli", "--speed", "1"};
+  CHECK(parse_options(3, real_time, true, options).ok);
+  DOUBLES_EQUAL(1.0, options.speed, 0.0);
+  const char* slow[] = {"boticelli", "--speed", "0.25"};
+  CHECK(parse_options(3, slow, true, options).ok);
+  DOUBLES_EQUAL(0.25, options.speed, 0.0);
+  for (const char* bad : {"-1", "", "x", "1e9", "inf", "nan", "0x2", "2s"}) {
+    const char* argv[] = {"boticelli", "--speed", bad};
+    const ParseResult r = parse_options(3, argv, true, options);
+    CHECK_FALSE_TEXT(r.ok, bad);
+    STRCMP_CONTAINS("'--speed' needs a number", r.error);
+  }
+  const ParseResult r = parse_options(3, real_time, false, options);
+  CHECK_FALSE(r.ok);
+  STRCMP_CONTAINS("sim board", r.error);
+}

@@ -186,7 +186,7 @@ TEST(SerialTermios, AFullLineAcceptsFewerBytesInsteadOfBlocking) {
 TEST(SerialTermios, RefusesAMissingDeviceWithAClearError) {
   SerialTermios s(SerialConfig{"/nonexistent/tty", 9600});
   CHECK_FALSE(s.open());
-  STRCMP_CONTAINS("open failed", s.error());
+  STRCMP_EQUAL("serial /nonexistent/tty: open failed: No such file or directory", s.error());
   std::uint8_t b = 0;
   CHECK_EQUAL(-1, s.read(&b, 1));
 }
@@ -201,7 +201,7 @@ TEST(SerialTermios, RefusesANonStandardBaudRate) {
 TEST(SerialTermios, RefusesAFileThatIsNotATerminal) {
   SerialTermios s(SerialConfig{"/dev/null", 9600});
   CHECK_FALSE(s.open());
-  STRCMP_CONTAINS("not a terminal", s.error());
+  STRCMP_CONTAINS("serial /dev/null: not a terminal", s.error());
 }
 
 TEST(SerialTermios, ReportsAFaultWhenThePeerHangsUp) {

@@ -1,5 +1,6 @@
 // Tests of the simulated devices: PTU and base kinematics in simulated time, collisions,
 // GPIO, lockstep clock, camera timing, watchdog, determinism.
+#include <ctime>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -386,4 +387,27 @@ TEST(SimDevices, AMissionLikeRunIsBitForBitRepeatableForASeed) {
   CHECK(a.pan == b.pan && a.collisions == b.collisions);
   CHECK(a.odo.x_m != c.odo.x_m);  // the odometry noise follows the seed
   CHECK(std::memcmp(&a.truth, &c.truth, sizeof a.truth) == 0);  // the truth does not
+}
+
+TEST(SimDevices, TheClockKeepsPaceWithWallTimeAtTheSpeedAskedAndRacesWithoutOne) {
+  start("rectangular_room");
+  ClockSim clock(g_sim);
+  const auto wall_s = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+  };
+  // Default: 2 s of simulated time in 10 ms frames take a small fraction of that.
+  double t0 = wall_s();
+  std::uint64_t sim_us = clock.now_us();
+  for (int i = 0; i < 200; ++i) clock.sleep_until_us(sim_us += 10000);
+  CHECK(wall_s() - t0 < 1.0);
+  // Speed 4: 0.8 s simulated take 0.2 s of wall time (the first frame sets the anchor).
+  clock.set_speed(4.0);
+  clock.sleep_until_us(sim_us += 10000);
+  t0 = wall_s();
+  for (int i = 0; i < 80; ++i) clock.sleep_until_us(sim_us += 10000);
+  const double took_s = wall_s() - t0;
+  DOUBLES_EQUAL(0.2, took_s, 0.05);
+  CHECK_EQUAL(sim_us, clock.now_us());
 }

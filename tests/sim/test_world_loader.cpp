@@ -266,6 +266,11 @@ TEST(WorldLoader, AMissingFileIsAnErrorNamingIt) {
   CHECK(std::strstr(g_error, "cannot open") != nullptr);
 }
 
+TEST(WorldLoader, ADirectoryIsAnErrorNamingItAndTheReason) {
+  CHECK_FALSE(load_world("/tmp", g_world, g_error, sizeof g_error));
+  STRCMP_EQUAL("/tmp: cannot read the world file: Is a directory", g_error);
+}
+
 TEST(WorldLoader, TooManyVisualsAreRejectedNotTruncated) {
   std::string models;
   for (std::size_t i = 0; i < kMaxSurfaces; ++i) {

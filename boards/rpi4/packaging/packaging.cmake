@@ -9,6 +9,28 @@ install(FILES ${BOTICELLI_PACKAGING_DIR}/boticelli.service
 install(FILES ${BOTICELLI_PACKAGING_DIR}/60-boticelli.rules DESTINATION lib/udev/rules.d)
 install(FILES ${PROJECT_SOURCE_DIR}/docs/flashing.md ${PROJECT_SOURCE_DIR}/docs/console.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR} OPTIONAL)
+install(FILES ${BOTICELLI_PACKAGING_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${BOTICELLI_PACKAGING_DIR}/boticelli.bash-completion
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions RENAME boticelli)
+
+# The changelog and the manual page gzipped as Debian wants them: maximum compression, no
+# name or time stamp in the header (gzip -9n), so the package is reproducible.
+set(boticelli_gz_dir ${CMAKE_CURRENT_BINARY_DIR}/packaging)
+set(boticelli_gz_files)
+foreach(pair "changelog;changelog.gz" "boticelli.8;boticelli.8.gz")
+  list(GET pair 0 source)
+  list(GET pair 1 output)
+  add_custom_command(
+    OUTPUT ${boticelli_gz_dir}/${output}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${boticelli_gz_dir}
+    COMMAND gzip -9nc ${BOTICELLI_PACKAGING_DIR}/${source} > ${boticelli_gz_dir}/${output}
+    DEPENDS ${BOTICELLI_PACKAGING_DIR}/${source}
+    COMMENT "gzip -9n ${source}" VERBATIM)
+  list(APPEND boticelli_gz_files ${boticelli_gz_dir}/${output})
+endforeach()
+add_custom_target(boticelli_package_docs ALL DEPENDS ${boticelli_gz_files})
+install(FILES ${boticelli_gz_dir}/changelog.gz DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${boticelli_gz_dir}/boticelli.8.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man8)
 
 if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64)$")
   set(BOTICELLI_DEB_ARCH arm64)
@@ -22,9 +44,20 @@ endif()
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME boticelli)
 set(CPACK_PACKAGE_VENDOR "Boticelli")
-set(CPACK_PACKAGE_CONTACT "Boticelli maintainers <boticelli@localhost>")
-set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
-    "Firmware of the Boticelli exploration robot (Raspberry Pi 4 board)")
+set(CPACK_PACKAGE_CONTACT "Boticelli maintainers <boticelli-maintainers@lists.example.org>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "firmware of the Boticelli exploration robot (Raspberry Pi 4)")
+# The extended description (control file lines after the summary).
+set(CPACK_DEBIAN_PACKAGE_DESCRIPTION
+    "Boticelli explores an unknown room with one camera on a pan-tilt unit and a\n\
+two-wheel ODrive base and finds a target without touching anything. It models\n\
+the room with a piecewise-linear occupancy function (an Adaptive Logic Network)\n\
+fitted to single-camera stereo, after D. O. Gorodnichy's thesis.\n\
+.\n\
+This package holds the firmware for the Raspberry Pi 4 reference robot as a\n\
+hardened systemd service with a software watchdog, the unit that brings up the\n\
+CAN interface, udev rules for the GPIO chip, watchdog and camera, the manual\n\
+page and bash completion. The serial console is documented in\n\
+/usr/share/doc/boticelli/console.md.")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
@@ -34,7 +67,15 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 # Runtime libraries of the rpi4 executable (see `readelf -d boticelli`), and what the
 # maintainer scripts and units call.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libgpiodcxx1 (>= 1.6), adduser, systemd, iproute2, udev")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libgpiodcxx1 (>= 1.6), adduser, systemd, init-system-helpers (>= 1.54~), iproute2, udev")
+# The console from a laptop or the robot itself, and CAN bring-up checks (docs/flashing.md).
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "picocom, can-utils")
+# A stripped binary in the package, its debug information in boticelli-dbgsym (a .ddeb):
+# CPack splits it off (objcopy --only-keep-debug, --strip-unneeded, a debug link), with the
+# target's binutils (CPACK_STRIP_FILES would strip before the split and lose it).
+set(CPACK_DEBIAN_DEBUGINFO_PACKAGE ON)
+set(CPACK_OBJCOPY_EXECUTABLE ${CMAKE_OBJCOPY})
+set(CPACK_READELF_EXECUTABLE ${CMAKE_READELF})
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${BOTICELLI_PACKAGING_DIR}/postinst ${BOTICELLI_PACKAGING_DIR}/prerm
     ${BOTICELLI_PACKAGING_DIR}/postrm)

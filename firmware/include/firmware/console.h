@@ -10,6 +10,7 @@
 #include "firmware/console_line.h"
 #include "firmware/console_parser.h"
 #include "firmware/executive.h"
+#include "firmware/log.h"
 #include "firmware/mission_view.h"
 #include "firmware/parameters.h"
 #include "firmware/safety.h"
@@ -17,10 +18,6 @@
 #include "hal/serial_port.h"
 
 namespace boticelli::firmware {
-
-enum class LogLevel : std::uint8_t { kError, kWarn, kInfo, kDebug };
-const char* log_level_name(LogLevel level);
-bool parse_log_level(std::string_view text, LogLevel& out);
 
 // Protocol (docs/console.md): one command per line; every command answers with its data
 // lines and then "OK", or with exactly one line "ERR <reason>" and no other effect.
@@ -38,6 +35,13 @@ class Console {
 
   // Registers the console's own parameters (telemetry_ms, echo); call once at init.
   bool register_parameters();
+  // The ring `log show` reads and every log line goes to (also while not shown), stamped
+  // with `clock`; and the board name `ver` reports. Optional, at init.
+  void set_log_ring(LogRing* ring, hal::Clock* clock) {
+    ring_ = ring;
+    clock_ = clock;
+  }
+  void set_board_name(const char* name) { board_name_ = name; }
   // The console task's body: flushes output, reads and executes input, sends telemetry.
   void service(std::uint64_t now_us);
   // Sends queued output only (no input, telemetry or health lines): for the shutdown drain.
@@ -66,6 +70,12 @@ class Console {
   void execute(std::string_view line);
   void reply_error(const char* reason);
   bool emit(std::string_view bytes);  // all or nothing into the ring
+  // A TLM or LOG line: never inside a reply being streamed; with echo on, a half-typed line
+  // is cleared first and typed again after it.
+  bool emit_unsolicited(std::string_view line);
+  bool streaming() const { return !model_pending_.empty() || log_streaming_; }
+  void stream_log();
+  void recall(bool older);
   std::size_t tx_free() const { return kTxBytes - tx_used_; }
   void flush();
   void stream_model();
@@ -85,6 +95,7 @@ class Console {
   void cmd_get(const Words& w);
   void cmd_set(const Words& w);
   void cmd_log(const Words& w);
+  void cmd_ver(const Words& w);
   void cmd_shutdown(const Words& w);
   void append_parameter(const Parameter& p);
 
@@ -97,6 +108,7 @@ class Console {
   ParameterTable& parameters_;
 
   LineAssembler line_;
+  CommandHistory history_;
   std::array<std::uint8_t, kReadChunkBytes> rx_{};
   std::size_t rx_pos_ = 0;
   std::size_t rx_len_ = 0;
@@ -107,6 +119,12 @@ class Console {
   TextBuffer<kReplyBytes> reply_;
 
   std::string_view model_pending_;  // rest of a `model` reply still to be queued
+  LogRing* ring_ = nullptr;
+  hal::Clock* clock_ = nullptr;
+  const char* board_name_ = "?";
+  bool log_streaming_ = false;  // a `log show` reply is being queued
+  std::uint64_t log_next_ = 0;  // its next line's sequence number in the ring
+  std::uint64_t log_end_ = 0;   // one past its last
 
   float telemetry_ms_ = 1000.0F;  // 0 = off
   float echo_ = 0.0F;             // 1 = echo typed characters (for terminals without local echo)

@@ -5,8 +5,10 @@
 
 #include "firmware/console.h"
 #include "firmware/executive.h"
+#include "firmware/mission_view.h"
 #include "firmware/safety.h"
 #include "firmware/service_notify.h"
+#include "firmware/text_buffer.h"
 #include "hal/hal.h"
 
 namespace boticelli::firmware {
@@ -97,23 +99,66 @@ class ConsoleTask final : public Task {
   Console& console_;
 };
 
+// What the status LED shows, most urgent first (docs/flashing.md): each pattern is ten
+// 100 ms steps, bit i = step i, repeated every second.
+enum class LedPattern : std::uint8_t {
+  kFault,        // a task unhealthy (watchdog withheld): double flash, 100 on 100 off 100 on
+  kEstop,        // e-stop latched (button, bumper, console): fast blink, 5 Hz
+  kTargetFound,  // the target confirmed by two views: steady on
+  kOk,           // running, healthy: slow blink, 1 Hz
+};
+constexpr std::uint16_t led_pattern_bits(LedPattern pattern) {
+  switch (pattern) {
+    case LedPattern::kFault:
+      return 0b0000000101;
+    case LedPattern::kEstop:
+      return 0b0101010101;
+    case LedPattern::kTargetFound:
+      return 0b1111111111;
+    case LedPattern::kOk:
+      return 0b0000011111;
+  }
+  return 0;
+}
+const char* led_pattern_name(LedPattern pattern);
+
 // Kicks /dev/watchdog and sends WATCHDOG=1 to systemd only while every task is healthy;
-// blinks the status LED while it does (steady off when it withholds the kick).
+// drives the status LED with the pattern of the robot's condition; once a second, when it
+// changed, reports the state to systemd as "STATUS=state=... cycle=N healthy=0|1 estop=...
+// target=..." (what `systemctl status` shows). Runs every 100 ms (kTaskTable).
 class WatchdogTask final : public Task {
  public:
   WatchdogTask(const Executive& executive, hal::Watchdog& watchdog, ServiceNotifier& notifier,
                hal::DigitalOut& led)
       : executive_(executive), watchdog_(watchdog), notifier_(notifier), led_(led) {}
+  // Where the e-stop and the mission's state come from (optional: without them only health).
+  void set_status_sources(const Safety* safety, const MissionView* view) {
+    safety_ = safety;
+    view_ = view;
+  }
   void run(std::uint64_t now_us) override;
   std::uint64_t kicks() const { return kicks_; }
   std::uint64_t withheld() const { return withheld_; }
+  LedPattern pattern() const { return pattern_; }
+  // The last STATUS= text sent (without the "STATUS=" prefix).
+  const char* status_text() const {
+    return status_.size() > kStatusPrefix ? status_.c_str() + kStatusPrefix : "";
+  }
 
  private:
+  static constexpr std::size_t kStatusPrefix = 7;  // "STATUS="
+  static constexpr std::uint32_t kStepsPerSecond = 10;
+  void report_status(bool healthy);
+
   const Executive& executive_;
   hal::Watchdog& watchdog_;
   ServiceNotifier& notifier_;
   hal::DigitalOut& led_;
-  bool led_on_ = false;
+  const Safety* safety_ = nullptr;
+  const MissionView* view_ = nullptr;
+  LedPattern pattern_ = LedPattern::kOk;
+  std::uint32_t step_ = 0;
+  TextBuffer<160> status_;
   std::uint64_t kicks_ = 0;
   std::uint64_t withheld_ = 0;
 };

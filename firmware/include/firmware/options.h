@@ -9,7 +9,8 @@ namespace boticelli::firmware {
 enum class ConsoleKind : std::uint8_t { kStdio, kPty, kPath };
 
 struct Options {
-  const char* world_file = nullptr;           // --world FILE (sim board only)
+  const char* world_file = nullptr;  // --world FILE (sim board only)
+  double speed = 0.0;  // --speed X (sim board only): simulated/wall time, 0 = as fast as possible
   std::uint64_t seed = 1;                     // --seed N
   std::uint64_t max_cycles = 0;               // --max-cycles N; 0 = no limit
   const char* snapshots_dir = nullptr;        // --snapshots DIR
@@ -29,7 +30,8 @@ struct ParseResult {
   const char* error = "";
 };
 
-// Parses argv[1..argc). `simulated` is false on hardware boards, where --world is refused.
+// Parses argv[1..argc). `simulated` is false on hardware boards, where --world and --speed
+// are refused.
 ParseResult parse_options(int argc, const char* const* argv, bool simulated, Options& out);
 
 // The usage text printed by --help and after a usage error.

@@ -580,8 +580,11 @@ bool load_world(const char* path, World& world, char* error, std::size_t error_s
   std::unique_ptr<char[]> text(new char[limit]);
   const std::size_t n = std::fread(text.get(), 1, limit, f);
   const bool read_error = std::ferror(f) != 0;
+  const int read_errno = errno;
   std::fclose(f);
-  if (read_error) return errors.fail(0, "cannot read the world file");
+  if (read_error) {
+    return errors.fail(0, "cannot read the world file: %s", std::strerror(read_errno));
+  }
   return parse_world(text.get(), n, path, world, error, error_size);
 }
 

@@ -1,5 +1,8 @@
-// ClockSim: lockstep simulated time; sleeping to a deadline steps the world to it.
+// ClockSim: lockstep simulated time; sleeping to a deadline steps the world to it, optionally
+// paced to wall time (--speed).
 #pragma once
+
+#include <cstdint>
 
 #include "hal/clock.h"
 #include "hal/sim/sim_world.h"
@@ -10,11 +13,19 @@ class ClockSim final : public Clock {
  public:
   explicit ClockSim(SimWorld& world) : world_(world) {}
   std::uint64_t now_us() override { return world_.now_us(); }
-  // Advances simulated time (and the PTU, base and contacts) to the deadline at once.
-  void sleep_until_us(std::uint64_t deadline_us) override { world_.advance_to(deadline_us); }
+  // Advances simulated time (and the PTU, base and contacts) to the deadline at once; with a
+  // speed, then waits until as much wall time has passed as simulated time, divided by the speed.
+  void sleep_until_us(std::uint64_t deadline_us) override;
+  // Simulated seconds per wall second: 1 = real time, 0 = as fast as possible (the default).
+  void set_speed(double speed);
+  double speed() const { return speed_; }
 
  private:
   SimWorld& world_;
+  double speed_ = 0.0;
+  bool anchored_ = false;
+  std::uint64_t anchor_sim_us_ = 0;   // simulated time at the anchor
+  std::uint64_t anchor_wall_ns_ = 0;  // CLOCK_MONOTONIC at the anchor
 };
 
 }  // namespace boticelli::hal::sim
