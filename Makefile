@@ -6,9 +6,11 @@ JOBS ?= $(shell nproc)
 WORLD ?= boards/sim/worlds/thesis_room.sdf
 ARGS ?=
 SUITE ?= all
+FUZZ_SECONDS ?= 60
 
-.PHONY: help deps deps-cross deps-armhf deps-bench run test check bench format format-check \
-        sim asan rpi4 armhf test-sim test-asan test-rpi4 clean
+.PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze run test check bench format \
+        format-check sim asan rpi4 armhf fuzz-build test-sim test-asan test-rpi4 test-fuzz fuzz \
+        analyze mutants clean
 
 help:
 	@echo "make run       install deps, build the sim preset, run the firmware on the sim board"
@@ -18,6 +20,9 @@ help:
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
 	@echo "make package-rpi4 / make deploy HOST=user@robot   build the arm64 .deb / install it over ssh"
 	@echo "make format    clang-format every C++ file; make format-check only reports"
+	@echo "make fuzz      run every libFuzzer target for FUZZ_SECONDS (default 60) each"
+	@echo "make analyze   clang-tidy and cppcheck over the tree (zero findings expected)"
+	@echo "make mutants   apply each tools/mutants patch to a scratch copy; all must be caught"
 
 deps:
 	@toolchain/install-deps.sh
@@ -27,6 +32,8 @@ deps-armhf:
 	@toolchain/install-deps.sh --armhf
 deps-bench:
 	@toolchain/install-deps.sh --bench
+deps-analyze:
+	@toolchain/install-deps.sh --analyze
 
 # configure+build one preset: $(call build,PRESET)
 define build
@@ -42,6 +49,8 @@ rpi4: deps-cross
 	$(call build,rpi4)
 armhf: deps-armhf
 	$(call build,armhf)
+fuzz-build: deps
+	$(call build,fuzz)
 
 SNAPSHOTS ?= build/run-snapshots
 run: sim
@@ -57,8 +66,31 @@ test-rpi4: rpi4
 	@file -L build/rpi4/bin/boticelli | grep -q 'ARM aarch64' \
 	  || { echo "build/rpi4/bin/boticelli is not an aarch64 binary" >&2; exit 1; }
 
-test: test-sim test-asan test-rpi4
-	@echo "make test: sim, asan and rpi4 (qemu-aarch64) presets passed"
+# The fuzz preset's ctest: every fuzzer replays its corpus and fuzzes a few seconds
+# (FUZZ_TEST_SECONDS in tests/fuzz/CMakeLists.txt), and the ThreadSanitizer test runs.
+test-fuzz: fuzz-build
+	ctest --preset fuzz -j $(JOBS)
+
+test: test-sim test-asan test-rpi4 test-fuzz
+	@echo "make test: sim, asan, rpi4 (qemu-aarch64) and fuzz presets passed"
+
+# Each fuzzer for FUZZ_SECONDS from its corpus and dictionary; new inputs are kept in
+# build/fuzz/tests/fuzz/new/NAME (copy the worth-keeping ones to tests/fuzz/corpus/NAME).
+fuzz: fuzz-build
+	@set -e; for f in build/fuzz/bin/fuzz_*; do \
+	  n=$$(basename $$f); mkdir -p build/fuzz/tests/fuzz/new/$$n; \
+	  echo "== $$n ($(FUZZ_SECONDS) s)"; \
+	  $$f -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -dict=tests/fuzz/dict/$$n.dict \
+	    -print_final_stats=1 build/fuzz/tests/fuzz/new/$$n tests/fuzz/corpus/$$n; \
+	done
+
+# clang-tidy (.clang-tidy) over the sim build's compile commands and cppcheck over the
+# sources; both must report nothing (docs/testing.md). Not part of make test: it takes long.
+analyze: deps-analyze sim
+	tools/analyze.sh
+
+mutants: deps
+	JOBS=$(JOBS) tools/mutants/run.sh
 
 check: test-sim
 

@@ -315,16 +315,29 @@ void Console::cmd_model(const Words& w) {
 
 void Console::stream_model() {
   if (model_pending_.empty()) return;
-  // Queue the text in pieces as the ring drains; then end the reply.
+  // Queue the text in pieces as the ring drains; then end the reply. Each piece ends at a
+  // newline at the latest, and a bare LF (the ALN writer's line end) goes out as CRLF like
+  // every console line; a CR LF in the text is kept as it is (never split between pieces).
   while (!model_pending_.empty()) {
     const std::size_t room = tx_free();
     if (room < 64) return;
-    const std::size_t n = model_pending_.size() < room - 32 ? model_pending_.size() : room - 32;
-    const bool last = n == model_pending_.size();
-    emit(model_pending_.substr(0, n));
+    std::size_t n = model_pending_.size() < room - 32 ? model_pending_.size() : room - 32;
+    const std::size_t nl = model_pending_.substr(0, n).find('\n');
+    if (nl != std::string_view::npos) {
+      n = nl + 1;
+      if (nl > 0 && model_pending_[nl - 1] == '\r') {
+        emit(model_pending_.substr(0, n));
+      } else {
+        emit(model_pending_.substr(0, nl));
+        emit(kEol);
+      }
+    } else {
+      if (n < model_pending_.size() && model_pending_[n - 1] == '\r') --n;
+      emit(model_pending_.substr(0, n));
+    }
     model_pending_.remove_prefix(n);
-    if (last) {
-      // model_pending_ is empty now; the text's last byte decides whether a line end is due.
+    if (model_pending_.empty()) {
+      // The text's last byte decides whether a line end is due.
       break;
     }
     flush();

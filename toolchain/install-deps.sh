@@ -8,6 +8,7 @@
 #                                        the :armhf libraries (armhf preset)
 #   toolchain/install-deps.sh --bench    also the peers the benchmarks compare against
 #                                        (OpenCV, OctoMap); never needed by the firmware
+#   toolchain/install-deps.sh --analyze  also clang-tidy and cppcheck (make analyze)
 #
 # Idempotent: when everything is present it prints nothing and exits 0.
 set -euo pipefail
@@ -15,20 +16,23 @@ set -euo pipefail
 want_cross=0
 want_bench=0
 want_armhf=0
+want_analyze=0
 for arg in "$@"; do
   case "$arg" in
     --cross) want_cross=1 ;;
     --bench) want_bench=1 ;;
     --armhf) want_armhf=1 ;;
-    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --analyze) want_analyze=1 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-deps: unknown option '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done
 
 # systemd: systemd-analyze for the unit's rating; libsdformat-dev: the test that loads every
-# world with SDFormat (tests only, never linked into the firmware).
+# world with SDFormat (tests only, never linked into the firmware); clang-14 with its runtime
+# (libFuzzer, sanitizers): the fuzz preset, which make test runs.
 host_pkgs=(
-  g++ make cmake pkg-config clang-format file systemd
+  g++ make cmake pkg-config clang-format file systemd clang-14 libclang-rt-14-dev
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
   libsdformat-dev
 )
@@ -43,11 +47,13 @@ armhf_pkgs=(
   libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf
 )
 bench_pkgs=(libopencv-dev liboctomap-dev)
+analyze_pkgs=(clang-tidy-14 cppcheck)
 
 pkgs=("${host_pkgs[@]}")
 [ "$want_cross" = 1 ] && pkgs+=("${cross_pkgs[@]}")
 [ "$want_armhf" = 1 ] && pkgs+=("${armhf_pkgs[@]}")
 [ "$want_bench" = 1 ] && pkgs+=("${bench_pkgs[@]}")
+[ "$want_analyze" = 1 ] && pkgs+=("${analyze_pkgs[@]}")
 
 if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
   echo "install-deps: this script needs a Debian-based system (dpkg and apt-get); install by hand: ${pkgs[*]}" >&2

@@ -25,6 +25,11 @@ namespace odrive = codec::odrive;
 namespace {
 
 constexpr const char* kSide[2] = {"left", "right"};
+// Encoder estimates beyond these are corrupt, not motion (finite, as the codec checks, but
+// they would overflow the odometry to infinity): 1e7 turns is where a float position no
+// longer resolves a turn; 1000 turns/s (60000 rpm) is beyond any wheel motor.
+constexpr float kMaxPlausiblePosTurns = 1e7F;
+constexpr float kMaxPlausibleVelTurnsS = 1000.0F;
 
 can_frame to_os(const odrive::CanFrame& f) {
   can_frame out{};
@@ -236,6 +241,11 @@ void BaseOdriveCan::receive(std::uint64_t now_us) {
       a.heartbeat_seen = true;
       a.last_heartbeat_us = now_us;
     } else if (m.command == odrive::Command::kGetEncoderEstimates) {
+      if (!(std::fabs(m.encoder.pos_turns) <= kMaxPlausiblePosTurns &&
+            std::fabs(m.encoder.vel_turns_s) <= kMaxPlausibleVelTurnsS)) {
+        ++rejected_frames_;
+        continue;
+      }
       a.encoder = m.encoder;
       a.encoder_seen = true;
       a.encoder_fresh = true;

@@ -1,6 +1,7 @@
 // Tests of ALN inversion in a monotone input (thesis §5.4.1).
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -101,6 +102,56 @@ TEST(AlnInvert, RangesAndBoundsMoveWithTheirVariables) {
   DOUBLES_EQUAL(100.0, g_inv.weight_hi(2), 1e-12);
   // m = 0.5 + 0.02 (r - 50) -> r = 50 + 50 (m - 0.5): m = 0.7 gives r = 60 dm.
   DOUBLES_EQUAL(60.0, g_inv.evaluate(Model::Vec(1.0, 5.0, 0.7)).value, 1e-12);
+}
+
+TEST(AlnInvert, TheBoundsOfADecreasingVariableAreTheReciprocalsInTheirOrder) {
+  // m = 0.5 - 0.02 (r - 50) with the slope bounded to [-0.5, -0.01]: dr/dm = 1 / (dm/dr)
+  // lies in [1 / -0.01, 1 / -0.5] = [-100, -2], and with an upper bound of 0, below -2.
+  Model f;
+  f.set_input_range(2, 0.0, 100.0);
+  f.set_weight_bounds(2, -0.5, -0.01);
+  aln::Piece<double, 3> p;
+  p.set(Model::Vec(0.0, 0.0, -0.02), Model::Vec(0.0, 10.0, 50.0), 0.5);
+  f.reset(p);
+  CHECK(aln::invert(f, 2, g_inv));
+  DOUBLES_EQUAL(-100.0, g_inv.weight_lo(2), 1e-12);
+  DOUBLES_EQUAL(-2.0, g_inv.weight_hi(2), 1e-12);
+  CHECK(g_inv.pieces_within_bounds());
+  DOUBLES_EQUAL(40.0, g_inv.evaluate(Model::Vec(1.0, 5.0, 0.7)).value, 1e-12);
+  f.set_weight_bounds(2, -0.5, 0.0);
+  CHECK(aln::invert(f, 2, g_inv));
+  CHECK(std::isinf(g_inv.weight_lo(2)) && g_inv.weight_lo(2) < 0.0);
+  DOUBLES_EQUAL(-2.0, g_inv.weight_hi(2), 1e-12);
+  // Inverting back gives the original bounds again.
+  f.set_weight_bounds(2, -0.5, -0.01);
+  CHECK(aln::invert(f, 2, g_inv));
+  CHECK(aln::invert(g_inv, 2, g_back));
+  DOUBLES_EQUAL(-0.5, g_back.weight_lo(2), 1e-12);
+  DOUBLES_EQUAL(-0.01, g_back.weight_hi(2), 1e-12);
+}
+
+TEST(AlnInvert, EveryPieceOfAnInvertedRandomModelIsInsideTheInvertedBounds) {
+  aln_test::Rng rng(31);
+  for (const double sign : {1.0, -1.0}) {
+    aln_test::random_model(g_f, 24, rng, 2);
+    double lo = 1e9;
+    double hi = -1e9;
+    for (std::size_t q = 0; q < g_f.piece_count(); ++q) {
+      aln::Piece<double, 3>& piece = g_f.piece(q);
+      Model::Vec w = piece.weight;
+      w(2) = sign * std::fabs(w(2));
+      piece.set(w, piece.centroid, piece.centroid_output);
+      lo = std::fmin(lo, w(2));
+      hi = std::fmax(hi, w(2));
+    }
+    g_f.set_weight_bounds(2, lo, hi);
+    CHECK(g_f.pieces_within_bounds());
+    CHECK(aln::invert(g_f, 2, g_inv));
+    CHECK(g_inv.pieces_within_bounds());
+    CHECK(g_inv.weight_lo(2) <= g_inv.weight_hi(2));
+  }
+  g_f.set_weight_bounds(2, -std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity());
 }
 
 TEST(AlnInvert, ANonMonotoneVariableIsRefused) {

@@ -1,8 +1,10 @@
 // Tests of ALN training: exact recovery, constrained fits, robust weights, resumable slices.
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -198,6 +200,64 @@ TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
   CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
   CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
   CHECK(same_model(g_model3, g_model3b));
+}
+
+TEST(AlnTrain, DifferentSeedsGiveDifferentModelsOfTheSameQuality) {
+  // The seed only jitters the split tilts: another seed, another model, fitted as well.
+  const std::size_t n = fill_room(2000, 0.0, 12);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.03;
+  cfg.seed = 5;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const double rms5 = g_trainer3.stats().rms;
+  cfg.seed = 6;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  const double rms6 = g_trainer3.stats().rms;
+  CHECK_FALSE(same_model(g_model3, g_model3b));
+  CHECK(rms5 < 0.03 && rms6 < 0.03);
+}
+
+TEST(AlnTrain, EveryPieceOfATrainedModelIsResponsibleForSomeSample) {
+  // Pieces no sample uses are pruned after each round (they would only cost evaluation
+  // time and could take over where there are no data).
+  for (const std::uint64_t seed : {3U, 31U, 77U}) {
+    const std::size_t n = fill_room(3000, 0.1, seed);
+    set_room_ranges(g_model3);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = 0.02;
+    cfg.max_iterations = 10;
+    g_trainer3.configure(cfg);
+    CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+    CHECK(g_model3.piece_count() > 4);
+    std::array<std::uint8_t, 256> used{};
+    for (std::size_t k = 0; k < n; ++k)
+      used[g_model3.evaluate_alpha_beta(g_samples3[k].x).piece] = 1;
+    std::size_t unused = 0;
+    for (std::size_t p = 0; p < g_model3.piece_count(); ++p) unused += used[p] == 0 ? 1U : 0U;
+    LONGS_EQUAL(0, unused);
+  }
+}
+
+TEST(AlnTrain, MoreSplitRoundsNeverGiveAWorseFit) {
+  // A round whose splits did not lower the error is undone, so the error of the model
+  // training ends with never rises with the number of rounds allowed.
+  const std::size_t n = fill_room(3000, 0.3, 77);
+  set_room_ranges(g_model3);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.02;
+  double previous = 1e9;
+  for (std::size_t rounds = 1; rounds <= 12; ++rounds) {
+    cfg.max_iterations = rounds;
+    g_trainer3.configure(cfg);
+    CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+    const double rms = g_trainer3.stats().rms;
+    CHECK_TEXT(rms <= previous * (1.0 + 1e-9), std::to_string(rounds).c_str());
+    previous = rms;
+  }
 }
 
 TEST(AlnTrain, RobustWeightsStopOutliersForcingExtraPieces) {

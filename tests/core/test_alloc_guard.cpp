@@ -1,5 +1,8 @@
 // Tests of the allocation guard: it must catch allocations and stay quiet on allocation-free code.
+#include <malloc.h>
+
 #include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <numeric>
 #include <vector>
@@ -36,6 +39,59 @@ TEST(AllocationGuard, CatchesADirectMalloc) {
   }
   std::free(p);
   CHECK(seen > 0);
+}
+
+// CppUTest's `new` macro (leak detection with file and line) has no over-aligned form; the
+// plain new-expressions below must reach the replaceable aligned operator new.
+#undef new
+
+namespace {
+struct alignas(128) CacheLines {
+  unsigned char bytes[256];
+};
+}  // namespace
+
+TEST(AllocationGuard, CatchesOverAlignedNew) {
+  static_assert(alignof(CacheLines) > __STDCPP_DEFAULT_NEW_ALIGNMENT__);
+  CacheLines* volatile one = nullptr;
+  CacheLines* volatile many = nullptr;
+  std::size_t seen_one = 0;
+  std::size_t seen_many = 0;
+  {
+    boticelli::test::AllocationGuard guard;
+    one = new CacheLines{};
+    seen_one = guard.allocations();
+    many = new CacheLines[3];
+    seen_many = guard.allocations() - seen_one;
+  }
+  CHECK(reinterpret_cast<std::uintptr_t>(one) % 128 == 0);
+  CHECK(reinterpret_cast<std::uintptr_t>(many) % 128 == 0);
+  delete one;
+  delete[] many;
+  CHECK(seen_one > 0);
+  CHECK(seen_many > 0);
+}
+
+TEST(AllocationGuard, CatchesEachAlignedAllocationCall) {
+  void* p = nullptr;
+  void* volatile q = nullptr;
+  void* volatile r = nullptr;
+  std::size_t seen[3] = {};
+  {
+    boticelli::test::AllocationGuard guard;
+    CHECK_EQUAL(0, posix_memalign(&p, 64, 100));
+    seen[0] = guard.allocations();
+    q = std::aligned_alloc(64, 128);
+    seen[1] = guard.allocations() - seen[0];
+    r = memalign(64, 100);
+    seen[2] = guard.allocations() - seen[0] - seen[1];
+  }
+  std::free(p);
+  std::free(q);
+  std::free(r);
+  CHECK(seen[0] > 0);
+  CHECK(seen[1] > 0);
+  CHECK(seen[2] > 0);
 }
 
 TEST(AllocationGuard, CatchesADynamicEigenMatrix) {

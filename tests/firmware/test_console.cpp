@@ -1,5 +1,6 @@
 // Tests of the serial console: line assembly, parsing with hostile input, every command, telemetry,
 // no allocation.
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -326,6 +327,28 @@ TEST(Console, StreamsAModelLargerThanItsOutputBufferThroughASlowLine) {
   CHECK_EQUAL("OK", reply[0]);  // model's end
   STRCMP_CONTAINS("status state=look", reply[1].c_str());
   CHECK_EQUAL("OK", reply[2]);
+}
+
+TEST(Console, SendsEachLineOfAModelWithBareLineFeedsAsACrLfLine) {
+  // The ALN writer ends lines with "\n"; on the console every line ends with CRLF.
+  std::string text;
+  while (text.size() < 2 * Console::kTxBytes) text += "0 : 0.125 (x0 - 1) - 1 (x3 - 0.5);\n";
+  text += "BLOCKS = 1;\n0 : MIN(0, 1);";  // no final newline: the console adds it
+  view.model = text;
+  port.set_write_limit(100);
+  port.clear_written();
+  port.feed("model\r");
+  service(600);
+  const std::string& out = port.written();
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (out[i] == '\n') CHECK_TEXT(i > 0 && out[i - 1] == '\r', "a bare LF");
+    if (out[i] == '\r') CHECK_TEXT(i + 1 < out.size() && out[i + 1] == '\n', "a bare CR");
+  }
+  const auto lines = lines_of(out);
+  CHECK_EQUAL(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 2,
+              lines.size());
+  CHECK_EQUAL("0 : MIN(0, 1);", lines[lines.size() - 2]);
+  CHECK_EQUAL("OK", lines.back());
 }
 
 TEST(Console, PausesAndResumesTheBackgroundWork) {

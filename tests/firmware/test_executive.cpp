@@ -416,6 +416,23 @@ TEST(Safety, StaysLatchedUntilClearedAndRefusesToClearWhileAnInputIsActive) {
   CHECK(base.health() == boticelli::hal::BaseHealth::kReady);
 }
 
+TEST(Safety, ABumperReleasedAndHitAgainBetweenTwoPollsCountsAsASecondCollision) {
+  bumper.press();
+  safety.poll();
+  CHECK_EQUAL(1U, safety.collisions());
+  safety.poll();  // still in contact: the same collision
+  CHECK_EQUAL(1U, safety.collisions());
+  bumper.edge = true;  // let go and hit again within one frame: the level never dropped
+  safety.poll();
+  CHECK_EQUAL(2U, safety.collisions());
+  bumper.level = false;
+  safety.poll();
+  bumper.press();  // a new contact after a poll saw it released
+  safety.poll();
+  CHECK_EQUAL(3U, safety.collisions());
+  CHECK(safety.cause() == StopCause::kBumper);
+}
+
 TEST(Safety, StopsTheBaseAgainIfSomethingResumesItBehindTheLatch) {
   safety.engage(StopCause::kConsole);
   base.health_ = boticelli::hal::BaseHealth::kReady;

@@ -88,6 +88,14 @@ void write_file(const std::string& path, const std::string& bytes) {
   std::fclose(f);
 }
 
+// A file body with its checksum line appended: a file that passes the CRC, so the body
+// parser is what accepts or rejects it.
+std::string with_crc(const std::string& body) {
+  char line[32];
+  std::snprintf(line, sizeof line, "crc32 %08x\n", crc32(body.data(), body.size()));
+  return body + line;
+}
+
 }  // namespace
 
 TEST_GROUP(Persistence) {
@@ -166,11 +174,6 @@ TEST(Persistence, RejectsAnyFlippedByte) {
 TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
   // A file whose CRC is right but whose content is not valid (as from a buggy writer).
   const char* why = "";
-  auto with_crc = [](std::string body) {
-    char line[32];
-    std::snprintf(line, sizeof line, "crc32 %08x\n", crc32(body.data(), body.size()));
-    return body + line;
-  };
   const std::string head = "BOTICELLI-STATE 1\ncycle 3\nseed 1\npose 0 0 0\ngoal none\n";
   const std::string tail = "exploration 0\nmodel 0\n\nlog 0\nend\n";
   std::string f = with_crc(head + "obstacles 1\n1 2\n" + tail);
@@ -188,6 +191,34 @@ TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
         std::string("cycle 3\n")}) {
     f = with_crc(body);
     CHECK_FALSE_TEXT(decode_state(f, g_b, &why), body.c_str());
+  }
+}
+
+TEST(Persistence, AWellChecksummedFileMustEndWithItsEndLine) {
+  const char* why = "";
+  const std::string head =
+      "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal none\nobstacles 0\n"
+      "exploration 0\nmodel 0\n\nlog 1\n2 saved\n";
+  CHECK_TRUE_TEXT(decode_state(with_crc(head + "end\n"), g_b, &why), why);
+  for (const char* last : {"END\n", "en\n", "end \n", "3 saved\n", "\n", "endx\n"}) {
+    CHECK_FALSE_TEXT(decode_state(with_crc(head + last), g_b, &why), last);
+    CHECK_EQUAL(0U, g_b.cycle);
+  }
+}
+
+TEST(Persistence, AWellChecksummedLogLineWithAControlCharacterIsRejected) {
+  // The log is shown on the console: a control byte in it (an escape sequence, a NUL, a
+  // DEL) could do anything to the operator's terminal.
+  const char* why = "";
+  const std::string head =
+      "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal none\nobstacles 0\n"
+      "exploration 0\nmodel 0\n\nlog 1\n2 ";
+  CHECK_TRUE_TEXT(decode_state(with_crc(head + "plain text ~!\nend\n"), g_b, &why), why);
+  for (const std::string& bad :
+       {std::string("a\x1b[2Jb"), std::string("tab\there"), std::string("nul\0x", 5),
+        std::string("del\x7f"), std::string("cr\rx"), std::string("high\xc3\xa9")}) {
+    CHECK_FALSE_TEXT(decode_state(with_crc(head + bad + "\nend\n"), g_b, &why), bad.c_str());
+    CHECK_EQUAL(0U, g_b.log.size());
   }
 }
 

@@ -257,6 +257,27 @@ TEST(BaseOdriveCan, MalformedFramesAreCountedAndChangeNothing) {
   DOUBLES_EQUAL(before.x_m, rig.base->odometry().x_m, 0.02);
 }
 
+TEST(BaseOdriveCan, ImpossibleButFiniteEncoderEstimatesAreRejectedAndTheOdometryStaysFinite) {
+  // Found by fuzzing: a velocity of -3.4e38 turns/s made the odometry's speed infinite.
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 20; ++i) rig.cycle();
+  const auto before = rig.base->odometry();
+  const std::uint32_t rejected = rig.base->rejected_frames();
+  rig.emu.send_frame(od::encode_encoder_estimates(3, {8.0F, -3.4028e38F}));
+  rig.emu.send_frame(od::encode_encoder_estimates(4, {3e38F, 1.0F}));
+  rig.emu.send_frame(od::encode_encoder_estimates(3, {-2e7F, 0.0F}));
+  rig.emu.send_frame(od::encode_encoder_estimates(4, {0.0F, 1001.0F}));
+  rig.base->update();
+  CHECK_EQUAL(rejected + 4U, rig.base->rejected_frames());
+  const auto after = rig.base->odometry();
+  CHECK(std::isfinite(after.x_m) && std::isfinite(after.y_m) && std::isfinite(after.yaw_rad));
+  CHECK(std::isfinite(after.v_m_s) && std::isfinite(after.omega_rad_s));
+  DOUBLES_EQUAL(before.x_m, after.x_m, 0.02);
+  CHECK(rig.base->health() == BaseHealth::kReady);
+}
+
 TEST(BaseOdriveCan, BadGeometryIsRefusedAtInit) {
   BaseOdriveCanConfig bc = Rig::config();
   bc.geometry.wheel_radius_m = 0.0F;

@@ -156,10 +156,44 @@ TEST(OdriveCanFrames, NonFiniteFloatsAreRejectedWithoutTouchingTheOutput) {
   CHECK(od::decode(f, m) == od::DecodeStatus::kNotFinite);
 }
 
+TEST(OdriveCanFrames, ANonFiniteVelocityIsRejectedAsMuchAsANonFinitePosition) {
+  od::Message m;
+  m.encoder.vel_turns_s = 7.0F;
+  for (const float bad :
+       {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+        -std::numeric_limits<float>::infinity()}) {
+    CHECK(od::decode(od::encode_encoder_estimates(1, {1.0F, bad}), m) ==
+          od::DecodeStatus::kNotFinite);
+    CHECK_EQUAL(7.0F, m.encoder.vel_turns_s);
+    CHECK(od::decode(od::encode_set_input_vel(1, 0.5F, bad), m) == od::DecodeStatus::kNotFinite);
+  }
+}
+
 TEST(OdriveCanFrames, ARemoteFrameIsARequestNotData) {
   od::Message m;
   CHECK(od::decode(od::encode_encoder_request(3), m) == od::DecodeStatus::kRemoteRequest);
   CHECK(m.command == od::Command::kGetEncoderEstimates);
+}
+
+TEST(OdriveCanFrames, ARemoteFrameOfAnyCommandIsNeverDecodedAsData) {
+  // An RTR frame carries no payload even when its dlc says 8: a remote heartbeat must not
+  // read as a healthy axis (or as an error) from whatever the data bytes hold.
+  od::Message m;
+  od::CanFrame f = od::encode_heartbeat(2, {0x800U, 8, 0, true});
+  f.remote = true;
+  m.heartbeat.axis_error = 5;
+  CHECK(od::decode(f, m) == od::DecodeStatus::kRemoteRequest);
+  CHECK(m.command == od::Command::kHeartbeat);
+  CHECK_EQUAL(5U, m.heartbeat.axis_error);
+  const od::CanFrame host[] = {od::encode_estop(2),
+                               od::encode_set_axis_state(2, od::AxisState::kIdle),
+                               od::encode_set_controller_mode(2, od::ControlMode::kVelocityControl,
+                                                              od::InputMode::kPassthrough),
+                               od::encode_set_input_vel(2, 1.0F), od::encode_clear_errors(2)};
+  for (od::CanFrame h : host) {
+    h.remote = true;
+    CHECK(od::decode(h, m) == od::DecodeStatus::kRemoteRequest);
+  }
 }
 
 TEST(OdriveCanFrames, DecodingDoesNotAllocate) {

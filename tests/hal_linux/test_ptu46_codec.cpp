@@ -194,6 +194,13 @@ TEST(Ptu46Lines, NonPrintableBytesMarkTheLineCorrupt) {
   STRCMP_EQUAL(std::string("#*\x01 5|* 6").c_str(), lines_of(a, "*\x01 5\n* 6\n").c_str());
 }
 
+TEST(Ptu46Lines, DelAndBytesWithTheHighBitSetMarkTheLineCorruptToo) {
+  // Line noise at the wrong baud rate shows up as bytes above 0x7E as often as below 0x20.
+  ptu::LineAssembler a;
+  STRCMP_EQUAL(std::string("#* 5\x7f|#*\x80 6|#\xff*|* 7").c_str(),
+               lines_of(a, "* 5\x7f\n*\x80 6\n\xff*\n* 7\n").c_str());
+}
+
 TEST(Ptu46Lines, ResetForgetsAHalfLine) {
   ptu::LineAssembler a;
   lines_of(a, "* 99");

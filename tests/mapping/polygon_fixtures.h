@@ -66,6 +66,51 @@ inline void random_star_polygon(Random& rng, mapping::StarPolygon& out, std::siz
   }
 }
 
+// The shrink tests' oracle, independent of the code under test: the smallest distance [m]
+// from the segment [0, p] (robot frame) to the boundary of `region`, by brute force over
+// every edge, with the vertices computed here from ρ_k and the angle 2πk/n (the shrink and
+// mapping::sweep_clearance_m share their vertex and segment code; this shares none).
+inline double reference_sweep_clearance_m(const mapping::StarPolygon& region, core::Point2 p) {
+  struct V {
+    double x;
+    double y;
+  };
+  const auto point_segment = [](V q, V a, V b) {
+    const double ex = b.x - a.x;
+    const double ey = b.y - a.y;
+    const double len2 = ex * ex + ey * ey;
+    double t = len2 > 0.0 ? ((q.x - a.x) * ex + (q.y - a.y) * ey) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    return std::hypot(q.x - (a.x + t * ex), q.y - (a.y + t * ey));
+  };
+  // Sign of the turn a -> b -> c (cross product of b - a and c - a).
+  const auto orient = [](V a, V b, V c) {
+    const double z = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    return z > 0.0 ? 1 : (z < 0.0 ? -1 : 0);
+  };
+  const std::size_t n = region.vertex_count();
+  const V o{0.0, 0.0};
+  const V q{static_cast<double>(p.x_m), static_cast<double>(p.y_m)};
+  const auto vertex = [&](std::size_t k) {
+    const double a =
+        2.0 * 3.14159265358979323846 * static_cast<double>(k % n) / static_cast<double>(n);
+    const double r = static_cast<double>(region.rho_m(k % n));
+    return V{r * std::cos(a), r * std::sin(a)};
+  };
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < n; ++j) {
+    const V a = vertex(j);
+    const V b = vertex(j + 1);
+    // Crossing segments (proper crossings only: a touch gives distance 0 below anyway).
+    if (orient(o, q, a) * orient(o, q, b) < 0 && orient(a, b, o) * orient(a, b, q) < 0) {
+      return 0.0;
+    }
+    best = std::min({best, point_segment(o, a, b), point_segment(q, a, b), point_segment(a, o, q),
+                     point_segment(b, o, q)});
+  }
+  return best;
+}
+
 // A wall segment in the world frame [m].
 struct Wall {
   core::Point2 a;

@@ -22,6 +22,12 @@ Point2 random_point_inside(Random& rng, const StarPolygon& p) {
   return {d * std::cos(a), d * std::sin(a)};
 }
 
+// The swept disc's clearance by the tests' own oracle (polygon_fixtures.h), which shares no
+// code with the shrink it checks.
+float clearance_m(const StarPolygon& free, Point2 p) {
+  return static_cast<float>(boticelli::test::reference_sweep_clearance_m(free, p));
+}
+
 }  // namespace
 
 TEST_GROUP(StarPolygon){};
@@ -94,13 +100,11 @@ TEST(Shrink, TheRobotDiscNeverLeavesTheFreeRegionOnAnyStraightPathToAPointInside
     for (std::size_t k = 0; k < nav.vertex_count(); ++k) {
       const Point2 v = nav.vertex(k);
       const Point2 w = nav.vertex((k + 1) % nav.vertex_count());
-      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(free, v));
-      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(
-                                   free, {0.5F * (v.x_m + w.x_m), 0.5F * (v.y_m + w.y_m)}));
+      worst = std::fmin(worst, clearance_m(free, v));
+      worst = std::fmin(worst, clearance_m(free, {0.5F * (v.x_m + w.x_m), 0.5F * (v.y_m + w.y_m)}));
     }
     for (int i = 0; i < 150; ++i) {
-      worst = std::fmin(worst,
-                        boticelli::mapping::sweep_clearance_m(free, random_point_inside(rng, nav)));
+      worst = std::fmin(worst, clearance_m(free, random_point_inside(rng, nav)));
     }
     CHECK_TRUE(worst >= kRadius - 1e-5F);
   }
@@ -121,11 +125,10 @@ TEST(Shrink, StaysSafeForFewAndForTheMostVertices) {
     }
     float worst = 1e9F;
     for (std::size_t k = 0; k < nav.vertex_count(); ++k) {
-      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(free, nav.vertex(k)));
+      worst = std::fmin(worst, clearance_m(free, nav.vertex(k)));
     }
     for (int i = 0; i < 100; ++i) {
-      worst = std::fmin(worst,
-                        boticelli::mapping::sweep_clearance_m(free, random_point_inside(rng, nav)));
+      worst = std::fmin(worst, clearance_m(free, random_point_inside(rng, nav)));
     }
     CHECK_TRUE(worst >= kRadius - 1e-5F);
   }
@@ -135,15 +138,18 @@ TEST(Shrink, IsTightAlongTheVertexRaysAndLosesAlmostNoArea) {
   // Exact, not merely safe: along almost every vertex ray the disc touches the boundary
   // 5 mm beyond the shrunk vertex. Where the free distance jumps between two rays the
   // straight edge would cut the disc's round path around the corner, so one vertex is
-  // pulled in; the area lost to that stays under 1% of the largest polygon of this form
-  // (each vertex at its exact limit on its ray, found by bisection with the brute force).
+  // pulled in, the one that keeps the larger triangle; the area lost to that is compared
+  // with the largest polygon of this form (each vertex at its exact limit on its ray, found
+  // by bisection with the independent oracle). Measured on these eight rooms: 0.13-0.48%
+  // lost, 0.31% in all; keeping the smaller triangle instead loses 0.30-1.15%, 0.74% in all.
   Random rng(5);
   constexpr float kRadius = 0.2F;
   auto clear = [](const StarPolygon& free, float a, float d) {
-    return boticelli::mapping::sweep_clearance_m(free, {d * std::cos(a), d * std::sin(a)}) >=
-           kRadius;
+    return clearance_m(free, {d * std::cos(a), d * std::sin(a)}) >= kRadius;
   };
-  for (int trial = 0; trial < 4; ++trial) {
+  double area = 0.0;
+  double limit_area = 0.0;
+  for (int trial = 0; trial < 8; ++trial) {
     StarPolygon free;
     boticelli::test::random_star_polygon(rng, free);
     StarPolygon nav;
@@ -165,8 +171,11 @@ TEST(Shrink, IsTightAlongTheVertexRaysAndLosesAlmostNoArea) {
       limit.set_rho_m(k, lo);
     }
     CHECK_TRUE(tight >= nav.vertex_count() * 94 / 100);
-    CHECK_TRUE(nav.area_m2() >= 0.99F * limit.area_m2());
+    CHECK_TRUE(nav.area_m2() >= 0.994F * limit.area_m2());
+    area += static_cast<double>(nav.area_m2());
+    limit_area += static_cast<double>(limit.area_m2());
   }
+  CHECK_TRUE(area >= 0.995 * limit_area);
 }
 
 TEST(Shrink, ADiscAlreadyTouchingAnObstacleLeavesNowhereToGo) {
@@ -200,19 +209,16 @@ TEST(Shrink, StaysSafeAndTightWhenJaggedWallsComeCloseToTheRobot) {
     for (std::size_t k = 0; k < nav.vertex_count(); ++k) {
       const Point2 v = nav.vertex(k);
       const Point2 w = nav.vertex((k + 1) % nav.vertex_count());
-      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(free, v));
-      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(
-                                   free, {0.5F * (v.x_m + w.x_m), 0.5F * (v.y_m + w.y_m)}));
+      worst = std::fmin(worst, clearance_m(free, v));
+      worst = std::fmin(worst, clearance_m(free, {0.5F * (v.x_m + w.x_m), 0.5F * (v.y_m + w.y_m)}));
       const float a = nav.angle_rad(k);
       const float beyond = nav.rho_m(k) + 0.005F;
-      if (boticelli::mapping::sweep_clearance_m(
-              free, {beyond * std::cos(a), beyond * std::sin(a)}) < kRadius) {
+      if (clearance_m(free, {beyond * std::cos(a), beyond * std::sin(a)}) < kRadius) {
         ++tight;
       }
     }
     for (int i = 0; i < 300; ++i) {
-      worst = std::fmin(worst,
-                        boticelli::mapping::sweep_clearance_m(free, random_point_inside(rng, nav)));
+      worst = std::fmin(worst, clearance_m(free, random_point_inside(rng, nav)));
     }
     CHECK_TRUE(worst >= kRadius - 1e-5F);
     CHECK_TRUE(tight >= nav.vertex_count() * 90 / 100);
@@ -294,9 +300,56 @@ TEST(Shrink, StraightWallsSeenHeadOnStopEveryRayIncludingThoseThroughTheJoints) 
     }
     float worst = 1e9F;
     for (std::size_t k = 0; k < n; ++k) {
-      worst = std::fmin(worst, boticelli::mapping::sweep_clearance_m(square, nav.vertex(k)));
+      worst = std::fmin(worst, clearance_m(square, nav.vertex(k)));
       CHECK_TRUE(nav.rho_m(k) <= square.rho_m(k) - 0.3F + 1e-5F);
     }
     CHECK_TRUE(worst >= 0.3F - 1e-5F);
+  }
+}
+
+TEST(Shrink, TheLibrarysSweepClearanceAgreesWithTheIndependentReference) {
+  // mapping::sweep_clearance_m (used by the planning tests) against the oracle, on points
+  // inside, on and outside jagged polygons.
+  Random rng(41);
+  for (int trial = 0; trial < 6; ++trial) {
+    StarPolygon free;
+    boticelli::test::random_star_polygon(rng, free, trial % 2 == 0 ? 360 : 37);
+    for (int i = 0; i < 300; ++i) {
+      const float a = rng.uniform(0.0F, 6.2831853F);
+      const float d = rng.uniform(0.0F, 1.2F) * free.radius_at_m(a);
+      const Point2 q{d * std::cos(a), d * std::sin(a)};
+      DOUBLES_EQUAL(boticelli::test::reference_sweep_clearance_m(free, q),
+                    boticelli::mapping::sweep_clearance_m(free, q), 1e-5);
+    }
+  }
+}
+
+TEST(Shrink, OnStraightWallsEveryVertexLiesOnTheExactOffsetWithinAMicrometre) {
+  // Square rooms (their corners on vertex rays, so every edge lies on a wall) at many
+  // resolutions, sizes and robot radii: the shrunk room is the square moved in by R, so
+  // each vertex is at (side − R) / max(|cos θ|, |sin θ|), computed here directly. A ray
+  // through the joint of two collinear inner sides that slips between them in rounding is
+  // only caught later by the chord check and ends micrometres short.
+  for (const std::size_t n :
+       {std::size_t{8}, std::size_t{16}, std::size_t{24}, std::size_t{36}, std::size_t{72},
+        std::size_t{120}, std::size_t{240}, std::size_t{360}, std::size_t{720}}) {
+    for (const double side : {0.9, 1.0, 1.7}) {
+      StarPolygon square(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double a = 2.0 * 3.14159265358979 * static_cast<double>(k) / static_cast<double>(n);
+        square.set_rho_m(k, static_cast<float>(
+                                side / std::fmax(std::fabs(std::cos(a)), std::fabs(std::sin(a)))));
+      }
+      for (const float radius : {0.1F, 0.2F, 0.25F, 0.3F, 0.45F}) {
+        StarPolygon nav;
+        CHECK_TRUE(boticelli::mapping::shrink_by_radius(square, radius, nav));
+        for (std::size_t k = 0; k < n; ++k) {
+          const double a = 2.0 * 3.14159265358979 * static_cast<double>(k) / static_cast<double>(n);
+          const double exact = (side - static_cast<double>(radius)) /
+                               std::fmax(std::fabs(std::cos(a)), std::fabs(std::sin(a)));
+          DOUBLES_EQUAL(exact, nav.rho_m(k), 1e-6);
+        }
+      }
+    }
   }
 }

@@ -8,9 +8,12 @@
 namespace boticelli::test {
 
 // While a guard lives, every operator new / new[] (through CppUTest's allocators, which
-// Debian's static CppUTest routes the global operator new to) and every malloc, calloc
-// and realloc made by the test binary's code (linked with --wrap) is counted. Guards do
-// not nest. Use CHECK_NO_ALLOCATION for the common case.
+// Debian's static CppUTest routes the global operator new to), every over-aligned new
+// (replaced in alloc_guard.cpp) and every malloc, calloc, realloc, posix_memalign,
+// aligned_alloc and memalign made by the test binary's code (linked with --wrap) is counted.
+// Not seen: allocations made inside shared libraries (libc's own, e.g. by fopen, strdup or
+// getaddrinfo; libstdc++'s, e.g. of exceptions; libpng's) and mmap or sbrk called directly
+// (docs/testing.md). Guards do not nest. Use CHECK_NO_ALLOCATION for the common case.
 class AllocationGuard {
  public:
   AllocationGuard();

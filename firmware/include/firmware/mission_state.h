@@ -26,7 +26,7 @@ struct MissionState {
   // holds and a restored one fits back into it.
   static constexpr std::size_t kMaxObstaclePoints = mapping::kMaxObstaclePoints;
   static constexpr std::size_t kMaxExplorationPoints = mapping::kMaxExplorationPoints;
-  static constexpr std::size_t kMaxModelBytes = 64 * 1024;
+  static constexpr std::size_t kMaxModelBytes = std::size_t{64} * 1024;
   static constexpr std::size_t kMaxLogEntries = 128;
 
   std::uint64_t cycle = 0;  // completed cycles

@@ -63,7 +63,7 @@ class StateStore {
     crash_hook_ = hook;
     crash_context_ = context;
   }
-  static constexpr std::size_t kWriteChunkBytes = 16 * 1024;
+  static constexpr std::size_t kWriteChunkBytes = std::size_t{16} * 1024;
 
  private:
   std::array<char, 512> dir_{};

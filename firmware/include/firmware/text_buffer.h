@@ -15,7 +15,7 @@ class TextBufferBase {
 
   // Appends formatted text; on overflow keeps what fits, sets truncated() and returns false.
   bool appendf(const char* format, ...) __attribute__((format(printf, 2, 3)));
-  bool vappendf(const char* format, std::va_list args);
+  bool vappendf(const char* format, std::va_list args) __attribute__((format(printf, 2, 0)));
   bool append(std::string_view text);
   void clear() {
     size_ = 0;
