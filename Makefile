@@ -15,7 +15,8 @@ FUZZ_SECONDS ?= 60
 help:
 	@echo "make run       install deps, build the sim preset, run the firmware on the sim board"
 	@echo "make test      install deps, build and test the sim, asan and rpi4 (qemu) presets"
-	@echo "make check     build and test the sim preset only (fast iteration)"
+	@echo "make test-sim  build and test the sim preset only (fast iteration)"
+	@echo "make check     format-check and analyze (about 15 min on two cores)"
 	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
 	@echo "make package-rpi4 / make deploy HOST=user@robot   build the arm64 .deb / install it over ssh"
@@ -84,15 +85,21 @@ fuzz: fuzz-build
 	    -print_final_stats=1 build/fuzz/tests/fuzz/new/$$n tests/fuzz/corpus/$$n; \
 	done
 
-# clang-tidy (.clang-tidy) over the sim build's compile commands and cppcheck over the
-# sources; both must report nothing (docs/testing.md). Not part of make test: it takes long.
-analyze: deps-analyze sim
-	tools/analyze.sh
+# clang-tidy (.clang-tidy) over the sim and rpi4 presets' compile commands (configured, not
+# built) and cppcheck over the sources; both must report nothing (docs/testing.md). Not part
+# of make test: it takes long.
+analyze: deps-analyze deps-cross
+	cmake --preset sim >/dev/null
+	cmake --preset rpi4 >/dev/null
+	JOBS=$(JOBS) tools/analyze.sh
 
 mutants: deps
 	JOBS=$(JOBS) tools/mutants/run.sh
 
-check: test-sim
+# The checks that read the code instead of running it (docs/testing.md).
+check: deps
+	$(MAKE) format-check
+	$(MAKE) analyze
 
 bench: deps-bench
 	$(call build,sim)

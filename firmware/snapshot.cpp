@@ -89,9 +89,9 @@ constexpr std::uint16_t glyph_bits(const char* rows) {
 
 constexpr std::array<std::uint16_t, 128> make_font_table() {
   std::array<std::uint16_t, 128> table{};
-  for (const Glyph& g : kFont) table[static_cast<std::size_t>(g.c)] = glyph_bits(g.rows);
+  for (const Glyph& g : kFont) table[static_cast<unsigned char>(g.c)] = glyph_bits(g.rows);
   for (char c = 'a'; c <= 'z'; ++c) {
-    table[static_cast<std::size_t>(c)] = table[static_cast<std::size_t>(c - 'a' + 'A')];
+    table[static_cast<unsigned char>(c)] = table[static_cast<unsigned char>(c - 'a' + 'A')];
   }
   return table;
 }

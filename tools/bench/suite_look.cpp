@@ -350,7 +350,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
   const hal::PanTiltLimits lim = settings.physics.ptu.limits;
   const std::vector<firmware::mission::LookView> views = look_views(params, lim);
   const stereo::CameraIntrinsics& cam = rig.camera();
-  const std::size_t stride = 2U * cam.width_px;
+  const std::size_t stride = std::size_t{2} * cam.width_px;
   std::vector<std::uint8_t> first_yuyv(stride * cam.height_px);
   std::vector<std::uint8_t> second_yuyv(stride * cam.height_px);
   const float height = config.robot_height_m;

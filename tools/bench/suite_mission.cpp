@@ -143,6 +143,7 @@ int run_firmware(const std::vector<std::string>& args, const std::string& out_pa
   timed_out = false;
   cpu_s = std::numeric_limits<double>::quiet_NaN();
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   const pid_t pid = ::fork();
@@ -256,7 +257,7 @@ void remove_tree(const std::string& dir) {
     while (const dirent* e = ::readdir(d)) {
       const std::string n = e->d_name;
       if (n == "." || n == "..") continue;
-      const std::string p = dir + "/" + n;
+      const std::string p = std::string(dir).append("/").append(n);
       if (::unlink(p.c_str()) != 0) remove_tree(p);
     }
     ::closedir(d);
@@ -293,7 +294,7 @@ int run() {
   std::size_t successes = 0;
   double spl_sum = 0.0;
   for (const std::string& name : names) {
-    const std::string world_path = folder + "/" + name + ".sdf";
+    const std::string world_path = std::string(folder).append("/").append(name).append(".sdf");
     char error[256] = "";
     if (!hal::sim::load_world(world_path.c_str(), g_world, error, sizeof error)) {
       std::fprintf(stderr, "mission: %s\n", error);

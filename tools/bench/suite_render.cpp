@@ -50,7 +50,7 @@ int bench_world(const char* name, int rounds) {
     std::fprintf(stderr, "render: %s\n", error);
     return 1;
   }
-  const std::size_t bytes = 2U * rig.camera().width_px * rig.camera().height_px;
+  const std::size_t bytes = std::size_t{2} * rig.camera().width_px * rig.camera().height_px;
   std::unique_ptr<std::uint8_t[]> image(new std::uint8_t[bytes]);
   // Places: the start, and the start moved 1 m along each axis when that is free.
   boticelli::core::Pose2 places[5];
@@ -74,7 +74,7 @@ int bench_world(const char* name, int rounds) {
           const std::int64_t c0 = thread_cpu_ns();
           const std::int64_t t0 = boticelli::bench::now_ns();
           renderer.render(pose, static_cast<std::uint32_t>(frames), image.get(),
-                          2U * rig.camera().width_px, nullptr);
+                          std::size_t{2} * rig.camera().width_px, nullptr);
           const std::int64_t dt = boticelli::bench::now_ns() - t0;
           cpu_ns += thread_cpu_ns() - c0;
           boticelli::bench::do_not_optimize(image[bytes / 2]);

@@ -364,7 +364,8 @@ std::vector<evidence::Reading> SyntheticRoom::generate_camera_readings(
   for (std::size_t image = 0; image < images; ++image) {
     // Images share the features evenly; the first ones take the remainder.
     const std::size_t quota = features / images + (image < features % images ? 1 : 0);
-    const double pan = pan_offset + kTwoPi * static_cast<double>(image / tilts) /
+    const std::size_t pan_index = image / tilts;  // each pan position takes `tilts` images
+    const double pan = pan_offset + kTwoPi * static_cast<double>(pan_index) /
                                         static_cast<double>(scan.pan_positions);
     const double tilt = scan.tilt_rad[image % tilts];
     const double cp = std::cos(pan);

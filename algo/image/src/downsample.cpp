@@ -32,7 +32,7 @@ bool downsample_yuyv(const std::uint8_t* yuyv, std::uint32_t width, std::uint32_
     std::array<std::uint16_t, std::size_t{LowResFrame::kMaxWidth} * 8> rows{};
     const std::size_t row_bytes = std::size_t{low_w} * 8;
     for (std::uint32_t lv = 0; lv < low_h; ++lv) {
-      const std::uint8_t* r0 = yuyv + std::size_t{lv * 4} * stride_bytes;
+      const std::uint8_t* r0 = yuyv + std::size_t{lv} * 4 * stride_bytes;
       const std::uint8_t* r1 = r0 + stride_bytes;
       const std::uint8_t* r2 = r1 + stride_bytes;
       const std::uint8_t* r3 = r2 + stride_bytes;

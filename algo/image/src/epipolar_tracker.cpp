@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 namespace boticelli::image {
@@ -24,7 +25,7 @@ Window window_of(const LowResFrame& frame, int u, int v) {
   const float centre = y[v * w + u];
   int k = 0;
   for (int dv = -kHalfWindow; dv <= kHalfWindow; ++dv) {
-    const float* row = y + (v + dv) * w + u - kHalfWindow;
+    const float* row = y + std::ptrdiff_t{v + dv} * w + u - kHalfWindow;
     for (int du = 0; du < 5; ++du) {
       out.values[static_cast<std::size_t>(k++)] = row[du] - centre;
     }
@@ -42,7 +43,7 @@ float error_against(const Window& feature, const LowResFrame& frame, int u, int 
   float e = 0.0F;
   int k = 0;
   for (int dv = -kHalfWindow; dv <= kHalfWindow; ++dv) {
-    const float* row = y + (v + dv) * w + u - kHalfWindow;
+    const float* row = y + std::ptrdiff_t{v + dv} * w + u - kHalfWindow;
     for (int du = 0; du < 5; ++du) {
       const float d = feature.values[static_cast<std::size_t>(k++)] - (row[du] - centre);
       e += d * d;
@@ -75,7 +76,7 @@ float bilinear(const LowResFrame& frame, float x, float y) {
   const float fx = x - static_cast<float>(x0);
   const float fy = y - static_cast<float>(y0);
   const auto w = static_cast<int>(frame.width);
-  const float* p = frame.luma.data() + y0 * w + x0;
+  const float* p = frame.luma.data() + std::ptrdiff_t{y0} * w + x0;
   const float top = p[0] + fx * (p[1] - p[0]);
   const float bottom = p[w] + fx * (p[w + 1] - p[w]);
   return top + fy * (bottom - top);

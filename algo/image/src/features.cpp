@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace boticelli::image {
 
@@ -26,7 +27,7 @@ std::size_t FeatureSelector::select(const LowResFrame& frame, const BandGeometry
     return 0;
   }
   const float* y = frame.luma.data();
-  const auto at = [w](int u, int v) { return static_cast<std::size_t>(v * w + u); };
+  const auto at = [w](int u, int v) { return static_cast<std::size_t>(std::ptrdiff_t{v} * w + u); };
   // |∂Y/∂v| by central difference on the band grown by one pixel.
   for (int v = v0 - 1; v <= v1 + 1; ++v) {
     for (int u = u0 - 1; u <= u1 + 1; ++u) {

@@ -7,10 +7,11 @@
 namespace boticelli::firmware {
 
 struct RealtimeConfig {
-  bool lock_memory = true;                        // mlockall(MCL_CURRENT | MCL_FUTURE)
-  std::size_t prefault_stack_bytes = 256 * 1024;  // stack touched once so no page fault later
-  bool fifo = true;                               // SCHED_FIFO when permitted
-  int fifo_priority = 50;                         // 1..99
+  bool lock_memory = true;  // mlockall(MCL_CURRENT | MCL_FUTURE)
+  std::size_t prefault_stack_bytes =
+      std::size_t{256} * 1024;  // stack touched once so no page fault later
+  bool fifo = true;             // SCHED_FIFO when permitted
+  int fifo_priority = 50;       // 1..99
 };
 
 struct RealtimeReport {

@@ -95,8 +95,8 @@ class SnapshotWriter {
   // libpng 1.6.39 + zlib 1.2.13 (level 3, 32 KB window, memLevel 8) take 286,336 bytes in 11
   // calls for this canvas, zlib's deflate state being most of it (measured; the same every
   // image, since libpng frees nothing that is not reused): 512 KB leaves a margin of 1.8x.
-  static constexpr std::size_t kArenaBytes = 512 * 1024;
-  static constexpr std::size_t kOutputBufferBytes = 64 * 1024;
+  static constexpr std::size_t kArenaBytes = std::size_t{512} * 1024;
+  static constexpr std::size_t kOutputBufferBytes = std::size_t{64} * 1024;
   static constexpr std::size_t kDirMax = 256;
 
   SnapshotWriter() = default;

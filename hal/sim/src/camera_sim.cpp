@@ -40,7 +40,7 @@ CameraPoll CameraSim::poll(Frame& frame) {
   next_capture_us_ += (late + 1) * period_us_;
   last_pose_ = world_.camera_pose();
   const std::uint32_t width = renderer_.width_px();
-  renderer_.render(last_pose_, sequence_, image_.get(), 2U * width,
+  renderer_.render(last_pose_, sequence_, image_.get(), std::size_t{2} * width,
                    depth_enabled_ ? depth_.get() : nullptr);
   frame.data = image_.get();
   frame.width_px = width;

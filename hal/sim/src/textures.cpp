@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <vector>
 
@@ -20,7 +21,7 @@ class ValueNoise {
         cells_y_(cells_y),
         span_x_(kTextureSize / cells_x),
         span_y_(kTextureSize / cells_y),
-        lattice_(cells_x * cells_y),
+        lattice_(std::size_t{cells_x} * cells_y),
         weight_x_(span_x_),
         weight_y_(span_y_) {
     for (std::uint32_t cy = 0; cy < cells_y; ++cy) {
@@ -42,8 +43,8 @@ class ValueNoise {
     const std::uint32_t y0 = y / span_y_;
     const std::uint32_t y1 = (y0 + 1U) % cells_y_;
     const float ty = weight_y_[y % span_y_];
-    const float* l0 = &lattice_[y0 * cells_x_];
-    const float* l1 = &lattice_[y1 * cells_x_];
+    const float* l0 = &lattice_[std::size_t{y0} * cells_x_];
+    const float* l1 = &lattice_[std::size_t{y1} * cells_x_];
     std::uint32_t x = 0;
     for (std::uint32_t cx = 0; cx < cells_x_; ++cx) {
       const std::uint32_t cx1 = (cx + 1U) % cells_x_;
@@ -77,7 +78,7 @@ void make_camouflage(std::uint32_t seed, std::uint8_t* packed) {
     coarse.add_row(y, 0.62F, row.data());
     medium.add_row(y, 0.28F, row.data());
     fine.add_row(y, 0.10F, row.data());
-    std::uint8_t* out = packed + y * (kTextureSize / 4U);
+    std::uint8_t* out = packed + std::size_t{y} * (kTextureSize / 4U);
     for (std::uint32_t x = 0; x < kTextureSize; x += 4U) {
       std::uint32_t byte = 0;
       for (std::uint32_t k = 0; k < 4U; ++k) {
@@ -103,6 +104,9 @@ void make_leaves(std::uint32_t seed, std::uint8_t* out) {
     streaks.add_row(y, 0.7F, row.data());
     broad.add_row(y, 0.3F, row.data());
     for (std::uint32_t x = 0; x < kTextureSize; ++x) {
+      // bugprone-incorrect-roundings: the tone is 70-190 (row is in [0, 1]), where adding 0.5
+      // and truncating rounds half up, as lround does but for the float just below .5.
+      // NOLINTNEXTLINE(bugprone-incorrect-roundings)
       out[y * kTextureSize + x] = static_cast<std::uint8_t>(70.0F + 120.0F * row[x] + 0.5F);
     }
   }

@@ -323,8 +323,10 @@ double shortest_path_m(const World& world, core::Point2 start, core::Point2 goal
   const long ny = j1 - j0 + 1;
   if (nx <= 0 || ny <= 0 || nx * ny > 40000000L) return kInf;  // beyond 1000 m worlds' sense
   auto node_point = [&](long k) {
-    return Vec{s.x + static_cast<double>(i0 + k % nx) * kCellM,
-               s.y + static_cast<double>(j0 + k / nx) * kCellM};
+    const long column = k % nx;  // node k of the nx-by-ny grid, row by row
+    const long row = k / nx;
+    return Vec{s.x + static_cast<double>(i0 + column) * kCellM,
+               s.y + static_cast<double>(j0 + row) * kCellM};
   };
   const auto count = static_cast<std::size_t>(nx * ny);
   std::vector<float> clearance(count);

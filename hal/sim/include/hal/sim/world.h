@@ -76,6 +76,9 @@ struct Collider {
   int line = 0;
 };
 
+// bugprone-reserved-identifier: clang-tidy 14 reports the `__i0` loop variable the compiler
+// makes up for the implicit copy assignment of the array members, not a name written here.
+// NOLINTNEXTLINE(bugprone-reserved-identifier)
 struct World {
   char name[kMaxNameLength + 1] = {};
   Rgb ambient{0.5F, 0.5F, 0.5F};
