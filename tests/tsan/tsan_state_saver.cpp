@@ -54,8 +54,13 @@ int main() {
     saver->start();
     for (std::uint64_t c = 1; c <= 200; ++c) {
       make_state(c, g_state);
-      while (!saver->submit(g_state)) {
-        (void)saver->saved();  // read the counters while the writer updates them
+      // Read the counters after every submit, taken or not: the writer updates them after
+      // each save, with no other hand-over in between, so an unguarded access races with it
+      // for certain, not only when the try_lock happens to meet the writer.
+      bool taken = false;
+      while (!taken) {
+        taken = saver->submit(g_state);
+        (void)saver->saved();
         (void)saver->failures();
         saver->last_error(error, sizeof error);
       }
