@@ -38,7 +38,7 @@ void robust_stats(const std::array<std::uint32_t, 256>& histogram, std::size_t c
       inside += histogram[static_cast<std::size_t>(mid - d)];
     }
     if (mid + d <= 255) {
-      inside += histogram[static_cast<std::size_t>(mid + d)];
+      inside += histogram[static_cast<std::size_t>(mid) + static_cast<std::size_t>(d)];
     }
   }
   median = static_cast<float>(mid);
@@ -376,7 +376,8 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
 bool FloorCue::floor_coverage(float tilt_rad, float& near_m, float& far_m) const {
   const CameraPose pose = rig_.camera_pose(0.0F, tilt_rad);
   const CameraIntrinsics& camera = rig_.low_res_camera();
-  const auto u = static_cast<float>(camera.width_px / 2);
+  const std::uint32_t centre_column = camera.width_px / 2;  // the middle column, a whole pixel
+  const auto u = static_cast<float>(centre_column);
   near_m = std::numeric_limits<float>::infinity();
   far_m = 0.0F;
   bool any = false;

@@ -24,8 +24,8 @@ CameraIntrinsics CameraIntrinsics::downsampled(std::uint32_t factor) const {
 }
 
 Eigen::Vector2f CameraIntrinsics::normalized_from_pixel(const Eigen::Vector2f& pixel) const {
-  const Eigen::Vector2f distorted((pixel.x() - principal_x_px) / focal_px,
-                                  (pixel.y() - principal_y_px) / focal_px);
+  Eigen::Vector2f distorted((pixel.x() - principal_x_px) / focal_px,
+                            (pixel.y() - principal_y_px) / focal_px);
   if (radial_k1 == 0.0F) {
     return distorted;
   }
