@@ -8,10 +8,10 @@ namespace boticelli::firmware {
 
 struct RealtimeConfig {
   bool lock_memory = true;  // mlockall(MCL_CURRENT | MCL_FUTURE)
-  std::size_t prefault_stack_bytes =
-      std::size_t{256} * 1024;  // stack touched once so no page fault later
-  bool fifo = true;             // SCHED_FIFO when permitted
-  int fifo_priority = 50;       // 1..99
+  // The stack touched once at start, so that it takes no page fault later.
+  std::size_t prefault_stack_bytes = std::size_t{256} * 1024;
+  bool fifo = true;        // SCHED_FIFO when permitted
+  int fifo_priority = 50;  // 1..99
 };
 
 struct RealtimeReport {
