@@ -36,6 +36,11 @@ class FakeBoard final : public Board {
  public:
   const BoardInfo& info() const override { return kInfo; }
   const BoardConfig& config() const override { return config_; }
+  // Binds the keys to config_ as the test prepared it (no reset to other defaults).
+  bool reset_config(ConfigSchema& schema) override {
+    return add_board_config_keys(schema, config_);
+  }
+  const char* default_config_path() const override { return default_config; }
   bool init(const Options&, char* error, std::size_t size) override {
     if (refuse) {
       std::snprintf(error, size, "fake board refuses");
@@ -46,6 +51,7 @@ class FakeBoard final : public Board {
   boticelli::hal::Hal& hal() override { return hal_; }
 
   bool refuse = false;
+  const char* default_config = nullptr;       // the board's default configuration file
   std::function<void(FakeBoard&)> after_run;  // looks at the devices after the run
   BoardConfig config_{};
   boticelli::fakes::FakeClock clock{1000};
