@@ -160,6 +160,22 @@ TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
   }
 }
 
+// toml++ 3.3.0 reaches undefined behaviour on some non-ASCII code points (fuzz_config_file
+// found U+FEBF); such bytes never get to it.
+TEST(ConfigFile, ANonAsciiByteIsRefusedWithItsLineBeforeTheTomlLibrarySeesIt) {
+  Rpi4Keys k;
+  char error[320] = "";
+  CHECK_FALSE(apply_config_text("[camera]\n# \xef\xba\xbf\nwidth_px = 640\n", "u.conf", k.schema,
+                                error, sizeof error));
+  STRCMP_EQUAL("u.conf:2: non-ASCII byte 0xEF (the file must be ASCII)", error);
+  float gain = 0.0F;
+  ParameterTable table;
+  CHECK(table.add({"gain", &gain, 0.0F, 1.0F, false, ""}));
+  CHECK(apply_parameters_text("gain = 1 \xef\xba\xbf\n", "p.conf", table, error, sizeof error,
+                              nullptr, nullptr) == ConfigLoad::kInvalid);
+  STRCMP_EQUAL("p.conf:1: non-ASCII byte 0xEF (the file must be ASCII)", error);
+}
+
 TEST(ConfigFile, KeysOutsideATableAndTablesGivenAsValuesAreRejected) {
   Rpi4Keys k;
   char error[320] = "";
