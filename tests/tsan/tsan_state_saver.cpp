@@ -1,7 +1,8 @@
 // ThreadSanitizer check of the state writer: the executive's thread submits states and
 // parameter files (as `param save` does) while the writer thread saves them, with the
-// counters and the last errors read from both sides; the files must end as the newest ones. A plain program (CppUTest's operator new collides with
-// ThreadSanitizer's), exit code 0 on success; any race report halts it.
+// counters and the last errors read from both sides; the files must end as the newest ones. A plain
+// program (CppUTest's operator new collides with ThreadSanitizer's), exit code 0 on success; any
+// race report halts it.
 #include <sys/stat.h>
 #include <unistd.h>
 
