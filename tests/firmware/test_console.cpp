@@ -274,7 +274,7 @@ TEST(Console, AnswersHelpWithEveryCommand) {
   CHECK_EQUAL("OK", reply.back());
   for (const char* name :
        {"help", "status", "stats", "pose", "model", "map", "pause", "resume", "estop",
-        "clear-estop", "get", "set", "log", "ver", "shutdown", "quit"}) {
+        "clear-estop", "get", "set", "log", "param", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);
