@@ -30,6 +30,10 @@ const Console::Command Console::kCommands[] = {
     {"set", "NAME VALUE", "set a parameter (range checked)", &Console::cmd_set},
     {"log", "[LEVEL|show [N]]", "log level (error|warn|info|debug), or the last N log lines",
      &Console::cmd_log},
+    {"log", "mission [N]", "the last N lines of the mission log (kept in the state file)",
+     &Console::cmd_log},
+    {"param", "show|save", "parameters changed from their defaults; save them for restarts",
+     &Console::cmd_param},
     {"ver", "", "firmware version and board", &Console::cmd_ver},
     {"shutdown", "", "stop the firmware in an orderly way", &Console::cmd_shutdown},
     {"quit", "", "same as shutdown", &Console::cmd_shutdown},
@@ -43,6 +47,14 @@ bool Console::register_parameters() {
   return parameters_.add({"telemetry_ms", &telemetry_ms_, 0.0F, 60000.0F, true,
                           "telemetry period [ms], 0 = off"}) &&
          parameters_.add({"echo", &echo_, 0.0F, 1.0F, true, "echo typed characters (0/1)"});
+}
+
+void Console::set_parameter_saver(StateSaver* saver) {
+  parameter_saver_ = saver;
+  if (saver != nullptr) {
+    seen_parameter_saves_ = saver->parameter_saves();
+    seen_parameter_failures_ = saver->parameter_failures();
+  }
 }
 
 bool Console::emit(std::string_view bytes) {
@@ -172,6 +184,7 @@ void Console::service(std::uint64_t now_us) {
     }
   }
   check_executive(now_us);
+  check_parameter_saves();
   send_telemetry(now_us);
   flush();
 }
@@ -423,18 +436,29 @@ void Console::cmd_ver(const Words& w) {
 
 void Console::stream_log() {
   if (!log_streaming_) return;
-  // One whole line at a time as the output ring drains; lines overwritten in the log ring
-  // since the command are skipped.
+  // One whole line at a time as the output ring drains; lines overwritten (the log ring) or
+  // dropped (the mission log) since the command are skipped.
   while (log_next_ < log_end_) {
-    const LogRing::Entry* e = ring_->find(log_next_);
-    if (e == nullptr) {
-      ++log_next_;
-      continue;
+    TextBuffer<LogRing::kTextBytes + MissionLogEntry::kMaxTextBytes + 48> line;
+    if (log_mission_) {
+      const MissionLogEntry* e = view_.mission_log_line(log_next_);
+      if (e == nullptr) {
+        ++log_next_;
+        continue;
+      }
+      line.appendf("mission cycle=%llu ", static_cast<unsigned long long>(e->cycle));
+      line.append(e->view());
+    } else {
+      const LogRing::Entry* e = ring_->find(log_next_);
+      if (e == nullptr) {
+        ++log_next_;
+        continue;
+      }
+      const auto since_start_us =
+          static_cast<double>(static_cast<std::int64_t>(e->t_us - start_us_));
+      line.appendf("log t_s=%.3f %s ", since_start_us * 1e-6, log_level_name(e->level));
+      line.append(e->view());
     }
-    TextBuffer<LogRing::kTextBytes + 48> line;
-    const auto since_start_us = static_cast<double>(static_cast<std::int64_t>(e->t_us - start_us_));
-    line.appendf("log t_s=%.3f %s ", since_start_us * 1e-6, log_level_name(e->level));
-    line.append(e->view());
     line.append(kEol);
     if (line.size() + 8 > tx_free()) return;
     emit(line.view());
@@ -461,10 +485,33 @@ void Console::cmd_log(const Words& w) {
     log_end_ = ring_->end_sequence();
     const std::uint64_t kept = ring_->size();
     log_next_ = log_end_ - (n < kept ? n : kept);
+    log_mission_ = false;
     log_streaming_ = true;
     return;
   }
-  if (w.count > 2) return reply_error("usage: log [error|warn|info|debug] or log show [N]");
+  if (w.count >= 2 && w.word[1] == "mission") {
+    static_assert(MissionState::kMaxLogEntries == 128, "the error message names the capacity");
+    std::uint64_t n = MissionState::kMaxLogEntries;
+    if (w.count > 3) return reply_error("usage: log mission [N]");
+    if (w.count == 3) {
+      float value = 0.0F;
+      if (!parse_number(w.word[2], value) || !(value >= 1.0F) ||
+          value > static_cast<float>(MissionState::kMaxLogEntries) ||
+          std::nearbyint(value) != value) {
+        return reply_error("N must be a whole number from 1 to 128");
+      }
+      n = static_cast<std::uint64_t>(value);
+    }
+    log_end_ = view_.mission_log_end();
+    const std::uint64_t kept = log_end_ - view_.mission_log_begin();
+    log_next_ = log_end_ - (n < kept ? n : kept);
+    log_mission_ = true;
+    log_streaming_ = true;
+    return;
+  }
+  if (w.count > 2) {
+    return reply_error("usage: log [error|warn|info|debug], log show [N] or log mission [N]");
+  }
   if (w.count == 2) {
     LogLevel level = LogLevel::kInfo;
     if (!parse_log_level(w.word[1], level)) return reply_error("unknown log level");
@@ -472,6 +519,73 @@ void Console::cmd_log(const Words& w) {
   }
   reply_.appendf("log level=%s\r\nOK\r\n", log_level_name(log_level_));
   emit(reply_.view());
+}
+
+void Console::cmd_param(const Words& w) {
+  if (w.count == 2 && w.word[1] == "show") {
+    // What differs from the defaults (the values at start, before any saved ones were
+    // loaded): what `param save` would keep.
+    for (std::size_t i = 0; i < parameters_.size(); ++i) {
+      if (parameters_.is_default(i)) continue;
+      const Parameter& p = parameters_[i];
+      reply_.appendf("%s=%g default=%g\r\n", p.name, static_cast<double>(*p.value),
+                     static_cast<double>(parameters_.default_value(i)));
+    }
+    if (reply_.truncated()) return reply_error("reply too long");
+    reply_.append("OK\r\n");
+    emit(reply_.view());
+    return;
+  }
+  if (w.count == 2 && w.word[1] == "save") {
+    if (parameter_saver_ == nullptr)
+      return reply_error("no state directory (start with --state DIR)");
+    const std::size_t bytes =
+        parameters_.encode_changed(parameter_text_.data(), parameter_text_.size());
+    if (bytes == 0) return reply_error("parameters do not fit the file buffer");
+    switch (parameter_saver_->submit_parameters({parameter_text_.data(), bytes})) {
+      case StateSaver::Submitted::kQueued:
+        // The writer thread reports the result as a LOG line (check_parameter_saves).
+        reply_.appendf("param save changed=%zu file=%s queued\r\nOK\r\n",
+                       parameters_.changed_count(), parameter_saver_->parameters_path());
+        break;
+      case StateSaver::Submitted::kSaved:
+        seen_parameter_saves_ = parameter_saver_->parameter_saves();
+        reply_.appendf("param save changed=%zu file=%s\r\nOK\r\n", parameters_.changed_count(),
+                       parameter_saver_->parameters_path());
+        break;
+      case StateSaver::Submitted::kFailed: {
+        seen_parameter_failures_ = parameter_saver_->parameter_failures();
+        char why[256] = "";
+        (void)parameter_saver_->parameter_error(why, sizeof why);
+        TextBuffer<300> text;
+        text.appendf("cannot save: %s", why);
+        return reply_error(text.c_str());
+      }
+      case StateSaver::Submitted::kBusy:
+        return reply_error("still saving, try again");
+      case StateSaver::Submitted::kTooLong:
+        return reply_error("parameters do not fit the file buffer");
+    }
+    emit(reply_.view());
+    return;
+  }
+  return reply_error("usage: param show or param save");
+}
+
+void Console::check_parameter_saves() {
+  if (parameter_saver_ == nullptr) return;
+  const std::uint64_t saves = parameter_saver_->parameter_saves();
+  if (saves != seen_parameter_saves_) {
+    seen_parameter_saves_ = saves;
+    log(LogLevel::kInfo, "parameters saved to %s", parameter_saver_->parameters_path());
+  }
+  const std::uint64_t failures = parameter_saver_->parameter_failures();
+  if (failures != seen_parameter_failures_) {
+    char why[256] = "";
+    if (!parameter_saver_->parameter_error(why, sizeof why)) return;  // next frame
+    seen_parameter_failures_ = failures;
+    log(LogLevel::kError, "parameters not saved: %s", why);
+  }
 }
 
 void Console::cmd_shutdown(const Words& w) {

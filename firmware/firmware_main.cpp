@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 
+#include "firmware/config_file.h"
 #include "firmware/console.h"
 #include "firmware/device_tasks.h"
 #include "firmware/executive.h"
@@ -45,6 +46,7 @@ double wall_seconds() {
 MissionState g_state;
 StateStore g_store;
 ParameterTable g_parameters;
+ConfigSchema g_config_keys;
 mission::TraceWriter g_trace;
 SnapshotWriter g_snapshots;
 LogRing g_log_ring;
@@ -92,6 +94,35 @@ int fail(const char* what, const char* why) {
   return 1;
 }
 
+void warn_line(const char* message, void* /*context*/) {
+  service_log().log(LogLevel::kWarn, "%s", message);
+}
+
+// The configuration file: --config FILE (must exist) or the board's default path (may be
+// missing: the compiled-in defaults). False after logging the error.
+bool apply_config(const Options& options, Board& board, char* error, std::size_t error_size) {
+  ServiceLog& slog = service_log();
+  g_config_keys.clear();
+  if (!board.reset_config(g_config_keys)) {
+    slog.log(LogLevel::kError, "configuration: key table full");
+    return false;
+  }
+  const char* path =
+      options.config_file != nullptr ? options.config_file : board.default_config_path();
+  if (path == nullptr) return true;
+  const ConfigLoad loaded = load_config_file(path, g_config_keys, error, error_size);
+  if (loaded == ConfigLoad::kLoaded) {
+    slog.log(LogLevel::kInfo, "configuration from %s", path);
+    return true;
+  }
+  if (loaded == ConfigLoad::kMissing && options.config_file == nullptr) {
+    slog.log(LogLevel::kInfo, "no %s: compiled-in defaults", path);
+    return true;
+  }
+  slog.log(LogLevel::kError, "configuration: %s", error);
+  return false;
+}
+
 }  // namespace
 
 int firmware_main(int argc, const char* const* argv, Board& board, const MainHooks* hooks) {
@@ -116,7 +147,9 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   std::fflush(stdout);
   if (options.show_version) return 0;
 
-  char error[256] = "";
+  char error[384] = "";
+  // A bad configuration is a usage error (2): the service is not restarted on it.
+  if (!apply_config(options, board, error, sizeof error)) return 2;
   if (!board.init(options, error, sizeof error)) return fail(error, "");
   const BoardConfig& config = board.config();
   hal::Hal& hal = board.hal();
@@ -200,6 +233,21 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
                          static_cast<float>(config.minor_frame_us), true,
                          "longest background slice [us], 0 = rest of the frame"})) {
     return fail("console parameters", "table full");
+  }
+  if (store != nullptr) {
+    // The values `param save` kept: a file that is not TOML stops the start (2); a name the
+    // table no longer has, or a value it refuses, is skipped with a warning.
+    const ConfigLoad loaded = load_parameters_file(g_store.parameters_path(), g_parameters, error,
+                                                   sizeof error, warn_line, nullptr);
+    if (loaded == ConfigLoad::kInvalid) {
+      slog.log(LogLevel::kError, "saved parameters: %s", error);
+      return 2;
+    }
+    if (loaded == ConfigLoad::kLoaded) {
+      slog.log(LogLevel::kInfo, "parameters from %s: %zu changed", g_store.parameters_path(),
+               g_parameters.changed_count());
+    }
+    console.set_parameter_saver(&rt.saver);
   }
 
   if (config.realtime) {

@@ -16,6 +16,7 @@ void MissionState::add_log(std::uint64_t at_cycle, std::string_view text) {
   if (log.full()) {
     for (std::size_t i = 1; i < log.size(); ++i) log[i - 1] = log[i];
     log.pop_back();
+    ++log_dropped;
   }
   MissionLogEntry e;
   e.cycle = at_cycle;
@@ -40,6 +41,7 @@ void MissionState::clear() {
   exploration.clear();
   model_bytes = 0;
   log.clear();
+  log_dropped = 0;
 }
 
 namespace {

@@ -61,7 +61,9 @@ const char* usage_text() {
          "  --snapshots DIR     write a picture of the map after each cycle into DIR\n"
          "  --trace FILE        write the robot's path as CSV to FILE\n"
          "  --console KIND      stdio (default), pty, or the PATH of a serial device\n"
-         "  --state DIR         keep the mission state in DIR (written atomically)\n"
+         "  --config FILE       read the configuration from FILE (default on the robot:\n"
+         "                      /etc/boticelli/boticelli.conf, if it exists)\n"
+         "  --state DIR         keep the mission state and saved parameters in DIR\n"
          "  --resume            continue the mission saved in --state DIR (new if none)\n"
          "  --version           print the version and board, then exit\n"
          "  --help              print this text, then exit\n";
@@ -104,6 +106,10 @@ ParseResult parse_options(int argc, const char* const* argv, bool simulated, Opt
       if (!value(out.snapshots_dir)) return fail("option ", arg, " needs a DIR");
     } else if (std::strcmp(arg, "--trace") == 0) {
       if (!value(out.trace_file)) return fail("option ", arg, " needs a FILE");
+    } else if (std::strcmp(arg, "--config") == 0) {
+      if (!value(out.config_file) || *out.config_file == '\0') {
+        return fail("option ", arg, " needs a FILE");
+      }
     } else if (std::strcmp(arg, "--state") == 0) {
       if (!value(out.state_dir)) return fail("option ", arg, " needs a DIR");
     } else if (std::strcmp(arg, "--console") == 0) {

@@ -298,36 +298,28 @@ namespace {
 void set_error(char* error, std::size_t size, const char* what, const char* path) {
   std::snprintf(error, size, "%s %s: %s", what, path, std::strerror(errno));
 }
-
-bool write_all(int fd, const char* data, std::size_t size) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd, data, size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
 }  // namespace
 
 bool StateStore::open(const char* dir, char* error, std::size_t error_size) {
   const int n1 = std::snprintf(dir_.data(), dir_.size(), "%s", dir);
   const int n2 = std::snprintf(path_.data(), path_.size(), "%s/%s", dir, kFileName);
-  const int n3 = std::snprintf(tmp_path_.data(), tmp_path_.size(), "%s/%s.tmp", dir, kFileName);
-  if (n1 < 0 || n2 < 0 || n3 < 0 || static_cast<std::size_t>(n3) >= tmp_path_.size()) {
+  const int n3 = std::snprintf(parameters_path_.data(), parameters_path_.size(), "%s/%s", dir,
+                               kParametersFileName);
+  // The longest name, with write_file_atomically()'s ".tmp", must fit its 512-byte paths.
+  if (n1 < 0 || n2 < 0 || n3 < 0 || static_cast<std::size_t>(n3) + 4 >= parameters_path_.size()) {
+    dir_[0] = '\0';
     std::snprintf(error, error_size, "state directory path too long");
     return false;
   }
   if (::mkdir(dir, 0750) != 0 && errno != EEXIST) {
     set_error(error, error_size, "cannot create state directory", dir);
+    dir_[0] = '\0';
     return false;
   }
   struct stat st {};
   if (::stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
     std::snprintf(error, error_size, "state path %s is not a directory", dir);
+    dir_[0] = '\0';
     return false;
   }
   return true;
@@ -339,62 +331,21 @@ bool StateStore::save(const MissionState& state, char* error, std::size_t error_
     std::snprintf(error, error_size, "state does not fit the file buffer");
     return false;
   }
-  auto crashed = [&](SaveStep step) {
-    if (crash_hook_ == nullptr || !crash_hook_(step, crash_context_)) return false;
-    std::snprintf(error, error_size, "save interrupted (test crash hook)");
-    return true;
-  };
-  const int fd = ::open(tmp_path_.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
-  if (fd < 0) {
-    set_error(error, error_size, "cannot create", tmp_path_.data());
+  if (!write_file_atomically(dir_.data(), kFileName, {buffer_.data(), size}, error, error_size,
+                             crash_hook_, crash_context_)) {
     return false;
   }
-  if (crashed(SaveStep::kTempCreated)) {
-    ::close(fd);
-    return false;
-  }
-  for (std::size_t done = 0; done < size;) {
-    const std::size_t n = size - done < kWriteChunkBytes ? size - done : kWriteChunkBytes;
-    if (!write_all(fd, buffer_.data() + done, n)) {
-      set_error(error, error_size, "cannot write", tmp_path_.data());
-      ::close(fd);
-      ::unlink(tmp_path_.data());
-      return false;
-    }
-    done += n;
-    if (crashed(SaveStep::kChunkWritten)) {
-      ::close(fd);
-      return false;
-    }
-  }
-  if (::fsync(fd) != 0) {
-    set_error(error, error_size, "cannot sync", tmp_path_.data());
-    ::close(fd);
-    ::unlink(tmp_path_.data());
-    return false;
-  }
-  if (::close(fd) != 0) {
-    set_error(error, error_size, "cannot close", tmp_path_.data());
-    ::unlink(tmp_path_.data());
-    return false;
-  }
-  if (crashed(SaveStep::kTempSynced)) return false;
-  if (::rename(tmp_path_.data(), path_.data()) != 0) {
-    set_error(error, error_size, "cannot rename onto", path_.data());
-    ::unlink(tmp_path_.data());
-    return false;
-  }
-  if (crashed(SaveStep::kRenamed)) return false;
-  // Make the rename itself durable.
-  const int dfd = ::open(dir_.data(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0 || ::fsync(dfd) != 0) {
-    set_error(error, error_size, "cannot sync directory", dir_.data());
-    if (dfd >= 0) ::close(dfd);
-    return false;
-  }
-  ::close(dfd);
   ++saves_;
   return true;
+}
+
+bool StateStore::save_parameters(std::string_view text, char* error, std::size_t error_size) {
+  if (!is_open()) {
+    std::snprintf(error, error_size, "no state directory");
+    return false;
+  }
+  return write_file_atomically(dir_.data(), kParametersFileName, text, error, error_size,
+                               crash_hook_, crash_context_);
 }
 
 LoadResult StateStore::load(MissionState& out, char* error, std::size_t error_size) {

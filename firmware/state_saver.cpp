@@ -54,7 +54,42 @@ bool StateSaver::submit(const MissionState& state) {
 
 void StateSaver::flush() {
   std::unique_lock<std::mutex> lock(mutex_);
-  idle_.wait(lock, [this] { return !has_pending_ && !busy_; });
+  idle_.wait(lock, [this] { return !has_pending_ && !has_parameters_ && !busy_; });
+}
+
+void StateSaver::save_parameters_now(std::string_view text) {
+  char error[256] = "";
+  const bool ok = store_.save_parameters(text, error, sizeof error);
+  if (!ok) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::snprintf(parameter_error_, sizeof parameter_error_, "%s", error);
+  }
+  // Counted after the reason is stored, so a reader that sees the count finds the reason.
+  (ok ? parameter_saves_ : parameter_failures_).fetch_add(1);
+}
+
+StateSaver::Submitted StateSaver::submit_parameters(std::string_view text) {
+  if (text.size() > parameters_pending_.size()) return Submitted::kTooLong;
+  if (!thread_.joinable()) {
+    const std::uint64_t failures = parameter_failures_.load();
+    save_parameters_now(text);
+    return parameter_failures_.load() == failures ? Submitted::kSaved : Submitted::kFailed;
+  }
+  std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return Submitted::kBusy;
+  std::memcpy(parameters_pending_.data(), text.data(), text.size());
+  parameters_pending_bytes_ = text.size();
+  has_parameters_ = true;
+  lock.unlock();
+  wake_.notify_one();
+  return Submitted::kQueued;
+}
+
+bool StateSaver::parameter_error(char* out, std::size_t size) const {
+  std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return false;
+  std::snprintf(out, size, "%s", parameter_error_);
+  return true;
 }
 
 std::uint64_t StateSaver::saved() const {
@@ -75,8 +110,20 @@ void StateSaver::last_error(char* out, std::size_t size) const {
 void StateSaver::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    wake_.wait(lock, [this] { return stop_ || has_pending_; });
-    if (!has_pending_ && stop_) break;
+    wake_.wait(lock, [this] { return stop_ || has_pending_ || has_parameters_; });
+    if (!has_pending_ && !has_parameters_ && stop_) break;
+    if (has_parameters_) {
+      const std::size_t bytes = parameters_pending_bytes_;
+      std::memcpy(parameters_writing_.data(), parameters_pending_.data(), bytes);
+      has_parameters_ = false;
+      busy_ = true;
+      lock.unlock();
+      save_parameters_now({parameters_writing_.data(), bytes});
+      lock.lock();
+      busy_ = false;
+      if (!has_pending_ && !has_parameters_) idle_.notify_all();
+      continue;
+    }
     writing_ = pending_;
     has_pending_ = false;
     busy_ = true;
@@ -91,7 +138,7 @@ void StateSaver::run() {
       ++failures_;
       std::snprintf(error_, sizeof error_, "%s", error);
     }
-    if (!has_pending_) idle_.notify_all();
+    if (!has_pending_ && !has_parameters_) idle_.notify_all();
   }
   idle_.notify_all();
 }

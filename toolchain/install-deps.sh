@@ -30,21 +30,22 @@ done
 
 # systemd: systemd-analyze for the unit's rating; libsdformat-dev: the test that loads every
 # world with SDFormat (tests only, never linked into the firmware); clang-14 with its runtime
-# (libFuzzer, sanitizers): the fuzz preset, which make test runs.
+# (libFuzzer, sanitizers): the fuzz preset, which make test runs. libtomlplusplus-dev: the
+# configuration file's parser (a shared library, libtomlplusplus3, which the .deb depends on).
 host_pkgs=(
   g++ make cmake pkg-config clang-format file systemd clang-14 libclang-rt-14-dev
-  libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev
+  libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev libtomlplusplus-dev
   libsdformat-dev
 )
 # lintian: the rpi4 preset's test of the .deb (tests/packaging).
 cross_pkgs=(
   g++-aarch64-linux-gnu qemu-user
   libcpputest-dev:arm64 libgpiod-dev:arm64 libtinyxml2-dev:arm64 libpng-dev:arm64
-  lintian
+  libtomlplusplus-dev:arm64 lintian
 )
 armhf_pkgs=(
   g++-arm-linux-gnueabihf
-  libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf
+  libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf libtomlplusplus-dev:armhf
 )
 bench_pkgs=(libopencv-dev liboctomap-dev)
 analyze_pkgs=(clang-tidy-14 cppcheck)

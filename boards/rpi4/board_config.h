@@ -1,40 +1,63 @@
 // rpi4 board config: the reference robot's devices, lines, rates and capacities, as data (wiring in
-// rpi4_board.cpp).
+// rpi4_board.cpp); these are the defaults /etc/boticelli/boticelli.conf may change.
 #pragma once
 
 #include <cstdint>
 
 #include "firmware/board.h"
+#include "firmware/config_file.h"
 
 namespace boticelli::boards::rpi4 {
 
 // Where each device is on the reference robot (Raspberry Pi 4, Debian 12 arm64).
 struct Rpi4Devices {
   // UVC webcam, V4L2 mmap streaming, YUYV 640x480.
-  const char* camera_device = "/dev/video0";
+  firmware::DeviceName camera_device = {"/dev/video0"};
   // FLIR / Directed Perception PTU-D46 on a USB-serial adapter, 9600 8N1.
-  const char* ptu_device = "/dev/ttyUSB0";
+  firmware::DeviceName ptu_device = {"/dev/ttyUSB0"};
   std::uint32_t ptu_baud = 9600;
   // Two ODrive axes on SocketCAN (bitrate set by boticelli-can0.service: 250 kbit/s).
-  const char* can_interface = "can0";
+  firmware::DeviceName can_interface = {"can0"};
   std::uint8_t odrive_left_node_id = 0;
   std::uint8_t odrive_right_node_id = 1;
   float odrive_max_wheel_turns_s = 8.0F;
   // GPIO on the 40-pin header (gpiochip0 = the BCM2711's lines, numbered as BCM GPIOs).
-  const char* gpio_chip = "gpiochip0";
-  unsigned estop_line = 17;       // pin 11: e-stop switch to GND, normally closed
-  bool estop_active_low = false;  // NC switch to GND: the line goes high (pulled up) when pressed
-  unsigned bumper_line = 27;      // pin 13: bumper microswitches to GND, normally open
+  firmware::DeviceName gpio_chip = {"gpiochip0"};
+  std::uint32_t estop_line = 17;   // pin 11: e-stop switch to GND, normally closed
+  bool estop_active_low = false;   // NC switch to GND: the line goes high (pulled up) when pressed
+  std::uint32_t bumper_line = 27;  // pin 13: bumper microswitches to GND, normally open
   bool bumper_active_low = true;
-  unsigned led_line = 22;  // pin 15: status LED through 330 Ω to GND
+  std::uint32_t led_line = 22;  // pin 15: status LED through 330 Ω to GND
   bool led_active_low = false;
   // Console UART on pins 8/10 (GPIO 14/15), 115200 8N1 (enable_uart=1, no serial getty).
-  const char* console_device = "/dev/ttyAMA0";
+  firmware::DeviceName console_device = {"/dev/ttyAMA0"};
   // Hardware watchdog of the BCM2711 (bcm2835_wdt; max timeout about 15 s).
-  const char* watchdog_device = "/dev/watchdog0";
+  firmware::DeviceName watchdog_device = {"/dev/watchdog0"};
 };
 
-inline constexpr Rpi4Devices kDevices{};
+// The configuration file's keys for the devices (besides add_board_config_keys()), bound to
+// `d`. CAN node ids are 6 bits (CAN Simple: id = node << 5 | cmd), GPIO offsets those of
+// the BCM2711's 58 lines.
+inline bool add_device_config_keys(firmware::ConfigSchema& s, Rpi4Devices& d) {
+  using firmware::ConfigKey;
+  return s.add(ConfigKey::path("camera", "device", d.camera_device)) &&
+         s.add(ConfigKey::path("ptu", "device", d.ptu_device)) &&
+         s.add(ConfigKey::baud("ptu", "baud", d.ptu_baud)) &&
+         s.add(ConfigKey::interface_name("base", "can_interface", d.can_interface)) &&
+         s.add(ConfigKey::whole("base", "left_node_id", d.odrive_left_node_id, 0, 63)) &&
+         s.add(ConfigKey::whole("base", "right_node_id", d.odrive_right_node_id, 0, 63)) &&
+         s.add(ConfigKey::number("base", "max_wheel_turns_s", d.odrive_max_wheel_turns_s, 0.1,
+                                 50.0)) &&
+         s.add(ConfigKey::interface_name("gpio", "chip", d.gpio_chip)) &&
+         s.add(ConfigKey::whole("gpio", "estop_line", d.estop_line, 0, 57)) &&
+         s.add(ConfigKey::flag_key("gpio", "estop_active_low", d.estop_active_low)) &&
+         s.add(ConfigKey::whole("gpio", "bumper_line", d.bumper_line, 0, 57)) &&
+         s.add(ConfigKey::flag_key("gpio", "bumper_active_low", d.bumper_active_low)) &&
+         s.add(ConfigKey::whole("gpio", "led_line", d.led_line, 0, 57)) &&
+         s.add(ConfigKey::flag_key("gpio", "led_active_low", d.led_active_low)) &&
+         s.add(ConfigKey::path("console", "device", d.console_device)) &&
+         s.add(ConfigKey::path("watchdog", "device", d.watchdog_device));
+}
 
 // The robot itself (thesis §3.4 and App. A for the camera arm), rates and capacities.
 inline firmware::BoardConfig make_config() {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 
 #include "board_config.h"
 #include "firmware/board.h"
@@ -17,32 +18,38 @@
 
 namespace boticelli::boards::rpi4 {
 
-// One static instance (main.cpp). The constructor only stores configuration; init() picks
-// the console and requests the GPIO lines (without its e-stop line the robot must not run);
-// the firmware then calls init()/open() of the camera, PTU, base and console.
+// One static instance (main.cpp). reset_config() binds the configuration file's keys to the
+// defaults of board_config.h; init() builds the drivers from the result, picks the console
+// and requests the GPIO lines (without its e-stop line the robot must not run); the
+// firmware then calls init()/open() of the camera, PTU, base and console.
 class Rpi4Board final : public firmware::Board {
  public:
   Rpi4Board();
   const firmware::BoardInfo& info() const override { return kInfo; }
   const firmware::BoardConfig& config() const override { return config_; }
+  bool reset_config(firmware::ConfigSchema& schema) override;
+  const char* default_config_path() const override { return "/etc/boticelli/boticelli.conf"; }
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
-  hal::Hal& hal() override { return hal_; }
+  hal::Hal& hal() override { return *hal_; }
 
  private:
   static constexpr firmware::BoardInfo kInfo{"rpi4", "Raspberry Pi 4 reference robot", false};
 
+  // The drivers are built in init() from the configured values (reset_config() and the
+  // file), in declaration order; the Hal bag last, as it refers to them.
   firmware::BoardConfig config_;
+  Rpi4Devices devices_;
   hal_linux::ClockPosix clock_;
-  hal_linux::SerialTermios ptu_port_;
-  hal_linux::PanTiltPtu46 pan_tilt_;
-  hal_linux::BaseOdriveCan base_;
-  hal_linux::CameraV4l2 camera_;
-  hal_linux::DigitalInGpiod estop_;
-  hal_linux::DigitalInGpiod bumper_;
-  hal_linux::DigitalOutGpiod status_led_;
-  hal_linux::WatchdogLinux watchdog_;
-  hal_linux::ConsolePort console_;
-  hal::Hal hal_;
+  std::optional<hal_linux::SerialTermios> ptu_port_;
+  std::optional<hal_linux::PanTiltPtu46> pan_tilt_;
+  std::optional<hal_linux::BaseOdriveCan> base_;
+  std::optional<hal_linux::CameraV4l2> camera_;
+  std::optional<hal_linux::DigitalInGpiod> estop_;
+  std::optional<hal_linux::DigitalInGpiod> bumper_;
+  std::optional<hal_linux::DigitalOutGpiod> status_led_;
+  std::optional<hal_linux::WatchdogLinux> watchdog_;
+  std::optional<hal_linux::ConsolePort> console_;
+  std::optional<hal::Hal> hal_;
 };
 
 }  // namespace boticelli::boards::rpi4

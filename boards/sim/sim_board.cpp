@@ -21,6 +21,11 @@ SimBoard::SimBoard()
       console_("/dev/tty", config_.console_baud),
       hal_{camera_, pan_tilt_, base_, estop_, bumper_, status_led_, console_, clock_, watchdog_} {}
 
+bool SimBoard::reset_config(firmware::ConfigSchema& schema) {
+  config_ = make_config();
+  return firmware::add_board_config_keys(schema, config_);
+}
+
 bool SimBoard::init(const firmware::Options& options, char* error, std::size_t error_size) {
   const char* path =
       options.world_file != nullptr ? options.world_file : BOTICELLI_SIM_DEFAULT_WORLD;
@@ -33,6 +38,14 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   // The seed drives the sensor noise and the odometry noise; the rest is deterministic.
   settings_.render.seed = options.seed;
   settings_.physics.seed = options.seed;
+  // The sim draws and drives the robot the firmware is told about (a --config FILE may have
+  // changed it).
+  const SimSettings geometry = make_settings(config_, options.seed);
+  settings_.physics.base.robot_radius_m = geometry.physics.base.robot_radius_m;
+  settings_.physics.base.robot_height_m = geometry.physics.base.robot_height_m;
+  settings_.physics.base.track_width_m = geometry.physics.base.track_width_m;
+  settings_.physics.base.max_speed_m_s = geometry.physics.base.max_speed_m_s;
+  settings_.physics.base.max_turn_rate_rad_s = geometry.physics.base.max_turn_rate_rad_s;
   rig_.emplace(make_rig_params(config_));
   if (!sim_.init(world_, *rig_, settings_.physics, why, sizeof why)) {
     std::snprintf(error, error_size, "%s: %s", path, why);
@@ -42,6 +55,7 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
     return false;
   }
   if (!camera_.setup(settings_.camera_fps, error, error_size)) return false;
+  console_.set_baud(config_.console_baud);
   console_.select(console_mode(options.console), options.console_path);
   clock_.set_speed(options.speed);
   outline_count_ = circle_count_ = 0;

@@ -32,6 +32,9 @@ class SimBoard final : public firmware::Board, public firmware::TruthSource {
   SimBoard();
   const firmware::BoardInfo& info() const override { return kInfo; }
   const firmware::BoardConfig& config() const override { return config_; }
+  // The keys every board has (add_board_config_keys); no device keys, no default file: the
+  // sim board reads a configuration only with --config FILE.
+  bool reset_config(firmware::ConfigSchema& schema) override;
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
   hal::Hal& hal() override { return hal_; }
   const firmware::TruthSource* truth() const override { return this; }

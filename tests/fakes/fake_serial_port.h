@@ -46,6 +46,7 @@ class FakeSerialPort final : public hal::SerialPort {
   void feed(std::string_view bytes) { input_.append(bytes); }
   const std::string& written() const { return output_; }
   void clear_written() { output_.clear(); }
+  void reserve_written(std::size_t bytes) { output_.reserve(bytes); }  // for allocation checks
   void set_fault(bool fault) { fault_ = fault; }
   void set_fail_open(bool fail) { fail_open_ = fail; }
   // At most this many bytes are accepted per write() call (to test partial writes).

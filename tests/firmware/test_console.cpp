@@ -1,7 +1,11 @@
 // Tests of the serial console: line assembly, parsing with hostile input, every command, telemetry,
 // no allocation.
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -12,6 +16,8 @@
 #include "firmware/console_line.h"
 #include "firmware/console_parser.h"
 #include "firmware/executive.h"
+#include "firmware/persistence.h"
+#include "firmware/state_saver.h"
 #include "firmware_fakes.h"
 
 #include "alloc_guard.h"
@@ -35,6 +41,20 @@ class FakeView final : public MissionView {
   std::string_view model_text() const override { return model; }
   MapCounts map_counts() const override { return {12, 34, 5}; }
   TargetEstimate target() const override { return target_value; }
+  std::uint64_t mission_log_begin() const override { return log_dropped; }
+  std::uint64_t mission_log_end() const override { return log_dropped + log.size(); }
+  const MissionLogEntry* mission_log_line(std::uint64_t n) const override {
+    if (n < mission_log_begin() || n >= mission_log_end()) return nullptr;
+    return &log[static_cast<std::size_t>(n - log_dropped)];
+  }
+  void add_log(std::uint64_t cycle, const std::string& text) {
+    MissionLogEntry e;
+    e.cycle = cycle;
+    std::snprintf(e.text.data(), e.text.size(), "%s", text.c_str());
+    log.push_back(e);
+  }
+  std::vector<MissionLogEntry> log;
+  std::uint64_t log_dropped = 0;
   boticelli::core::Pose2 pose_value{1.25F, -0.5F, 0.75F};
   TargetEstimate target_value{};
   std::string model;
@@ -229,9 +249,9 @@ TEST_GROUP(Console) {
     CHECK(exec.add_task({"estop", 10000, 200}, idle, &error));
     CHECK(exec.add_task({"camera", 20000, 2000}, idle, &error));
     CHECK(exec.start(ExecutiveConfig{}, &error));
+    console.set_telemetry_ms(0.0F);  // before the registration: its default
     CHECK(console.register_parameters());
     CHECK(parameters.add({"gain", &gain, 0.0F, 10.0F, false, "a gain [1]"}));
-    console.set_telemetry_ms(0.0F);
   }
   void service(int times = 1) {
     for (int i = 0; i < times; ++i) {
@@ -254,7 +274,7 @@ TEST(Console, AnswersHelpWithEveryCommand) {
   CHECK_EQUAL("OK", reply.back());
   for (const char* name :
        {"help", "status", "stats", "pose", "model", "map", "pause", "resume", "estop",
-        "clear-estop", "get", "set", "log", "ver", "shutdown", "quit"}) {
+        "clear-estop", "get", "set", "log", "param", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);
@@ -585,3 +605,109 @@ TEST(Console, HandlesBytesAndLinesWithoutAllocating) {
   CHECK(port.written().size() > 1000U);
   DOUBLES_EQUAL(3.0, gain, 0.0);
 }
+
+TEST(Console, ParamShowListsOnlyTheParametersThatDifferFromTheirDefaults) {
+  auto reply = command("param show");
+  CHECK_EQUAL(1U, reply.size());
+  CHECK_EQUAL("OK", reply[0]);
+  CHECK_EQUAL("OK", command("set gain 4.5").at(0));
+  CHECK_EQUAL("OK", command("set echo 0").at(0));  // set, but to its default
+  reply = command("param show");
+  CHECK_EQUAL(2U, reply.size());
+  CHECK_EQUAL("gain=4.5 default=2", reply[0]);
+  CHECK_EQUAL("OK", reply[1]);
+  CHECK_EQUAL("OK", command("set gain 2").at(0));
+  CHECK_EQUAL(1U, command("param show").size());
+  CHECK_EQUAL("ERR usage: param show or param save", command("param").at(0));
+  CHECK_EQUAL("ERR usage: param show or param save", command("param show all").at(0));
+}
+
+TEST(Console, ParamSaveIsRefusedWithoutAStateDirectory) {
+  CHECK_EQUAL("ERR no state directory (start with --state DIR)", command("param save").at(0));
+}
+
+TEST(Console, ParamSaveWritesTheChangedValuesIntoTheStateDirectoryWithoutAllocating) {
+  char templ[] = "/tmp/boticelli-console-XXXXXX";
+  const std::string dir = mkdtemp(templ);
+  static StateStore store;
+  char why[256] = "";
+  CHECK(store.open(dir.c_str(), why, sizeof why));
+  StateSaver saver(store);  // no thread: written at once (as on the sim board)
+  console.set_parameter_saver(&saver);
+  port.clear_written();
+  port.feed("set gain 7.25\rparam save\r");
+  CHECK_NO_ALLOCATION(service(5));
+  const auto reply = lines_of(port.written());
+  CHECK_EQUAL(3U, reply.size());  // written at once: the reply says so, no LOG line follows
+  CHECK_EQUAL("param save changed=1 file=" + dir + "/parameters.conf", reply[1]);
+  CHECK_EQUAL("OK", reply[2]);
+  std::string text(256, '\0');
+  FILE* f = std::fopen((dir + "/parameters.conf").c_str(), "rb");
+  CHECK(f != nullptr);
+  text.resize(std::fread(text.data(), 1, text.size(), f));
+  std::fclose(f);
+  STRCMP_CONTAINS("\ngain = 7.25\n", text.c_str());
+  CHECK(text.find("telemetry_ms") == std::string::npos);
+  // A failed save answers ERR with the reason.
+  unlink((dir + "/parameters.conf").c_str());
+  rmdir(dir.c_str());
+  const std::string failed = command("param save").at(0);
+  STRCMP_CONTAINS("ERR cannot save: cannot create", failed.c_str());
+}
+
+TEST(Console, LogMissionShowsTheMissionLogKeptInTheStateFile) {
+  CHECK_EQUAL("OK", command("log mission").at(0));  // nothing yet
+  for (int c = 1; c <= 5; ++c) view.add_log(static_cast<std::uint64_t>(c), "cycle done");
+  view.add_log(5, "target confirmed");
+  auto reply = command("log mission");
+  CHECK_EQUAL(7U, reply.size());
+  CHECK_EQUAL("mission cycle=1 cycle done", reply[0]);
+  CHECK_EQUAL("mission cycle=5 target confirmed", reply[5]);
+  CHECK_EQUAL("OK", reply[6]);
+  reply = command("log mission 2");
+  CHECK_EQUAL(3U, reply.size());
+  CHECK_EQUAL("mission cycle=5 cycle done", reply[0]);
+  CHECK_EQUAL("mission cycle=5 target confirmed", reply[1]);
+  for (const char* bad : {"log mission 0", "log mission 129", "log mission 1.5", "log mission x"}) {
+    CHECK_EQUAL_TEXT("ERR N must be a whole number from 1 to 128", command(bad).at(0), bad);
+  }
+  CHECK_EQUAL("ERR usage: log mission [N]", command("log mission 1 2").at(0));
+}
+
+TEST(Console, LogMissionStreamsAFullLogWithoutAllocating) {
+  for (int c = 0; c < 128; ++c) {
+    view.add_log(static_cast<std::uint64_t>(c), std::string(90, static_cast<char>('a' + c % 26)));
+  }
+  view.log_dropped = 1000;  // numbered as after a long run
+  port.clear_written();
+  port.reserve_written(32768);  // the fake port's own buffer
+  port.feed("log mission\r");
+  CHECK_NO_ALLOCATION(service(40));
+  const auto reply = lines_of(port.written());
+  CHECK_EQUAL(129U, reply.size());
+  STRCMP_CONTAINS("mission cycle=0 aaaa", reply[0].c_str());
+  STRCMP_CONTAINS("mission cycle=127 xxxx", reply[127].c_str());
+  CHECK_EQUAL("OK", reply[128]);
+}
+
+#ifndef BOTICELLI_TESTS_UNDER_EMULATOR
+TEST(Console, ParamSaveThroughTheWriterThreadReportsTheResultAsALogLine) {
+  char templ[] = "/tmp/boticelli-console-XXXXXX";
+  const std::string dir = mkdtemp(templ);
+  static StateStore store;
+  char why[256] = "";
+  CHECK(store.open(dir.c_str(), why, sizeof why));
+  StateSaver saver(store);
+  saver.start();
+  console.set_parameter_saver(&saver);
+  const auto reply = command("param save");
+  CHECK_EQUAL("param save changed=0 file=" + dir + "/parameters.conf queued", reply.at(0));
+  saver.flush();
+  port.clear_written();
+  service(2);
+  STRCMP_CONTAINS(("LOG info parameters saved to " + dir + "/parameters.conf").c_str(),
+                  port.written().c_str());
+  unlink((dir + "/parameters.conf").c_str());
+  rmdir(dir.c_str());
+}
+#endif

@@ -36,6 +36,11 @@ class FakeBoard final : public Board {
  public:
   const BoardInfo& info() const override { return kInfo; }
   const BoardConfig& config() const override { return config_; }
+  // Binds the keys to config_ as the test prepared it (no reset to other defaults).
+  bool reset_config(ConfigSchema& schema) override {
+    return add_board_config_keys(schema, config_);
+  }
+  const char* default_config_path() const override { return default_config; }
   bool init(const Options&, char* error, std::size_t size) override {
     if (refuse) {
       std::snprintf(error, size, "fake board refuses");
@@ -46,6 +51,7 @@ class FakeBoard final : public Board {
   boticelli::hal::Hal& hal() override { return hal_; }
 
   bool refuse = false;
+  const char* default_config = nullptr;       // the board's default configuration file
   std::function<void(FakeBoard&)> after_run;  // looks at the devices after the run
   BoardConfig config_{};
   boticelli::fakes::FakeClock clock{1000};
@@ -135,6 +141,8 @@ TEST_GROUP(FirmwareMain) {
   }
   void teardown() override {
     unlink((dir + "/mission.state").c_str());
+    unlink((dir + "/parameters.conf").c_str());
+    unlink((dir + "/boticelli.conf").c_str());
     rmdir(dir.c_str());
   }
 };
@@ -225,4 +233,90 @@ TEST(FirmwareMain, RefusesToResumeFromACorruptState) {
   const Run r = run_firmware({"--state", dir.c_str(), "--resume"});
   CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS("boticelli: cannot resume:", r.err.c_str());
+}
+
+namespace {
+void write_text(const std::string& path, const char* text) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  CHECK(f != nullptr);
+  std::fputs(text, f);
+  std::fclose(f);
+}
+}  // namespace
+
+TEST(FirmwareMain, AMissingFileAtTheDefaultPathIsFineButAMissingConfigFileIsAnError) {
+  Run r = run_firmware({"--max-cycles", "1"},
+                       [](FakeBoard& b) { b.default_config = "/nonexistent/boticelli.conf"; });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("no /nonexistent/boticelli.conf: compiled-in defaults", r.err.c_str());
+  r = run_firmware({"--config", "/nonexistent/other.conf"});
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+  STRCMP_CONTAINS("configuration: /nonexistent/other.conf: No such file or directory",
+                  r.err.c_str());
+  CHECK(r.out.find("MISSION") == std::string::npos);  // stopped before anything ran
+}
+
+TEST(FirmwareMain, ABadConfigFileStopsTheStartWithFileLineWhy) {
+  const std::string conf = dir + "/boticelli.conf";
+  write_text(conf, "[console]\ntelemetry_period_ms = 90000\n");
+  Run r = run_firmware({"--config", conf.c_str()});
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+  STRCMP_CONTAINS(
+      (conf + ":2: console.telemetry_period_ms = 90000 is out of range (0 to 60000)").c_str(),
+      r.err.c_str());
+  // The same file at the board's default path is just as fatal.
+  r = run_firmware({}, [&](FakeBoard& b) { b.default_config = conf.c_str(); });
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+}
+
+TEST(FirmwareMain, TheConfigFileSetsWhatTheFirmwareStartsWith) {
+  const std::string conf = dir + "/boticelli.conf";
+  write_text(conf, "[console]\ntelemetry_period_ms = 250\n");
+  std::string console_output;
+  const Run r = run_firmware({"--config", conf.c_str()}, [&](FakeBoard& b) {
+    b.console.feed("get telemetry_ms\rparam show\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS(("configuration from " + conf).c_str(), r.err.c_str());
+  STRCMP_CONTAINS("telemetry_ms=250 range=[0,60000]", console_output.c_str());
+  // The configured value is the parameter's default: nothing to show.
+  CHECK(console_output.find("telemetry_ms=250 default") == std::string::npos);
+}
+
+TEST(FirmwareMain, SavedParametersSurviveARestart) {
+  std::string console_output;
+  Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.console.feed("set telemetry_ms 250\rset bg_slice_us 3000\rparam save\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS(("param save changed=2 file=" + dir + "/parameters.conf").c_str(),
+                  console_output.c_str());
+  r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.console.feed("param show\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("parameters from ", r.err.c_str());
+  STRCMP_CONTAINS("telemetry_ms=250 default=1000\r\nbg_slice_us=3000 default=0\r\nOK",
+                  console_output.c_str());
+}
+
+TEST(FirmwareMain, ASavedParameterTheFirmwareNoLongerHasIsSkippedButAFileThatIsNotTomlStops) {
+  write_text(dir + "/parameters.conf", "retired_gain = 3\ntelemetry_ms = 500\n");
+  std::string console_output;
+  Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.console.feed("get telemetry_ms\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("parameters.conf:1: retired_gain: unknown parameter; default kept",
+                  r.err.c_str());
+  STRCMP_CONTAINS("telemetry_ms=500 ", console_output.c_str());
+  write_text(dir + "/parameters.conf", "telemetry_ms = \n");
+  r = run_firmware({"--state", dir.c_str()});
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+  STRCMP_CONTAINS("saved parameters: ", r.err.c_str());
+  STRCMP_CONTAINS("parameters.conf:1: ", r.err.c_str());
 }

@@ -82,3 +82,18 @@ TEST(Options, TakesASpeedOnlyOnTheSimBoardAndOnlyFromZeroUp) {
   CHECK_FALSE(r.ok);
   STRCMP_CONTAINS("sim board", r.error);
 }
+
+TEST(Options, TakesAConfigFileAndRefusesAnEmptyOne) {
+  const char* argv[] = {"boticelli", "--config", "/etc/robot2.conf"};
+  CHECK(parse_options(3, argv, false, options).ok);
+  STRCMP_EQUAL("/etc/robot2.conf", options.config_file);
+  const char* empty[] = {"boticelli", "--config", ""};
+  const ParseResult r = parse_options(3, empty, false, options);
+  CHECK_FALSE(r.ok);
+  STRCMP_EQUAL("option '--config' needs a FILE", r.error);
+  const char* missing[] = {"boticelli", "--config"};
+  CHECK_FALSE(parse_options(2, missing, false, options).ok);
+  const char* none[] = {"boticelli"};
+  CHECK(parse_options(1, none, false, options).ok);
+  CHECK(options.config_file == nullptr);
+}

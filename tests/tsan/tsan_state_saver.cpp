@@ -1,7 +1,8 @@
-// ThreadSanitizer check of the state writer: the executive's thread submits states while the
-// writer thread saves them, with the counters and the last error read from both sides; the
-// file must end as the newest state. A plain program (CppUTest's operator new collides with
-// ThreadSanitizer's), exit code 0 on success; any race report halts it.
+// ThreadSanitizer check of the state writer: the executive's thread submits states and
+// parameter files (as `param save` does) while the writer thread saves them, with the
+// counters and the last errors read from both sides; the files must end as the newest ones. A plain
+// program (CppUTest's operator new collides with ThreadSanitizer's), exit code 0 on success; any
+// race report halts it.
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -52,6 +53,7 @@ int main() {
   for (int round = 0; round < 3 && status == 0; ++round) {
     auto saver = std::make_unique<fw::StateSaver>(g_store);
     saver->start();
+    char parameters[64] = "";
     for (std::uint64_t c = 1; c <= 200; ++c) {
       make_state(c, g_state);
       // Read the counters after every submit, taken or not: the writer updates them after
@@ -64,9 +66,22 @@ int main() {
         (void)saver->failures();
         saver->last_error(error, sizeof error);
       }
+      std::snprintf(parameters, sizeof parameters, "gain = %llu\n",
+                    static_cast<unsigned long long>(c));
+      while (saver->submit_parameters(parameters) == fw::StateSaver::Submitted::kBusy) {
+        (void)saver->parameter_saves();
+        (void)saver->parameter_failures();
+        (void)saver->parameter_error(error, sizeof error);
+      }
     }
     saver->flush();
-    if (saver->failures() != 0) status = fail("a save failed");
+    if (saver->failures() != 0 || saver->parameter_failures() != 0) status = fail("a save failed");
+    char last[64] = "";
+    FILE* f = std::fopen((std::string(dir) + "/parameters.conf").c_str(), "rb");
+    if (f == nullptr) return fail("no parameters file");
+    last[std::fread(last, 1, sizeof last - 1, f)] = '\0';
+    std::fclose(f);
+    if (std::strcmp(last, "gain = 200\n") != 0) status = fail("the parameters are not the newest");
     if (saver->saved() < 1 || saver->saved() > 200) status = fail("implausible save count");
     saver.reset();  // joins the writer
     if (g_store.load(g_loaded, error, sizeof error) != fw::LoadResult::kLoaded) {
@@ -79,6 +94,7 @@ int main() {
   const std::string base(dir);
   unlink((base + "/mission.state").c_str());
   unlink((base + "/mission.state.tmp").c_str());
+  unlink((base + "/parameters.conf").c_str());
   rmdir(dir);
   if (status == 0) std::printf("tsan_state_saver: ok\n");
   return status;

@@ -7,7 +7,11 @@ install(FILES ${BOTICELLI_PACKAGING_DIR}/boticelli.service
               ${BOTICELLI_PACKAGING_DIR}/boticelli-can0.service
         DESTINATION lib/systemd/system)
 install(FILES ${BOTICELLI_PACKAGING_DIR}/60-boticelli.rules DESTINATION lib/udev/rules.d)
+# The configuration file, every key commented out at its default: a conffile (listed in
+# DEBIAN/conffiles below), so dpkg keeps an administrator's changes across upgrades.
+install(FILES ${BOTICELLI_PACKAGING_DIR}/boticelli.conf DESTINATION /etc/boticelli)
 install(FILES ${PROJECT_SOURCE_DIR}/docs/flashing.md ${PROJECT_SOURCE_DIR}/docs/console.md
+              ${PROJECT_SOURCE_DIR}/docs/configuration.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR} OPTIONAL)
 install(FILES ${BOTICELLI_PACKAGING_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(FILES ${BOTICELLI_PACKAGING_DIR}/boticelli.bash-completion
@@ -55,8 +59,9 @@ fitted to single-camera stereo, after D. O. Gorodnichy's thesis.\n\
 .\n\
 This package holds the firmware for the Raspberry Pi 4 reference robot as a\n\
 hardened systemd service with a software watchdog, the unit that brings up the\n\
-CAN interface, udev rules for the GPIO chip, watchdog and camera, the manual\n\
-page and bash completion. The serial console is documented in\n\
+CAN interface, udev rules for the GPIO chip, watchdog and camera, the\n\
+configuration file /etc/boticelli/boticelli.conf, the manual page and bash\n\
+completion. The serial console is documented in\n\
 /usr/share/doc/boticelli/console.md.")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
@@ -67,7 +72,7 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 # Runtime libraries of the rpi4 executable (see `readelf -d boticelli`), and what the
 # maintainer scripts and units call.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libgpiodcxx1 (>= 1.6), adduser, systemd, init-system-helpers (>= 1.54~), iproute2, udev")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libgpiodcxx1 (>= 1.6), libpng16-16 (>= 1.6), libtomlplusplus3 (>= 3.3.0), adduser, systemd, init-system-helpers (>= 1.54~), iproute2, udev")
 # The console from a laptop or the robot itself, and CAN bring-up checks (docs/flashing.md).
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "picocom, can-utils")
 # A stripped binary in the package, its debug information in boticelli-dbgsym (a .ddeb):
@@ -78,6 +83,6 @@ set(CPACK_OBJCOPY_EXECUTABLE ${CMAKE_OBJCOPY})
 set(CPACK_READELF_EXECUTABLE ${CMAKE_READELF})
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${BOTICELLI_PACKAGING_DIR}/postinst ${BOTICELLI_PACKAGING_DIR}/prerm
-    ${BOTICELLI_PACKAGING_DIR}/postrm)
+    ${BOTICELLI_PACKAGING_DIR}/postrm ${BOTICELLI_PACKAGING_DIR}/conffiles)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 include(CPack)

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "algo/core/geometry.h"
+#include "firmware/config_file.h"
 #include "firmware/options.h"
 #include "firmware/snapshot.h"
 #include "hal/hal.h"
@@ -99,6 +100,14 @@ class Board {
   virtual ~Board() = default;
   virtual const BoardInfo& info() const = 0;
   virtual const BoardConfig& config() const = 0;
+  // Puts the config (and the board's device settings) back to the compiled-in defaults of
+  // boards/<board>/board_config.h and adds the keys a configuration file may set, bound to
+  // them (add_board_config_keys() and the board's devices). The firmware then applies the
+  // file, before init().
+  virtual bool reset_config(ConfigSchema& schema) = 0;
+  // The configuration file read when there is no --config FILE (it may be missing), or
+  // nullptr: only --config.
+  virtual const char* default_config_path() const { return nullptr; }
   // Creates the devices for these options (the sim board loads --world). The firmware then
   // calls each device's init()/open() once. On failure returns false and writes a one-line
   // reason into `error`.

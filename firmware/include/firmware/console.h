@@ -14,6 +14,7 @@
 #include "firmware/mission_view.h"
 #include "firmware/parameters.h"
 #include "firmware/safety.h"
+#include "firmware/state_saver.h"
 #include "firmware/text_buffer.h"
 #include "hal/serial_port.h"
 
@@ -42,6 +43,9 @@ class Console {
     clock_ = clock;
   }
   void set_board_name(const char* name) { board_name_ = name; }
+  // Where `param save` hands the changed parameters (written into the state directory by
+  // the saver's thread); without one (no --state DIR) `param save` is refused. At init.
+  void set_parameter_saver(StateSaver* saver);
   // The console task's body: flushes output, reads and executes input, sends telemetry.
   void service(std::uint64_t now_us);
   // Sends queued output only (no input, telemetry or health lines): for the shutdown drain.
@@ -95,6 +99,8 @@ class Console {
   void cmd_get(const Words& w);
   void cmd_set(const Words& w);
   void cmd_log(const Words& w);
+  void cmd_param(const Words& w);
+  void check_parameter_saves();
   void cmd_ver(const Words& w);
   void cmd_shutdown(const Words& w);
   void append_parameter(const Parameter& p);
@@ -122,9 +128,15 @@ class Console {
   LogRing* ring_ = nullptr;
   hal::Clock* clock_ = nullptr;
   const char* board_name_ = "?";
-  bool log_streaming_ = false;  // a `log show` reply is being queued
+  bool log_streaming_ = false;  // a `log show` or `log mission` reply is being queued
+  bool log_mission_ = false;    // ... and it is `log mission` (the mission log, by line number)
   std::uint64_t log_next_ = 0;  // its next line's sequence number in the ring
   std::uint64_t log_end_ = 0;   // one past its last
+
+  StateSaver* parameter_saver_ = nullptr;
+  std::array<char, ParameterTable::kMaxFileBytes> parameter_text_{};  // `param save`'s file
+  std::uint64_t seen_parameter_saves_ = 0;
+  std::uint64_t seen_parameter_failures_ = 0;
 
   float telemetry_ms_ = 1000.0F;  // 0 = off
   float echo_ = 0.0F;             // 1 = echo typed characters (for terminals without local echo)

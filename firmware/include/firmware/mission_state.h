@@ -43,6 +43,9 @@ struct MissionState {
   std::array<char, kMaxModelBytes> model{};  // the last occupancy ALN, text format (opaque here)
   std::size_t model_bytes = 0;
   core::FixedVector<MissionLogEntry, kMaxLogEntries> log;  // oldest first
+  // Lines dropped from the front of `log` since clear() (not saved): log[i] is line number
+  // log_dropped + i of this run, so a reader can follow the log while it moves on.
+  std::uint64_t log_dropped = 0;
 
   std::string_view model_text() const { return {model.data(), model_bytes}; }
   // False (model unchanged) when the text is longer than kMaxModelBytes or contains NUL.
@@ -54,6 +57,7 @@ struct MissionState {
   void clear();
 };
 
+// Compares what the state file holds (log_dropped is not part of it).
 bool operator==(const MissionState& a, const MissionState& b);
 
 }  // namespace boticelli::firmware

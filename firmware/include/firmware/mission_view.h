@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "algo/core/geometry.h"
+#include "firmware/mission_state.h"
 
 namespace boticelli::firmware {
 
@@ -43,6 +44,14 @@ class MissionView {
   virtual std::string_view model_text() const { return {}; }
   virtual MapCounts map_counts() const { return {}; }
   virtual TargetEstimate target() const { return {}; }
+  // The mission log kept in the state file (MissionState::log), by line number: the first
+  // line still kept, one past the last, and a line (nullptr when no longer or not yet kept).
+  virtual std::uint64_t mission_log_begin() const { return 0; }
+  virtual std::uint64_t mission_log_end() const { return 0; }
+  virtual const MissionLogEntry* mission_log_line(std::uint64_t number) const {
+    (void)number;
+    return nullptr;
+  }
 
  protected:
   MissionView() = default;

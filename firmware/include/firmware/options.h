@@ -18,6 +18,7 @@ struct Options {
   ConsoleKind console = ConsoleKind::kStdio;  // --console stdio|pty|PATH
   const char* console_path = nullptr;         // the PATH of --console PATH
   const char* state_dir = nullptr;            // --state DIR
+  const char* config_file = nullptr;          // --config FILE (else the board's default path)
   bool resume = false;                        // --resume
   bool show_help = false;                     // --help
   bool show_version = false;                  // --version

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "firmware/atomic_file.h"
 #include "firmware/mission_state.h"
 
 namespace boticelli::firmware {
@@ -29,23 +30,14 @@ bool decode_state(std::string_view file, MissionState& out, const char** error);
 
 enum class LoadResult : std::uint8_t { kLoaded, kMissing, kCorrupt, kIoError };
 
-// The steps of StateStore::save(), for the crash hook.
-enum class SaveStep : std::uint8_t {
-  kTempCreated,   // the temporary file exists, empty
-  kChunkWritten,  // another chunk of the file is written (not yet synced)
-  kTempSynced,    // the temporary file is complete and fsynced
-  kRenamed,       // it has replaced the state file (directory not yet synced)
-};
-// Test seam: called after each step; returning true makes save() stop there as if the
-// process had been killed (its descriptors closed, nothing cleaned up).
-using SaveCrashHook = bool (*)(SaveStep step, void* context);
-
-// The state directory. save() is atomic: it writes `mission.state.tmp`, fsyncs it, renames
-// it over `mission.state` and fsyncs the directory, so after a crash at any point the file
-// is either the previous state or the new one, never a mix.
+// The state directory. save() is atomic (write_file_atomically): it writes
+// `mission.state.tmp`, fsyncs it, renames it over `mission.state` and fsyncs the directory,
+// so after a crash at any point the file is either the previous state or the new one, never
+// a mix. save_parameters() does the same for the console's saved parameters.
 class StateStore {
  public:
   static constexpr const char* kFileName = "mission.state";
+  static constexpr const char* kParametersFileName = "parameters.conf";
 
   StateStore() = default;
   StateStore(const StateStore&) = delete;
@@ -54,21 +46,25 @@ class StateStore {
   // Uses `dir`, creating it (one level) when missing. False with a reason otherwise.
   bool open(const char* dir, char* error, std::size_t error_size);
   bool save(const MissionState& state, char* error, std::size_t error_size);
+  // Replaces `parameters.conf` with `text` (the console's `param save`), atomically.
+  bool save_parameters(std::string_view text, char* error, std::size_t error_size);
   // kLoaded fills `out`; kMissing when there is no state file; kCorrupt (out cleared) when
   // the file is truncated, altered or from another version; the reason goes to `error`.
   LoadResult load(MissionState& out, char* error, std::size_t error_size);
   const char* path() const { return path_.data(); }
+  const char* parameters_path() const { return parameters_path_.data(); }
+  bool is_open() const { return dir_[0] != '\0'; }
   std::uint64_t saves() const { return saves_; }
   void set_crash_hook(SaveCrashHook hook, void* context) {
     crash_hook_ = hook;
     crash_context_ = context;
   }
-  static constexpr std::size_t kWriteChunkBytes = std::size_t{16} * 1024;
+  static constexpr std::size_t kWriteChunkBytes = kAtomicWriteChunkBytes;
 
  private:
   std::array<char, 512> dir_{};
   std::array<char, 512> path_{};
-  std::array<char, 512> tmp_path_{};
+  std::array<char, 512> parameters_path_{};
   std::array<char, kMaxStateFileBytes> buffer_{};
   std::uint64_t saves_ = 0;
   SaveCrashHook crash_hook_ = nullptr;

@@ -2,12 +2,16 @@
 // frames.
 #pragma once
 
+#include <array>
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <string_view>
 #include <thread>
 
 #include "firmware/mission_state.h"
+#include "firmware/parameters.h"
 #include "firmware/persistence.h"
 
 namespace boticelli::firmware {
@@ -16,7 +20,8 @@ namespace boticelli::firmware {
 // no allocation); the writer thread (normal scheduling, started at init) encodes and saves
 // it atomically through the StateStore. When states come faster than the disk takes them,
 // the newest one waits and older, not yet started ones are dropped (each file is a
-// complete state, so only the latest matters).
+// complete state, so only the latest matters). The console's saved parameters take the
+// same road (submit_parameters), so `param save` never waits for the disk either.
 class StateSaver {
  public:
   explicit StateSaver(StateStore& store) : store_(store) {}
@@ -37,8 +42,26 @@ class StateSaver {
   // The last failure's reason, copied into `out`.
   void last_error(char* out, std::size_t size) const;
 
+  enum class Submitted : std::uint8_t {
+    kQueued,  // handed to the writer thread; parameter_saves() or parameter_failures() counts it
+    kSaved,   // written at once (no writer thread)
+    kFailed,  // written at once and failed: parameter_error() says why
+    kBusy,    // the writer is taking the previous text: try again later
+    kTooLong  // longer than ParameterTable::kMaxFileBytes
+  };
+  // Hands a copy of the parameter file's text to the writer (try_lock, no I/O, no
+  // allocation), or writes it at once when the thread is not started.
+  Submitted submit_parameters(std::string_view text);
+  std::uint64_t parameter_saves() const { return parameter_saves_.load(); }
+  std::uint64_t parameter_failures() const { return parameter_failures_.load(); }
+  // The last failed parameter save's reason into `out`; false (nothing copied) when the
+  // writer holds the lock just now (try again later). Never blocks.
+  bool parameter_error(char* out, std::size_t size) const;
+  const char* parameters_path() const { return store_.parameters_path(); }
+
  private:
   void run();
+  void save_parameters_now(std::string_view text);  // counts the result
 
   StateStore& store_;
   mutable std::mutex mutex_;
@@ -52,6 +75,13 @@ class StateSaver {
   std::uint64_t failures_ = 0;
   char error_[256] = "";
   MissionState writing_;  // the writer thread's own copy
+  std::array<char, ParameterTable::kMaxFileBytes> parameters_pending_{};  // guarded by mutex_
+  std::size_t parameters_pending_bytes_ = 0;
+  bool has_parameters_ = false;
+  std::array<char, ParameterTable::kMaxFileBytes> parameters_writing_{};  // the writer's copy
+  std::atomic<std::uint64_t> parameter_saves_{0};
+  std::atomic<std::uint64_t> parameter_failures_{0};
+  char parameter_error_[256] = "";  // guarded by mutex_
   std::thread thread_;
 };
 

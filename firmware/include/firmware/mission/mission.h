@@ -109,6 +109,12 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint32_t pieces() const override { return last_pieces_; }
   std::uint64_t cycles() const override { return state_.cycle; }
   std::string_view model_text() const override { return state_.model_text(); }
+  std::uint64_t mission_log_begin() const override { return state_.log_dropped; }
+  std::uint64_t mission_log_end() const override { return state_.log_dropped + state_.log.size(); }
+  const MissionLogEntry* mission_log_line(std::uint64_t number) const override {
+    if (number < mission_log_begin() || number >= mission_log_end()) return nullptr;
+    return &state_.log[static_cast<std::size_t>(number - state_.log_dropped)];
+  }
   MapCounts map_counts() const override;
   TargetEstimate target() const override;
 

@@ -28,6 +28,8 @@ class ConsolePort final : public hal::SerialPort {
   // At board init (before open()): which line open() will use. Builds the termios port in
   // place (no heap).
   void select(ConsoleMode mode, const char* device_path);
+  // Before select(): the baud rate of a kDevice line (the board's configured one).
+  void set_baud(std::uint32_t baud) { baud_ = baud; }
   bool open() override;
   std::ptrdiff_t read(std::uint8_t* buffer, std::size_t max) override;
   std::ptrdiff_t write(const std::uint8_t* data, std::size_t size) override;
