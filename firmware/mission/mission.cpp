@@ -983,6 +983,10 @@ void Mission::snapshot_step() {
 void Mission::finish_saving() {
   while (snapshot_pending_ || snapshot_writing_) snapshot_step();  // the last cycle's picture
   if (saver_ == nullptr) return;
+  // Where the base came to rest, not where the last cycle ended: it may still have rolled a
+  // few millimetres after its step was done, or been stopped mid-drive.
+  state_.pose = odometry_pose();
+  submit_pending_ = true;
   while (submit_pending_) submit_pending_ = !saver_->submit(state_);
   saver_->flush();
 }

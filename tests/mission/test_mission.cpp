@@ -341,10 +341,14 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   const MissionRun second =
       run_mission("thesis_room", "1", 0.0F, nullptr, {"--state", dir.c_str(), "--resume"});
   check_found_safely(second);
+  // Put back where the base came to rest (the trace keeps 4 decimals, and its last row may be
+  // a frame older than the last odometry). On this run the base has stopped when the last
+  // cycle ends; where it had not (it rolled 2.4 mm on in a run of other Look settings), the
+  // pose saved at shutdown is the one that holds this.
   const sim::TraceRow& resumed = second.trace.front();
-  DOUBLES_EQUAL(stopped.x_m, resumed.x_m, 0.002);
-  DOUBLES_EQUAL(stopped.y_m, resumed.y_m, 0.002);
-  DOUBLES_EQUAL(0.0, std::remainder(stopped.yaw_rad - resumed.yaw_rad, 2.0 * M_PI), 0.002);
+  DOUBLES_EQUAL(stopped.x_m, resumed.x_m, 0.0005);
+  DOUBLES_EQUAL(stopped.y_m, resumed.y_m, 0.0005);
+  DOUBLES_EQUAL(0.0, std::remainder(stopped.yaw_rad - resumed.yaw_rad, 2.0 * M_PI), 0.0005);
   // The pose in the mission's frame (the trace's odometry columns) carries on too: the map
   // and the goal saved in that frame still fit.
   double before[3] = {0.0, 0.0, 0.0};

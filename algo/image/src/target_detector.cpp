@@ -334,6 +334,10 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   out.u_px = static_cast<float>(u_apex);
   out.v_px = static_cast<float>(v_apex);
   out.area_px = area;
+  out.box_u_min = u_min;
+  out.box_u_max = u_max;
+  out.box_v_min = v_min;
+  out.box_v_max = v_max;
   return out;
 }
 

@@ -1,6 +1,7 @@
 // Frame-pair processing: features → epipolar tracks → triangulation → Readings (Eq 3.8).
 #include "algo/stereo/stereo_processor.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "algo/evidence/sensor_model.h"
@@ -133,11 +134,77 @@ TargetFix StereoProcessor::locate_target(const image::LowResFrame& first,
                    Eigen::Vector2f(fix.second.u_px, fix.second.v_px), fix.point_ptu_m)) {
     return fix;
   }
+  if (params_.target_range_from_edges) {
+    refine_target_range(first, second, pose1, pose2, fix);
+  }
   fix.confidence =
       fix.first.confidence < fix.second.confidence ? fix.first.confidence : fix.second.confidence;
   fix.reading = reading_from_point(fix.point_ptu_m, fix.confidence);
   fix.found = true;
   return fix;
+}
+
+void StereoProcessor::refine_target_range(const image::LowResFrame& first,
+                                          const image::LowResFrame& second, const CameraPose& pose1,
+                                          const CameraPose& pose2, TargetFix& fix) {
+  // Edge pixels of the triangle (its box grown by one): strong vertical derivative, tracked
+  // along their epipolar lines, triangulated; their horizontal distance from the PTU axis.
+  // The paper is upright, so the vertex shares the distance of the triangle's middle, which
+  // the median of a symmetric set of edges gives.
+  const image::TargetDetection& d = fix.first;
+  const std::uint32_t u0 = d.box_u_min > 0 ? d.box_u_min - 1 : 0;
+  const std::uint32_t v0 = d.box_v_min > 0 ? d.box_v_min - 1 : 0;
+  const std::uint32_t u1 = std::min(d.box_u_max + 1, first.width - 1);
+  const std::uint32_t v1 = std::min(d.box_v_max + 1, first.height - 1);
+  std::size_t n = 0;
+  for (std::uint32_t v = std::max(v0, 3U); v <= v1 && v + 3 < first.height; ++v) {
+    for (std::uint32_t u = std::max(u0, 3U); u <= u1 && u + 3 < first.width; ++u) {
+      if (n >= edge_rho_.size()) break;
+      const float g = 0.5F * std::fabs(first.y(u, v + 1) - first.y(u, v - 1));
+      if (g < params_.target_edge_min_strength) continue;
+      const Eigen::Vector2f px(static_cast<float>(u), static_cast<float>(v));
+      image::EpipolarSegment segment;
+      if (!epipolar_segment(pose1, pose2, px, segment)) continue;
+      const image::Track t = image::track_feature(first, u, v, second, segment, params_.tracking);
+      if (!t.found) continue;
+      Eigen::Vector3f p;
+      if (!triangulate(pose1, pose2, px, Eigen::Vector2f(t.u_px, t.v_px), p)) continue;
+      edge_rho_[n++] = std::hypot(p.x(), p.y());
+    }
+  }
+  // The vertex's own triangulation sets the window the edges may refine it in: a fraction of
+  // the range error of one pixel of disparity (Eq 3.7) around its horizontal distance. Edges
+  // outside it matched something else (near the target, many of a pair's edges can land on
+  // the background and pull the median off by most of a metre).
+  const float vertex_rho = std::hypot(fix.point_ptu_m.x(), fix.point_ptu_m.y());
+  const float window = params_.target_edge_window *
+                       evidence::range_error_m((fix.point_ptu_m - pose1.centre_m).norm(),
+                                               (pose2.centre_m - pose1.centre_m).norm(),
+                                               rig_.low_res_camera().focal_px);
+  std::size_t inliers = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::fabs(edge_rho_[i] - vertex_rho) <= window) edge_rho_[inliers++] = edge_rho_[i];
+  }
+  n = inliers;
+  if (n < params_.target_min_edges || n == 0) return;
+  const auto mid = edge_rho_.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(edge_rho_.begin(), mid, edge_rho_.begin() + static_cast<std::ptrdiff_t>(n));
+  const float rho = *mid;
+  // The vertex on its first-frame line of sight c + t·d at horizontal distance ρ:
+  // |c_xy + t·d_xy|² = ρ², the far root (the line leaves the PTU axis outwards).
+  const Eigen::Vector3f dir =
+      RigModel::ray_ptu(pose1, rig_.low_res_camera(), Eigen::Vector2f(d.u_px, d.v_px));
+  const Eigen::Vector2f c(pose1.centre_m.x(), pose1.centre_m.y());
+  const Eigen::Vector2f e(dir.x(), dir.y());
+  const float a = e.squaredNorm();
+  const float b = 2.0F * c.dot(e);
+  const float k = c.squaredNorm() - rho * rho;
+  const float disc = b * b - 4.0F * a * k;
+  if (!(a > 1e-9F) || !(disc >= 0.0F)) return;
+  const float t = (-b + std::sqrt(disc)) / (2.0F * a);
+  if (!(t > 0.0F)) return;
+  fix.point_ptu_m = pose1.centre_m + t * dir;
+  fix.edges = n;
 }
 
 }  // namespace boticelli::stereo

@@ -127,7 +127,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // Ends the mission from outside: shutdown (aborted) or --max-cycles (not found).
   void abort(const char* why);
   void finish_not_found(const char* why) { finish(Result::kNotFound, why); }
-  // Shutdown: hands over a state still waiting for the writer and waits until it is saved.
+  // Shutdown: saves the pose where the base came to rest and waits until the state is written.
   void finish_saving();
   // Per-stage host CPU time so far [s] (the benchmark's split).
   [[nodiscard]] double look_cpu_s() const { return cpu_s_[0]; }

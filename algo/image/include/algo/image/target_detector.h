@@ -41,6 +41,11 @@ struct TargetDetection {
   float v_px = 0.0F;
   float confidence = 0.0F;  // in [0, 1]
   std::size_t area_px = 0;  // green area of the triangle [low-resolution px]
+  // The triangle's bounding box, inclusive [low-resolution px].
+  std::uint32_t box_u_min = 0;
+  std::uint32_t box_u_max = 0;
+  std::uint32_t box_v_min = 0;
+  std::uint32_t box_v_max = 0;
 };
 
 // Finds green blobs (connected components, hysteresis on chromaticity), keeps those shaped

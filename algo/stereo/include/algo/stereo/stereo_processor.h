@@ -1,6 +1,7 @@
 // Single-camera stereo on one frame pair (§3.4.1): features, tracks, triangulation → Readings.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -23,6 +24,19 @@ struct StereoParams {
   float match_error_max = 1500.0F;  // E_max of Eq 3.8 [grey levels²], in agreement with E_thresh
   float min_range_m = 0.2F;         // nearest depth searched, from the first optical centre [m]
   bool fast_triangulation = false;  // Eq 3.4 instead of the exact Eq 3.2
+  // The target's range from its edges: the triangle's edges are tracked like features
+  // (sub-pixel along the epipolar line) and the vertex put at their median horizontal
+  // distance on its own line of sight; the vertex alone is two fitted lines' intersection,
+  // whose row is several times less precise than a tracked edge's. Needs at least
+  // target_min_edges tracked edge pixels within target_edge_window (else the vertex's own
+  // triangulation stands).
+  bool target_range_from_edges = false;
+  std::size_t target_min_edges = 4;
+  // Edges count only within this share of the vertex's one-pixel range error δr (Eq 3.7) of
+  // its own distance: the vertex is located to a few tenths of a pixel, so an edge farther
+  // off tracked something other than the triangle.
+  float target_edge_window = 0.2F;
+  float target_edge_min_strength = 4.0F;  // |∂Y/∂v| of an edge pixel [grey levels per px]
 };
 
 // Where the PTU was for the two frames [rad]: same pan; the second frame after tilting
@@ -46,8 +60,9 @@ struct StereoPoint {
 
 // The target (§3.4.2) found in both frames of a pair and triangulated like a feature.
 struct TargetFix {
-  bool found = false;                                     // seen in both frames and triangulated
-  float confidence = 0.0F;                                // the lower of the two detections'
+  bool found = false;       // seen in both frames and triangulated
+  float confidence = 0.0F;  // the lower of the two detections'
+  std::size_t edges = 0;    // tracked edge pixels that set the range (0: the vertex's own)
   Eigen::Vector3f point_ptu_m = Eigen::Vector3f::Zero();  // the corner, PTU frame [m]
   evidence::Reading reading;     // {α, h, r} of the corner; m = confidence
   image::TargetDetection first;  // per-frame detections (low-res px)
@@ -98,6 +113,9 @@ class StereoProcessor {
   [[nodiscard]] const core::FixedVector<StereoPoint, kMaxPoints>& points() const { return points_; }
 
  private:
+  void refine_target_range(const image::LowResFrame& first, const image::LowResFrame& second,
+                           const CameraPose& pose1, const CameraPose& pose2, TargetFix& fix);
+
   RigModel rig_;
   StereoParams params_;
   image::FeatureSelector selector_;
@@ -106,6 +124,7 @@ class StereoProcessor {
   image::LowResFrame second_;
   core::FixedVector<image::Feature, kMaxPoints> features_;
   core::FixedVector<StereoPoint, kMaxPoints> points_;
+  std::array<float, 512> edge_rho_{};  // the target's edge distances [m]
 };
 
 }  // namespace boticelli::stereo
