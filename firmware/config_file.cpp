@@ -232,14 +232,20 @@ bool parse_toml(std::string_view text, const char* path, toml::table& out, char*
   }
 }
 
+// The fields every key has; the factories below add where its value lives and its range.
+ConfigKey key_of(const char* table, const char* name, ConfigKind kind) {
+  ConfigKey k;
+  k.table = table;
+  k.name = name;
+  k.kind = kind;
+  return k;
+}
+
 }  // namespace
 
 ConfigKey ConfigKey::whole(const char* table, const char* name, std::uint32_t& value,
                            std::uint32_t min, std::uint32_t max, std::uint32_t multiple_of) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kWhole;
+  ConfigKey k = key_of(table, name, ConfigKind::kWhole);
   k.u32 = &value;
   k.min = min;
   k.max = max;
@@ -249,10 +255,7 @@ ConfigKey ConfigKey::whole(const char* table, const char* name, std::uint32_t& v
 
 ConfigKey ConfigKey::whole(const char* table, const char* name, std::uint8_t& value,
                            std::uint8_t min, std::uint8_t max) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kWhole;
+  ConfigKey k = key_of(table, name, ConfigKind::kWhole);
   k.u8 = &value;
   k.min = min;
   k.max = max;
@@ -261,10 +264,7 @@ ConfigKey ConfigKey::whole(const char* table, const char* name, std::uint8_t& va
 
 ConfigKey ConfigKey::number(const char* table, const char* name, float& value, double min,
                             double max) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kNumber;
+  ConfigKey k = key_of(table, name, ConfigKind::kNumber);
   k.f32 = &value;
   k.min = min;
   k.max = max;
@@ -272,37 +272,25 @@ ConfigKey ConfigKey::number(const char* table, const char* name, float& value, d
 }
 
 ConfigKey ConfigKey::flag_key(const char* table, const char* name, bool& value) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kFlag;
+  ConfigKey k = key_of(table, name, ConfigKind::kFlag);
   k.flag = &value;
   return k;
 }
 
 ConfigKey ConfigKey::baud(const char* table, const char* name, std::uint32_t& value) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kBaud;
+  ConfigKey k = key_of(table, name, ConfigKind::kBaud);
   k.u32 = &value;
   return k;
 }
 
 ConfigKey ConfigKey::path(const char* table, const char* name, DeviceName& value) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kPath;
+  ConfigKey k = key_of(table, name, ConfigKind::kPath);
   k.text = &value;
   return k;
 }
 
 ConfigKey ConfigKey::interface_name(const char* table, const char* name, DeviceName& value) {
-  ConfigKey k;
-  k.table = table;
-  k.name = name;
-  k.kind = ConfigKind::kName;
+  ConfigKey k = key_of(table, name, ConfigKind::kName);
   k.text = &value;
   return k;
 }

@@ -21,6 +21,7 @@
 #include "firmware/persistence.h"
 #include "firmware/state_saver.h"
 
+#include "test_files.h"
 #include "CppUTest/TestHarness.h"
 
 using namespace boticelli::firmware;
@@ -28,30 +29,9 @@ namespace rpi4 = boticelli::boards::rpi4;
 
 namespace {
 
-std::string read_file(const std::string& path) {
-  std::string out;
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return out;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.append(buf, n);
-  std::fclose(f);
-  return out;
-}
-
-void write_file(const std::string& path, const std::string& text) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  CHECK(f != nullptr);
-  std::fwrite(text.data(), 1, text.size(), f);
-  std::fclose(f);
-}
-
-std::string temp_dir() {
-  char templ[] = "/tmp/boticelli-config-XXXXXX";
-  const char* dir = mkdtemp(templ);
-  CHECK(dir != nullptr);
-  return dir;
-}
+using boticelli::test::read_file;
+using boticelli::test::temp_dir;
+using boticelli::test::write_file;
 
 void remove_dir(const std::string& dir) {
   for (const char* name :
@@ -191,7 +171,7 @@ TEST(ConfigFile, AMissingFileIsReportedAsMissingAndAnUnreadableOneAsInvalid) {
   CHECK(load_config_file("/nonexistent/boticelli.conf", k.schema, error, sizeof error) ==
         ConfigLoad::kMissing);
   STRCMP_CONTAINS("/nonexistent/boticelli.conf: No such file", error);
-  const std::string dir = temp_dir();
+  const std::string dir = temp_dir("config");
   // A directory cannot be read as a file.
   CHECK(load_config_file(dir.c_str(), k.schema, error, sizeof error) == ConfigLoad::kInvalid);
   write_file(dir + "/boticelli.conf", "[robot]\nradius_m = 0.3\n");
@@ -323,7 +303,7 @@ TEST(SavedParameters, UnknownNamesAndRefusedValuesAreSkippedWithTheirLine) {
 }
 
 TEST(SavedParameters, ARoundTripThroughTheStateDirectoryKeepsEveryChangedValue) {
-  const std::string dir = temp_dir();
+  const std::string dir = temp_dir("config");
   static StateStore store;
   char error[320] = "";
   CHECK(store.open(dir.c_str(), error, sizeof error));
@@ -347,7 +327,7 @@ TEST(SavedParameters, ARoundTripThroughTheStateDirectoryKeepsEveryChangedValue) 
 
 #ifndef BOTICELLI_TESTS_UNDER_EMULATOR
 TEST(SavedParameters, TheWriterThreadSavesWhatTheConsoleHandsItWithoutBlockingIt) {
-  const std::string dir = temp_dir();
+  const std::string dir = temp_dir("config");
   static StateStore store;
   char error[320] = "";
   CHECK(store.open(dir.c_str(), error, sizeof error));
@@ -364,7 +344,7 @@ TEST(SavedParameters, TheWriterThreadSavesWhatTheConsoleHandsItWithoutBlockingIt
 TEST_GROUP(AtomicWrite) {
   std::string dir;
   void setup() override {
-    dir = temp_dir();
+    dir = temp_dir("config");
   }
   void teardown() override {
     remove_dir(dir);

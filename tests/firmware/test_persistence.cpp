@@ -18,12 +18,17 @@
 #include "firmware/persistence.h"
 #include "firmware/state_saver.h"
 
+#include "test_files.h"
 #include "CppUTest/TestHarness.h"
 
 using namespace boticelli::firmware;
 using boticelli::core::Point2;
 
 namespace {
+
+using boticelli::test::read_file;
+using boticelli::test::temp_dir;
+using boticelli::test::write_file;
 
 // Large buffers live in static storage, not on the stack.
 MissionState g_a;
@@ -58,34 +63,9 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   }
 }
 
-std::string temp_dir() {
-  char templ[] = "/tmp/boticelli-state-XXXXXX";
-  const char* dir = mkdtemp(templ);
-  CHECK(dir != nullptr);
-  return dir;
-}
-
 void remove_dir(const std::string& dir) {
   for (const char* name : {"/mission.state", "/mission.state.tmp"}) unlink((dir + name).c_str());
   rmdir(dir.c_str());
-}
-
-std::string read_file(const std::string& path) {
-  std::string out;
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return out;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) out.append(buf, n);
-  std::fclose(f);
-  return out;
-}
-
-void write_file(const std::string& path, const std::string& bytes) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  CHECK(f != nullptr);
-  std::fwrite(bytes.data(), 1, bytes.size(), f);
-  std::fclose(f);
 }
 
 // A file body with its checksum line appended: a file that passes the CRC, so the body
@@ -102,7 +82,7 @@ TEST_GROUP(Persistence) {
   std::string dir;
   char error[256] = "";
   void setup() override {
-    dir = temp_dir();
+    dir = temp_dir("state");
   }
   void teardown() override {
     remove_dir(dir);
