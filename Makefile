@@ -9,14 +9,14 @@ SUITE ?= all
 FUZZ_SECONDS ?= 60
 
 .PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze run test check bench format \
-        format-check sim asan rpi4 armhf fuzz-build test-sim test-asan test-rpi4 test-fuzz fuzz \
+        format-check bench-build sim asan rpi4 armhf fuzz-build test-sim test-asan test-rpi4 test-fuzz fuzz \
         analyze mutants clean
 
 help:
 	@echo "make run       install deps, build the sim preset, run the firmware on the sim board"
 	@echo "make test      install deps, build and test the sim, asan and rpi4 (qemu) presets"
 	@echo "make test-sim  build and test the sim preset only (fast iteration)"
-	@echo "make check     format-check and analyze (about 15 min on two cores)"
+	@echo "make check     format-check, analyze and build the bench (about 15 min on two cores)"
 	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
 	@echo "make package-rpi4 / make deploy HOST=user@robot   build the arm64 .deb / install it over ssh"
@@ -100,9 +100,18 @@ mutants: deps
 check: deps
 	$(MAKE) format-check
 	$(MAKE) analyze
+	$(MAKE) bench-build
 
+# Builds boticelli-bench (warnings are errors) without running it: make check's guard that the
+# bench still compiles, since make test does not build it.
+bench-build: deps-bench
+	$(call build,sim)
+	cmake --build --preset sim --target boticelli-bench -j $(JOBS)
+
+# The bench is not in the sim preset's default build (make test does not need it).
 bench: deps-bench
 	$(call build,sim)
+	cmake --build --preset sim --target boticelli-bench -j $(JOBS)
 	build/sim/bin/boticelli-bench $(SUITE) --json
 
 format:

@@ -33,7 +33,7 @@ done
 # (libFuzzer, sanitizers): the fuzz preset, which make test runs. libtomlplusplus-dev: the
 # configuration file's parser (a shared library, libtomlplusplus3, which the .deb depends on).
 host_pkgs=(
-  g++ make cmake pkg-config clang-format file systemd clang-14 libclang-rt-14-dev
+  g++ make cmake ninja-build pkg-config clang-format file systemd clang-14 libclang-rt-14-dev
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev libtomlplusplus-dev
   libsdformat-dev
 )
