@@ -304,10 +304,11 @@ bool BaseOdriveCan::encoders_current(std::uint64_t now_us) const {
 }
 
 void BaseOdriveCan::update_odometry(std::uint64_t now_us) {
-  // Both wheels' estimates must be current: a wheel whose stream stopped would otherwise
-  // be integrated as standing still while the other moves (a phantom turn).
+  // Only with a new estimate from both wheels: a wheel whose stream stopped would otherwise
+  // be integrated as standing still while the other moves (a phantom turn). Its silence
+  // stops the base after encoder_timeout_ms (update()).
   if (!encoders_current(now_us)) return;
-  if (!axes_[0].encoder_fresh && !axes_[1].encoder_fresh) return;
+  if (!axes_[0].encoder_fresh || !axes_[1].encoder_fresh) return;
   axes_[0].encoder_fresh = axes_[1].encoder_fresh = false;
   integrator_.update({axes_[0].encoder.pos_turns, axes_[1].encoder.pos_turns});
   odometry_.x_m = integrator_.x_m();
