@@ -103,10 +103,10 @@ modinfo_field() { # FILE FIELD
     tr '\0' '\n' | sed -n "s/^$2=//p"
 }
 declare -A module_file=()
-while IFS= read -r f; do
-  n=$(basename "$f" .ko)
+while read -r n f; do
+  n=${n%.ko}
   module_file[${n//-/_}]=$f
-done < <(find "$modules/kernel" -name '*.ko')
+done < <(find "$modules/kernel" -name '*.ko' -printf '%f %p\n')
 module_file[gpio_sim]=$gsim/gpio-sim.ko
 declare -A have=()
 add_module() {
