@@ -14,8 +14,8 @@
 #                                        amd64 kernel and kernel source packages, fetched with
 #                                        apt-get download into the kernel cache (below)
 #
-# The kernel cache is $BOTICELLI_KERNEL_CACHE, by default build/kernel-cache in the
-# repository; it holds the two .deb files (about 210 MB), never installed into the host.
+# The kernel cache is $BOTICELLI_KERNEL_CACHE, by default ~/.cache/boticelli-kernel (so fresh
+# clones share it); it holds the two .deb files (about 210 MB), never installed into the host.
 # Idempotent: when everything is present it prints nothing and exits 0.
 set -euo pipefail
 
@@ -70,7 +70,9 @@ pkgs=("${host_pkgs[@]}")
 [ "$want_kernel" = 1 ] && pkgs+=("${kernel_pkgs[@]}")
 
 repo=$(cd "$(dirname "$0")/.." && pwd)
-kernel_cache=${BOTICELLI_KERNEL_CACHE:-$repo/build/kernel-cache}
+if [ -n "${HOME:-}" ]; then default_cache=${XDG_CACHE_HOME:-$HOME/.cache}/boticelli-kernel
+else default_cache=$repo/build/kernel-cache; fi
+kernel_cache=${BOTICELLI_KERNEL_CACHE:-$default_cache}
 pkg_installed() {
   [ "$(dpkg-query -W -f='${db:Status-Status}' "$1" 2>/dev/null || true)" = installed ]
 }

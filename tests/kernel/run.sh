@@ -15,7 +15,10 @@ tests_bin=$(readlink -f "$1")
 work=$2
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
-cache=${BOTICELLI_KERNEL_CACHE:-$repo/build/kernel-cache}
+# The same default as toolchain/install-deps.sh.
+if [ -n "${HOME:-}" ]; then default_cache=${XDG_CACHE_HOME:-$HOME/.cache}/boticelli-kernel
+else default_cache=$repo/build/kernel-cache; fi
+cache=${BOTICELLI_KERNEL_CACHE:-$default_cache}
 mkdir -p "$work"
 work=$(cd "$work" && pwd)
 
