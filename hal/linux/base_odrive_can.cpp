@@ -138,6 +138,7 @@ bool BaseOdriveCan::open_socket() {
     return false;
   }
   ifindex_ = ifr.ifr_ifindex;
+  bus_off_ = false;  // a new socket on a (re-added) interface: its controller starts afresh
   return true;
 }
 
@@ -249,6 +250,9 @@ void BaseOdriveCan::receive(std::uint64_t now_us) {
     if (n < 0) {
       if (errno == EINTR) continue;
       if (errno != EAGAIN && errno != EWOULDBLOCK) {
+        // ENETDOWN: the link went down (ip link set can0 down); bringing it up again starts
+        // the controller afresh, so a bus-off seen before is over. ENODEV: it was deleted.
+        if (errno == ENETDOWN || errno == ENODEV) bus_off_ = false;
         char text[120];
         set_error(text, "CAN read failed", errno);
         fault(text);

@@ -133,7 +133,7 @@ console=$work/console.log
 echo "kernel_in_the_loop: $kver ($pkgver), ${#have[@]} modules; prepared in ${prepared} s"
 boot_start=$(date +%s.%N)
 set +e
-timeout 240 qemu-system-x86_64 -accel tcg -m 512M -smp 1 -nographic -no-reboot \
+timeout 240 qemu-system-x86_64 -accel tcg -m 512M -smp 1 -nographic -no-reboot -nic none -vga none \
   -kernel "$kdir/boot/vmlinuz-$kver" -initrd "$work/initrd.gz" \
   -append "console=ttyS0 quiet panic=-1 printk.time=1" </dev/null 2>&1 |
   while IFS= read -r line; do

@@ -171,6 +171,22 @@ TEST(KernelCanLink, TheLinkGoingDownStopsTheBaseAndResumeWaitsUntilItIsUp) {
   CHECK_TRUE_TEXT(rig.ready_within(1500), rig.base->error());
 }
 
+TEST(KernelCanLink, ABusOffIsOverOnceTheLinkHasBeenTakenDownAndUp) {
+  CanRig rig;
+  CHECK_TRUE_TEXT(rig.start(), rig.base->error());
+  rig.emu.send_error_frame(CAN_ERR_BUSOFF);
+  CHECK_TRUE(rig.stopped_within(200));
+  CHECK_TRUE(rig.base->bus_off());
+  // What an operator does when the controller has no restart-ms: the controller starts
+  // afresh, and no CAN_ERR_RESTARTED frame says so.
+  CHECK_EQUAL(0, sh("ip link set down vcan0"));
+  rig.run_ms(100);
+  CHECK_EQUAL(0, sh("ip link set up vcan0"));
+  CHECK_FALSE(rig.base->bus_off());
+  CHECK_TRUE_TEXT(rig.base->resume(), rig.base->error());
+  CHECK_TRUE_TEXT(rig.ready_within(1500), rig.base->error());
+}
+
 TEST(KernelCanLink, AStopThatCouldNotBeSentWhileTheLinkWasDownIsSentWhenItIsBack) {
   CanRig rig;
   CHECK_TRUE_TEXT(rig.start(), rig.base->error());
