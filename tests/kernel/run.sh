@@ -7,8 +7,8 @@
 #
 # Exit 0: every part passed; 1: a part failed (the console log says which); 77: skipped
 # because qemu cannot run here (the reason is printed). The kernel and source packages come
-# from the kernel cache that toolchain/install-deps.sh --kernel fills; unpacked kernels, the
-# gpio-sim module and the parts' logs are kept in WORK_DIR between runs.
+# from the kernel cache that toolchain/install-deps.sh --kernel fills; the unpacked kernel
+# and the gpio-sim module are kept there too, the initramfs and the console log in WORK_DIR.
 set -euo pipefail
 
 tests_bin=$(readlink -f "$1")
@@ -51,8 +51,12 @@ source_deb=$(ls "$cache"/linux-source-*_"$pkgver"_all.deb 2>/dev/null | head -n1
 headers=/usr/src/linux-headers-$kver
 [ -d "$headers" ] || fail "$headers is missing (toolchain/install-deps.sh --kernel)"
 
-# 1. The kernel, unpacked once per version.
-kdir=$work/kernel-$pkgver
+# 1. The kernel, unpacked once per version into the kernel cache (so that fresh clones
+# share it; about 400 MB), older versions' products removed.
+for old in "$cache"/unpacked-* "$cache"/gpio-sim-*; do
+  case "$old" in *-"$pkgver") ;; *) [ -d "$old" ] && rm -rf "$old" ;; esac
+done
+kdir=$cache/unpacked-$pkgver
 if [ ! -f "$kdir/.unpacked" ]; then
   rm -rf "$kdir"
   dpkg-deb -x "$image_deb" "$kdir"
@@ -63,7 +67,7 @@ modules=$kdir/lib/modules/$kver
 # 2. gpio-sim, built out of tree once per version: Debian's config does not build it. It
 # needs irq_sim (CONFIG_IRQ_SIM is off too, so it is compiled into the same module), and in
 # 6.1 irq_to_desc is not exported: its one call becomes generic_handle_irq.
-gsim=$work/gpio-sim-$pkgver
+gsim=$cache/gpio-sim-$pkgver
 if [ ! -f "$gsim/gpio-sim.ko" ]; then
   rm -rf "$gsim" && mkdir -p "$gsim/src"
   series=$(basename "$source_deb" | sed 's/^linux-source-\([0-9.]*\)_.*/\1/')
