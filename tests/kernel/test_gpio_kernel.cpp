@@ -50,14 +50,14 @@ GpioLineConfig line(unsigned offset, bool active_low = false) {
   return c;
 }
 
-// Toggles the line `toggles` times, 0.5 ms apart (each edge reaches the event queue; the
-// queue holds 16), without polling in between.
+// Toggles the line `toggles` times, 1 ms apart (so that each edge reaches the event queue;
+// the queue holds 16), without polling in between.
 void bounce(unsigned offset, bool from_high, int toggles) {
   bool high = from_high;
   for (int i = 0; i < toggles; ++i) {
     high = !high;
     set_level(offset, high);
-    ::usleep(500);
+    ::usleep(1000);
   }
 }
 
@@ -103,13 +103,13 @@ TEST(KernelGpio, AContactBouncingMoreThan16TimesBetweenTwoPollsEndsAtTheRightLev
   CHECK_NO_ALLOCATION(level = estop.read());  // 16 events and the level in one poll
   CHECK_TRUE(level);
   CHECK_TRUE(poll_for(estop, 50));
-  CHECK_EQUAL(16U, estop.events() - before);  // the kernel's queue was full
+  CHECK_EQUAL_TEXT(16U, estop.events() - before, "the bounce did not fill the kernel's queue");
   // And back: 41 edges from high end low; the 16th kept is a rising one.
   bounce(0, true, 41);
   CHECK_EQUAL(0, line_value(0));
   const std::uint32_t middle = estop.events();
   CHECK_FALSE(poll_for(estop, 50));
-  CHECK_EQUAL(16U, estop.events() - middle);
+  CHECK_EQUAL_TEXT(16U, estop.events() - middle, "the bounce did not fill the kernel's queue");
 }
 
 TEST(KernelGpio, TheBumperIsActiveLowWithItsLinePulledDown) {
