@@ -112,6 +112,21 @@ TEST(KernelGpio, AContactBouncingMoreThan16TimesBetweenTwoPollsEndsAtTheRightLev
   CHECK_EQUAL_TEXT(16U, estop.events() - middle, "the bounce did not fill the kernel's queue");
 }
 
+TEST(KernelGpio, EdgesAreDebouncedAtTheirKernelTimestampsNotAtThePoll) {
+  set_level(0, false);
+  DigitalInGpiod estop(line(0), cycles.clock(), true);
+  CHECK_TRUE_TEXT(estop.init(), estop.error());
+  CHECK_FALSE(estop.read());
+  set_level(0, true);  // a 3 ms press ...
+  ::usleep(3000);
+  set_level(0, false);
+  ::usleep(30000);                                // ... seen by a poll 30 ms later
+  CHECK_TRUE(estop.activated_since_last_poll());  // latched, so not missed
+  // Released 27 ms ago, past the 10 ms debounce: inactive now. Debounced at the poll's time,
+  // the release would still be held back for 10 ms.
+  CHECK_FALSE(estop.read());
+}
+
 TEST(KernelGpio, TheBumperIsActiveLowWithItsLinePulledDown) {
   set_level(1, true);
   DigitalInGpiod bumper(line(1, true), cycles.clock());
