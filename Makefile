@@ -8,14 +8,16 @@ ARGS ?=
 SUITE ?= all
 FUZZ_SECONDS ?= 60
 
-.PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze run test check bench format \
-        format-check bench-build sim asan rpi4 armhf fuzz-build test-sim test-asan test-rpi4 test-fuzz fuzz \
+.PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze deps-kernel test-kernel run test check \
+        bench bench-build format format-check sim asan rpi4 armhf fuzz-build test-sim test-asan \
+        test-rpi4 test-fuzz fuzz \
         analyze mutants clean
 
 help:
 	@echo "make run       install deps, build the sim preset, run the firmware on the sim board"
 	@echo "make test      install deps, build and test the sim, asan and rpi4 (qemu) presets"
 	@echo "make test-sim  build and test the sim preset only (fast iteration)"
+	@echo "make test-kernel  the drivers against the kernel's virtual devices under qemu"
 	@echo "make check     format-check, analyze and build the bench (about 15 min on two cores)"
 	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
@@ -35,6 +37,8 @@ deps-bench:
 	@toolchain/install-deps.sh --bench
 deps-analyze:
 	@toolchain/install-deps.sh --analyze
+deps-kernel:
+	@toolchain/install-deps.sh --kernel
 
 # configure+build one preset: $(call build,PRESET)
 define build
@@ -58,8 +62,14 @@ run: sim
 	@echo "snapshots of each cycle go to $(SNAPSHOTS)/"
 	build/sim/bin/boticelli --world $(WORLD) --snapshots $(SNAPSHOTS) --max-cycles 60 $(ARGS)
 
-test-sim: sim
+# The sim preset's ctest includes kernel_in_the_loop (tests/kernel), which needs --kernel.
+test-sim: sim deps-kernel
 	ctest --preset sim -j $(JOBS)
+# The kernel-in-the-loop test alone (about a minute; docs/testing.md).
+test-kernel: deps-kernel
+	cmake --preset sim >/dev/null
+	cmake --build --preset sim --target kernel_tests -j $(JOBS)
+	ctest --preset sim -R kernel_in_the_loop --output-on-failure
 test-asan: asan
 	ctest --preset asan -j $(JOBS)
 test-rpi4: rpi4

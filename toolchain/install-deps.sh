@@ -9,7 +9,13 @@
 #   toolchain/install-deps.sh --bench    also the peers the benchmarks compare against
 #                                        (OpenCV, OctoMap); never needed by the firmware
 #   toolchain/install-deps.sh --analyze  also clang-tidy and cppcheck (make analyze)
+#   toolchain/install-deps.sh --kernel   also what the kernel-in-the-loop test needs (qemu,
+#                                        busybox, can-utils, the kernel headers) and Debian's
+#                                        amd64 kernel and kernel source packages, fetched with
+#                                        apt-get download into the kernel cache (below)
 #
+# The kernel cache is $BOTICELLI_KERNEL_CACHE, by default ~/.cache/boticelli-kernel (so fresh
+# clones share it); it holds the two .deb files (about 210 MB), never installed into the host.
 # Idempotent: when everything is present it prints nothing and exits 0.
 set -euo pipefail
 
@@ -17,13 +23,15 @@ want_cross=0
 want_bench=0
 want_armhf=0
 want_analyze=0
+want_kernel=0
 for arg in "$@"; do
   case "$arg" in
     --cross) want_cross=1 ;;
     --bench) want_bench=1 ;;
     --armhf) want_armhf=1 ;;
     --analyze) want_analyze=1 ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --kernel) want_kernel=1 ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-deps: unknown option '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -49,12 +57,36 @@ armhf_pkgs=(
 )
 bench_pkgs=(libopencv-dev liboctomap-dev)
 analyze_pkgs=(clang-tidy-14 cppcheck)
+# tests/kernel: qemu boots Debian's kernel with a busybox initramfs; candump records the CAN
+# bus; binutils (objcopy) reads the modules' dependencies; xz-utils unpacks the kernel source.
+# The headers of the image's kernel ABI (for the out-of-tree gpio-sim module) are added below.
+kernel_pkgs=(qemu-system-x86 busybox-static cpio can-utils binutils xz-utils)
 
 pkgs=("${host_pkgs[@]}")
 [ "$want_cross" = 1 ] && pkgs+=("${cross_pkgs[@]}")
 [ "$want_armhf" = 1 ] && pkgs+=("${armhf_pkgs[@]}")
 [ "$want_bench" = 1 ] && pkgs+=("${bench_pkgs[@]}")
 [ "$want_analyze" = 1 ] && pkgs+=("${analyze_pkgs[@]}")
+[ "$want_kernel" = 1 ] && pkgs+=("${kernel_pkgs[@]}")
+
+repo=$(cd "$(dirname "$0")/.." && pwd)
+if [ -n "${HOME:-}" ]; then default_cache=${XDG_CACHE_HOME:-$HOME/.cache}/boticelli-kernel
+else default_cache=$repo/build/kernel-cache; fi
+kernel_cache=${BOTICELLI_KERNEL_CACHE:-$default_cache}
+pkg_installed() {
+  [ "$(dpkg-query -W -f='${db:Status-Status}' "$1" 2>/dev/null || true)" = installed ]
+}
+# The kernel cache is complete when it holds one image, the source of the same version, and
+# that version's headers are installed.
+kernel_ready() {
+  local img abi ver
+  img=$(ls "$kernel_cache"/linux-image-*-amd64_*_amd64.deb 2>/dev/null | head -n1)
+  [ -n "$img" ] || return 1
+  abi=$(dpkg-deb -f "$img" Package) && abi=${abi#linux-image-}
+  ver=$(dpkg-deb -f "$img" Version)
+  ls "$kernel_cache"/linux-source-*_"$ver"_all.deb >/dev/null 2>&1 || return 1
+  pkg_installed "linux-headers-$abi"
+}
 
 if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
   echo "install-deps: this script needs a Debian-based system (dpkg and apt-get); install by hand: ${pkgs[*]}" >&2
@@ -71,7 +103,9 @@ for p in "${pkgs[@]}"; do
   [ -n "$status" ] || status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
   [ "$status" = "installed" ] || missing+=("$p")
 done
-[ "${#missing[@]}" = 0 ] && exit 0
+need_kernel=0
+if [ "$want_kernel" = 1 ] && ! kernel_ready; then need_kernel=1; fi
+[ "${#missing[@]}" = 0 ] && [ "$need_kernel" = 0 ] && exit 0
 
 sudo=()
 if [ "$(id -u)" != 0 ]; then
@@ -83,7 +117,7 @@ if [ "$(id -u)" != 0 ]; then
   fi
 fi
 
-echo "install-deps: installing ${missing[*]}"
+[ "${#missing[@]}" = 0 ] || echo "install-deps: installing ${missing[*]}"
 needs_arch() {
   local arch=$1
   printf '%s\n' "${missing[@]}" | grep -q ":$arch\$" || return 1
@@ -110,9 +144,36 @@ if [ "$updated" = 0 ]; then
   grep -E '^(E|W):' "$log" | head -n 5 >&2 || true
   echo "install-deps: warning: 'apt-get update' reported errors; trying the install with the package lists apt has" >&2
 fi
-if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >"$log" 2>&1; then
+if [ "${#missing[@]}" -gt 0 ] &&
+   ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >"$log" 2>&1; then
   tail -n 30 "$log" >&2
   echo "install-deps: could not install: ${missing[*]}" >&2
   exit 1
+fi
+
+if [ "$need_kernel" = 1 ]; then
+  # The kernel the linux-image-amd64 dependency names now (e.g. linux-image-6.1.0-57-amd64),
+  # the source package of the same version and that ABI's headers: all three move together
+  # when Debian's kernel ABI number changes.
+  image=$(apt-cache depends linux-image-amd64 2>/dev/null |
+          sed -n 's/^ *Depends: \(linux-image-[0-9].*-amd64\)$/\1/p' | head -n1)
+  [ -n "$image" ] || { echo "install-deps: apt does not know linux-image-amd64's kernel" >&2; exit 1; }
+  abi=${image#linux-image-}
+  ver=$(apt-cache show "$image" | sed -n 's/^Version: //p' | head -n1)
+  series=${abi%%.0-*}  # 6.1.0-57 -> 6.1
+  echo "install-deps: fetching $image $ver and linux-source-$series into $kernel_cache"
+  if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "linux-headers-$abi=$ver" >"$log" 2>&1; then
+    tail -n 30 "$log" >&2
+    echo "install-deps: could not install linux-headers-$abi" >&2
+    exit 1
+  fi
+  mkdir -p "$kernel_cache"
+  rm -f "$kernel_cache"/linux-image-*.deb "$kernel_cache"/linux-source-*.deb
+  # apt-get download writes into the current directory; as root it warns about the sandbox.
+  if ! (cd "$kernel_cache" && apt-get download -qq "$image=$ver" "linux-source-$series=$ver") >"$log" 2>&1; then
+    tail -n 30 "$log" >&2
+    echo "install-deps: could not download $image and linux-source-$series $ver" >&2
+    exit 1
+  fi
 fi
 echo "install-deps: done"

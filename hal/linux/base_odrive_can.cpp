@@ -85,40 +85,9 @@ bool BaseOdriveCan::init() {
   if (config_.socket_fd >= 0) {
     fd_ = config_.socket_fd;
     config_.socket_fd = -1;  // owned now; a second init() opens the interface
-  } else {
-    fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
-    if (fd_ < 0) {
-      set_error(error_, "base: cannot open a CAN socket", errno);
-      return false;
-    }
-    // Kernel filters: only frames from the two nodes (any command), plus error frames.
-    can_filter filters[2];
-    for (int i = 0; i < 2; ++i) {
-      filters[i].can_id = static_cast<canid_t>(axes_[i].node_id) << 5U;
-      filters[i].can_mask = (static_cast<canid_t>(odrive::kMaxNodeId) << 5U) | CAN_EFF_FLAG;
-    }
-    const can_err_mask_t err_mask = CAN_ERR_MASK;  // every error class
-    ifreq ifr{};
-    std::snprintf(ifr.ifr_name, IFNAMSIZ, "%s", config_.interface);
-    sockaddr_can addr{};
-    if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, filters, sizeof filters) != 0 ||
-        ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof err_mask) != 0) {
-      set_error(error_, "base: cannot set CAN filters", errno);
-      close_socket();
-      return false;
-    }
-    if (::ioctl(fd_, SIOCGIFINDEX, &ifr) != 0) {
-      set_error(error_, "base: no such CAN interface", errno);
-      close_socket();
-      return false;
-    }
-    addr.can_family = AF_CAN;
-    addr.can_ifindex = ifr.ifr_ifindex;
-    if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-      set_error(error_, "base: cannot bind the CAN socket", errno);
-      close_socket();
-      return false;
-    }
+    owns_interface_ = false;
+  } else if (!open_socket()) {
+    return false;
   }
   ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK);
   integrator_ = codec::DiffDriveOdometry(config_.geometry);
@@ -128,12 +97,82 @@ bool BaseOdriveCan::init() {
   return true;
 }
 
+bool BaseOdriveCan::open_socket() {
+  close_socket();
+  owns_interface_ = true;
+  fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+  if (fd_ < 0) {
+    set_error(error_, "base: cannot open a CAN socket", errno);
+    return false;
+  }
+  // Kernel filters: only frames from the two nodes (any command), plus the error frames the
+  // driver acts on. Bus errors (CAN_ERR_PROT, CAN_ERR_BUSERROR, ...) are left out: on a bad
+  // bus they come by the thousand and would crowd the heartbeats out of the bounded drain.
+  can_filter filters[2];
+  for (int i = 0; i < 2; ++i) {
+    filters[i].can_id = static_cast<canid_t>(axes_[i].node_id) << 5U;
+    filters[i].can_mask = (static_cast<canid_t>(odrive::kMaxNodeId) << 5U) | CAN_EFF_FLAG;
+  }
+  const can_err_mask_t err_mask = CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
+  if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, filters, sizeof filters) != 0 ||
+      ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof err_mask) != 0) {
+    set_error(error_, "base: cannot set CAN filters", errno);
+    close_socket();
+    return false;
+  }
+  ifreq ifr{};
+  std::snprintf(ifr.ifr_name, IFNAMSIZ, "%s", config_.interface);
+  if (::ioctl(fd_, SIOCGIFINDEX, &ifr) != 0) {
+    char what[80];
+    std::snprintf(what, sizeof what, "base: no such CAN interface %s", ifr.ifr_name);
+    set_error(error_, what, errno);
+    close_socket();
+    return false;
+  }
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = ifr.ifr_ifindex;
+  if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    set_error(error_, "base: cannot bind the CAN socket", errno);
+    close_socket();
+    return false;
+  }
+  ifindex_ = ifr.ifr_ifindex;
+  bus_off_ = false;  // a new socket on a (re-added) interface: its controller starts afresh
+  return true;
+}
+
+// True when the interface the socket should use exists and is up; a socket bound to an
+// interface that was deleted (and maybe added again under the same name, with a new index)
+// is dead for good, so a new one is opened.
+bool BaseOdriveCan::interface_usable() {
+  ifreq ifr{};
+  std::snprintf(ifr.ifr_name, IFNAMSIZ, "%s", config_.interface);
+  char what[80];
+  if (fd_ < 0 || ::ioctl(fd_, SIOCGIFINDEX, &ifr) != 0) {
+    if (!open_socket()) return false;
+  } else if (ifr.ifr_ifindex != ifindex_ && !open_socket()) {
+    return false;
+  }
+  if (::ioctl(fd_, SIOCGIFFLAGS, &ifr) != 0) {
+    std::snprintf(what, sizeof what, "base: cannot read the state of %s", ifr.ifr_name);
+    set_error(error_, what, errno);
+    return false;
+  }
+  if ((ifr.ifr_flags & IFF_UP) == 0) {
+    std::snprintf(error_, sizeof error_, "base: CAN interface %s is down", ifr.ifr_name);
+    return false;
+  }
+  return true;
+}
+
 void BaseOdriveCan::begin_startup(std::uint64_t now_us) {
   health_ = hal::BaseHealth::kStarting;
   error_[0] = '\0';
   setpoint_turns_s_ = {};
   for (Axis& a : axes_) {
     a.heartbeat_seen = false;
+    a.encoder_seen = false;
     a.encoder_fresh = false;
   }
   startup_deadline_us_ = now_us + std::uint64_t{config_.startup_timeout_ms} * 1000U;
@@ -182,6 +221,7 @@ void BaseOdriveCan::fault(const char* what, const char* side, std::uint32_t valu
     }
   }
   health_ = hal::BaseHealth::kStopped;
+  next_stop_send_us_ = clock_.now_us() + std::uint64_t{config_.stop_resend_ms} * 1000U;
   setpoint_turns_s_ = {};
   odometry_.v_m_s = 0.0F;
   odometry_.omega_rad_s = 0.0F;
@@ -210,6 +250,9 @@ void BaseOdriveCan::receive(std::uint64_t now_us) {
     if (n < 0) {
       if (errno == EINTR) continue;
       if (errno != EAGAIN && errno != EWOULDBLOCK) {
+        // ENETDOWN: the link went down (ip link set can0 down); bringing it up again starts
+        // the controller afresh, so a bus-off seen before is over. ENODEV: it was deleted.
+        if (errno == ENETDOWN || errno == ENODEV) bus_off_ = false;
         char text[120];
         set_error(text, "CAN read failed", errno);
         fault(text);
@@ -249,15 +292,27 @@ void BaseOdriveCan::receive(std::uint64_t now_us) {
       a.encoder = m.encoder;
       a.encoder_seen = true;
       a.encoder_fresh = true;
+      a.last_encoder_us = now_us;
     } else {
       ++rejected_frames_;  // a host -> ODrive command seen on the bus (another master)
     }
   }
 }
 
+bool BaseOdriveCan::encoders_current(std::uint64_t now_us) const {
+  const std::uint64_t limit = std::uint64_t{config_.encoder_timeout_ms} * 1000U;
+  for (const Axis& a : axes_) {
+    if (!a.encoder_seen || now_us - a.last_encoder_us > limit) return false;
+  }
+  return true;
+}
+
 void BaseOdriveCan::update_odometry(std::uint64_t now_us) {
-  if (!axes_[0].encoder_seen || !axes_[1].encoder_seen) return;
-  if (!axes_[0].encoder_fresh && !axes_[1].encoder_fresh) return;
+  // Only with a new estimate from both wheels: a wheel whose stream stopped would otherwise
+  // be integrated as standing still while the other moves (a phantom turn). Its silence
+  // stops the base after encoder_timeout_ms (update()).
+  if (!encoders_current(now_us)) return;
+  if (!axes_[0].encoder_fresh || !axes_[1].encoder_fresh) return;
   axes_[0].encoder_fresh = axes_[1].encoder_fresh = false;
   integrator_.update({axes_[0].encoder.pos_turns, axes_[1].encoder.pos_turns});
   odometry_.x_m = integrator_.x_m();
@@ -282,6 +337,7 @@ void BaseOdriveCan::update() {
     }
     if (ready) {
       health_ = hal::BaseHealth::kReady;
+      ready_since_us_ = now;
     } else if (now >= startup_deadline_us_) {
       for (int k = 0; k < 2; ++k) {
         const Axis& a = axes_[k];
@@ -306,9 +362,27 @@ void BaseOdriveCan::update() {
       return;
     }
   }
+  if (health_ == hal::BaseHealth::kStopped) {
+    // Keep commanding the stop: one that was refused (link down, full TX queue) or lost
+    // gets through later, and an ODrive that came back on its own is stopped again.
+    if (now >= next_stop_send_us_) {
+      for (const Axis& a : axes_) {
+        send(odrive::encode_set_input_vel(a.node_id, 0.0F));
+        send(odrive::encode_estop(a.node_id));
+      }
+      next_stop_send_us_ = now + std::uint64_t{config_.stop_resend_ms} * 1000U;
+    }
+    return;
+  }
   if (health_ != hal::BaseHealth::kReady) return;
+  const std::uint64_t encoder_limit_us = std::uint64_t{config_.encoder_timeout_ms} * 1000U;
   for (int k = 0; k < 2; ++k) {
     const Axis& a = axes_[k];
+    const std::uint64_t encoder_since = a.encoder_seen ? a.last_encoder_us : ready_since_us_;
+    if (now - encoder_since > encoder_limit_us) {
+      fault("encoder estimates stopped", kSide[k], 0);
+      return;
+    }
     if (now - a.last_heartbeat_us > std::uint64_t{config_.heartbeat_timeout_ms} * 1000U) {
       fault("heartbeat lost", kSide[k], 0);
       return;
@@ -356,9 +430,15 @@ void BaseOdriveCan::stop() {
 }
 
 bool BaseOdriveCan::resume() {
-  if (fd_ < 0) return false;
+  if (fd_ < 0 && !owns_interface_) return false;
   if (health_ != hal::BaseHealth::kStopped) return true;
-  bus_off_ = false;  // a bus-off controller restarts (restart-ms); the heartbeats will tell
+  if (bus_off_) {
+    // The controller leaves bus-off by itself with restart-ms set (CAN_ERR_RESTARTED), or by
+    // `ip link set can0 type can restart`; until then nothing can be sent.
+    set_error(error_, "base: the CAN controller is bus-off; resume after it restarts");
+    return false;
+  }
+  if (owns_interface_ && !interface_usable()) return false;
   integrator_.reset_reference();
   begin_startup(clock_.now_us());
   return true;

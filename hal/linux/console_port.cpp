@@ -38,6 +38,9 @@ void ConsolePort::select(ConsoleMode mode, const char* device_path) {
 
 bool ConsolePort::open() {
   error_[0] = '\0';
+  // A second open() makes a new pair: the old slave goes (it used to leak).
+  if (pty_slave_fd_ >= 0) ::close(pty_slave_fd_);
+  pty_slave_fd_ = -1;
   if (!active_->open()) return false;
   if (mode_ != ConsoleMode::kPty) return true;
   const int master = tty_->fd();

@@ -1,8 +1,11 @@
 // DigitalInGpiod / DigitalOutGpiod: thin libgpiod 1.6 wrappers; the logic is in DebouncedInput.
 #include "hal/linux/gpio_gpiod.h"
 
+#include <linux/gpio.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <exception>
@@ -39,7 +42,8 @@ bool DigitalInGpiod::init() {
     if (config_.pull_up) req.flags = gpiod::line_request::FLAG_BIAS_PULL_UP;
     line_.request(req);
     event_fd_ = line_.event_get_fd();
-    filter_.reset(line_.get_value() != 0, clock_.now_us());
+    last_event_us_ = clock_.now_us();
+    filter_.reset(line_.get_value() != 0, last_event_us_);
   } catch (const std::exception& e) {
     describe(error_, sizeof error_, "cannot request the input line", config_, e);
     return false;
@@ -52,13 +56,28 @@ bool DigitalInGpiod::init() {
 void DigitalInGpiod::service() {
   if (!ok_) return;
   try {
+    const std::uint64_t now = clock_.now_us();
     for (int i = 0; i < 32; ++i) {  // bounded: a bouncing contact cannot keep us here
       pollfd p{event_fd_, POLLIN, 0};
       if (::poll(&p, 1, 0) <= 0 || (p.revents & POLLIN) == 0) break;
       const gpiod::line_event ev = line_.event_read();
-      filter_.on_edge(ev.event_type == gpiod::line_event::RISING_EDGE, clock_.now_us());
+      ++events_;
+      // The kernel stamps each edge on CLOCK_MONOTONIC (the Linux board's clock) when it
+      // happens; kept in order and never later than now, whatever clock the board uses.
+      const auto stamp_ns = static_cast<std::uint64_t>(ev.timestamp.count());
+      last_event_us_ = std::clamp(stamp_ns / 1000U, last_event_us_, now);
+      filter_.on_edge(ev.event_type == gpiod::line_event::RISING_EDGE, last_event_us_);
     }
-    filter_.settle(clock_.now_us());
+    // The kernel's queue holds 16 events and drops the newest when full, so after a long
+    // bounce the last edge may be gone: the line's level now has the last word. One ioctl
+    // on the event descriptor (GPIOHANDLE_GET_LINE_VALUES_IOCTL), nothing allocated.
+    gpiohandle_data level{};
+    if (::ioctl(event_fd_, GPIOHANDLE_GET_LINE_VALUES_IOCTL, &level) != 0) {
+      set_error(error_, "gpio: reading the input line's level failed", errno);
+      ok_ = false;
+      return;
+    }
+    filter_.on_level(level.values[0] != 0, now);
   } catch (const std::exception& e) {
     describe(error_, sizeof error_, "reading events failed", config_, e);
     ok_ = false;

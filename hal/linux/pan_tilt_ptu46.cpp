@@ -55,6 +55,13 @@ void PanTiltPtu46::pop_front() {
   sent_bytes_ = 0;
 }
 
+bool PanTiltPtu46::queued(Kind kind) const {
+  for (std::size_t i = 0; i < count_; ++i) {
+    if (queue_[(head_ + i) % kQueueCapacity].kind == kind) return true;
+  }
+  return false;
+}
+
 void PanTiltPtu46::drop_queued(Kind kind) {
   // Removes not-yet-sent commands of one kind, keeping the order of the others.
   const std::size_t first = outstanding_ ? 1 : 0;
@@ -168,10 +175,19 @@ void PanTiltPtu46::update() {
       return;
     }
   }
-  if (phase_ == Phase::kReady && state_.moving && count_ == 0 && now >= next_poll_us_) {
+  // Position polls while moving, whatever else is queued (a move_to() every cycle keeps
+  // the queue busy), but never two pending at once.
+  if (phase_ == Phase::kReady && state_.moving && now >= next_poll_us_ && !queued(Kind::kQuery)) {
     queue_query(Axis::kPan, Query::kPosition);
     queue_query(Axis::kTilt, Query::kPosition);
     next_poll_us_ = now + std::uint64_t{config_.position_poll_ms} * 1000U;
+  }
+  // Liveness while idle: a unit that died (power, cable) must be noticed before the next
+  // move needs it; any answer counts, so this only asks when the line has been quiet.
+  if (phase_ == Phase::kReady && count_ == 0 && config_.idle_query_ms > 0 &&
+      now >= next_liveness_us_) {
+    queue_query(Axis::kPan, Query::kPosition);
+    next_liveness_us_ = now + std::uint64_t{config_.idle_query_ms} * 1000U;
   }
   send_next(now);
 }
@@ -224,14 +240,14 @@ void PanTiltPtu46::handle_line(std::string_view line, std::uint64_t now_us) {
   const bool in_reset = outstanding_ && queue_[head_].kind == Kind::kReset;
   if (r.kind == ReplyKind::kLimitPan || r.kind == ReplyKind::kLimitTilt) {
     if (in_reset) return;  // the reset runs each axis into its limits on purpose
+    // A report of its own, not an answer: the command in flight (a move of that axis too)
+    // still gets its '*', so nothing is taken off the queue, or every later reply would be
+    // matched with the command after its own.
     const Axis a = r.kind == ReplyKind::kLimitPan ? Axis::kPan : Axis::kTilt;
-    const bool answers_move =
-        outstanding_ && queue_[head_].kind == Kind::kMove && queue_[head_].axis == a;
     std::snprintf(error_, sizeof error_, "PTU: %s axis hit a limit",
                   a == Axis::kPan ? "pan" : "tilt");
     state_.fault = true;
     axis(a).moving = false;
-    if (answers_move) pop_front();
     if (phase_ == Phase::kReady) queue_query(a, Query::kPosition);
     refresh_state();
     return;
@@ -240,6 +256,7 @@ void PanTiltPtu46::handle_line(std::string_view line, std::uint64_t now_us) {
     ++garbage_lines_;  // a reply nobody asked for (stale, or from before a resync)
     return;
   }
+  next_liveness_us_ = now_us + std::uint64_t{config_.idle_query_ms} * 1000U;
   complete(r, now_us);
 }
 
@@ -350,6 +367,7 @@ void PanTiltPtu46::finish_init() {
   limits_.tilt_resolution_rad =
       static_cast<float>(codec::ptu46::counts_to_rad(1.0, t.arcsec_per_count));
   phase_ = Phase::kReady;
+  next_liveness_us_ = clock_.now_us() + std::uint64_t{config_.idle_query_ms} * 1000U;
   state_.fault = false;
   error_[0] = '\0';
 }

@@ -3,8 +3,10 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 
@@ -160,17 +162,47 @@ SerialStdio::~SerialStdio() {
   close();
 }
 
+namespace {
+
+// A descriptor of its own for stdin or stdout that is non-blocking without touching the
+// shared one: O_NONBLOCK belongs to the open file description, which the parent shell
+// shares and would keep after a crash (its next read fails with EAGAIN). A terminal or pipe
+// is opened anew through /proc/self/fd (a new description); a regular file never blocks
+// and is duplicated (a new open would start at offset 0); anything else (a socket) is
+// duplicated and `guarded`: read and written only when poll() says it will not block.
+int private_stdio_fd(int fd, int access, bool& guarded) {
+  guarded = false;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return -1;
+  if (S_ISREG(st.st_mode)) return ::fcntl(fd, F_DUPFD_CLOEXEC, 3);
+  if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode)) {
+    char path[32];
+    std::snprintf(path, sizeof path, "/proc/self/fd/%d", fd);
+    const int own = ::open(path, access | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (own >= 0) return own;
+  }
+  guarded = true;
+  return ::fcntl(fd, F_DUPFD_CLOEXEC, 3);
+}
+
+bool ready_for(int fd, short events) {
+  pollfd p{fd, events, 0};
+  return ::poll(&p, 1, 0) > 0 && (p.revents & (events | POLLHUP | POLLERR)) != 0;
+}
+
+}  // namespace
+
 bool SerialStdio::open() {
   close();
-  in_flags_ = ::fcntl(STDIN_FILENO, F_GETFL);
-  out_flags_ = ::fcntl(STDOUT_FILENO, F_GETFL);
-  if (in_flags_ < 0 || out_flags_ < 0) {
+  in_fd_ = private_stdio_fd(STDIN_FILENO, O_RDONLY, in_guarded_);
+  out_fd_ = private_stdio_fd(STDOUT_FILENO, O_WRONLY, out_guarded_);
+  if (in_fd_ < 0 || out_fd_ < 0) {
     set_error(error_, "stdio: stdin/stdout not open", errno);
-    in_flags_ = out_flags_ = -1;
+    close_fds();
     return false;
   }
-  stdin_tty_ = ::isatty(STDIN_FILENO) == 1;
-  if (stdin_tty_ && ::tcgetattr(STDIN_FILENO, &saved_) == 0) {
+  stdin_tty_ = ::isatty(in_fd_) == 1;
+  if (stdin_tty_ && ::tcgetattr(in_fd_, &saved_) == 0) {
     saved_valid_ = true;
     termios t = saved_;
     // Raw input for a console: no echo, byte at a time, but keep output post-processing
@@ -179,23 +211,25 @@ bool SerialStdio::open() {
     t.c_iflag &= ~static_cast<tcflag_t>(IXON | ICRNL | INLCR | IGNCR);
     t.c_cc[VMIN] = 0;
     t.c_cc[VTIME] = 0;
-    ::tcsetattr(STDIN_FILENO, TCSANOW, &t);
+    ::tcsetattr(in_fd_, TCSANOW, &t);
   }
-  ::fcntl(STDIN_FILENO, F_SETFL, in_flags_ | O_NONBLOCK);
-  ::fcntl(STDOUT_FILENO, F_SETFL, out_flags_ | O_NONBLOCK);
   open_ = true;
   eof_ = false;
   error_[0] = '\0';
   return true;
 }
 
+void SerialStdio::close_fds() {
+  if (in_fd_ >= 0) ::close(in_fd_);
+  if (out_fd_ >= 0) ::close(out_fd_);
+  in_fd_ = out_fd_ = -1;
+}
+
 void SerialStdio::close() {
   if (!open_) return;
-  if (saved_valid_) ::tcsetattr(STDIN_FILENO, TCSANOW, &saved_);
-  if (in_flags_ >= 0) ::fcntl(STDIN_FILENO, F_SETFL, in_flags_);
-  if (out_flags_ >= 0) ::fcntl(STDOUT_FILENO, F_SETFL, out_flags_);
+  if (saved_valid_) ::tcsetattr(in_fd_, TCSANOW, &saved_);
   saved_valid_ = false;
-  in_flags_ = out_flags_ = -1;
+  close_fds();
   open_ = false;
 }
 
@@ -205,9 +239,10 @@ std::ptrdiff_t SerialStdio::read(std::uint8_t* buffer, std::size_t max) {
     return -1;
   }
   if (eof_) return 0;  // stdin closed (pipe at its end): nothing more will come
+  if (in_guarded_ && !ready_for(in_fd_, POLLIN)) return 0;
   int err = 0;
   bool eof = false;
-  const std::ptrdiff_t n = read_fd(STDIN_FILENO, buffer, max, eof, err);
+  const std::ptrdiff_t n = read_fd(in_fd_, buffer, max, eof, err);
   // On a terminal in raw mode (VMIN = 0) a 0 only means "nothing typed yet".
   if (eof && !stdin_tty_) eof_ = true;
   if (n < 0) set_error(error_, "stdio: read failed", err);
@@ -219,8 +254,14 @@ std::ptrdiff_t SerialStdio::write(const std::uint8_t* data, std::size_t size) {
     set_error(error_, "stdio: not open");
     return -1;
   }
+  if (out_guarded_) {
+    // Blocking descriptor: write only what fits without waiting (POLLOUT promises at
+    // least PIPE_BUF bytes on a pipe or socket buffer of the usual size).
+    if (!ready_for(out_fd_, POLLOUT)) return 0;
+    size = std::min<std::size_t>(size, 512);
+  }
   int err = 0;
-  const std::ptrdiff_t n = write_fd(STDOUT_FILENO, data, size, err);
+  const std::ptrdiff_t n = write_fd(out_fd_, data, size, err);
   if (n < 0) set_error(error_, "stdio: write failed", err);
   return n;
 }

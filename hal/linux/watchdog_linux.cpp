@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 
 #include "hal/linux/error_text.h"
 
@@ -41,14 +42,33 @@ bool WatchdogLinux::start(std::uint32_t timeout_ms) {
   }
   fd_ = io_.open(config_.device);
   if (fd_ < 0) {
-    set_error(error_, "watchdog: cannot open the device", errno);
+    const int err = errno;
+    char what[140];
+    if (err == EBUSY) {
+      // The device has one opener at a time: systemd holds it when RuntimeWatchdogSec= is set.
+      std::snprintf(what, sizeof what,
+                    "watchdog: %s is busy (another process holds it, e.g. systemd with "
+                    "RuntimeWatchdogSec=)",
+                    config_.device);
+    } else {
+      std::snprintf(what, sizeof what, "watchdog: cannot open %s", config_.device);
+    }
+    set_error(error_, what, err);
     return false;
   }
-  int seconds = static_cast<int>((timeout_ms + 999U) / 1000U);
+  const int asked = static_cast<int>((timeout_ms + 999U) / 1000U);
+  int seconds = asked;
   if (io_.ioctl(fd_, WDIOC_SETTIMEOUT, &seconds) != 0) {
     const int err = errno;
     stop();
-    set_error(error_, "watchdog: WDIOC_SETTIMEOUT failed", err);
+    char what[140];
+    // Drivers refuse a timeout outside their range with EINVAL; the Raspberry Pi's
+    // (bcm2835-wdt) ends at about 15 s.
+    std::snprintf(what, sizeof what,
+                  "watchdog: the device refused a timeout of %d s (WDIOC_SETTIMEOUT; the "
+                  "Raspberry Pi's accepts at most 15 s)",
+                  asked);
+    set_error(error_, what, err);
     return false;
   }
   timeout_s_ = seconds;  // the driver writes back the timeout it actually uses

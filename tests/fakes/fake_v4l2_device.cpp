@@ -11,6 +11,7 @@
 namespace boticelli::fakes {
 
 int FakeV4l2Device::open(const char*) {
+  ++slow_calls_;
   if (!present_) {
     errno = ENOENT;
     return -1;
@@ -33,6 +34,7 @@ int FakeV4l2Device::close(int fd) {
 }
 
 void* FakeV4l2Device::mmap(std::size_t length, int fd, std::int64_t offset) {
+  ++slow_calls_;
   const auto index = static_cast<std::size_t>(offset / 0x100000);
   if (fd != kFd || !present_ || index >= storage_.size() || length > storage_[index].size()) {
     errno = EINVAL;
@@ -74,6 +76,7 @@ bool FakeV4l2Device::capture(bool error_flag, std::uint32_t bytes_short) {
 }
 
 int FakeV4l2Device::ioctl(int fd, unsigned long request, void* arg) {
+  if (request != VIDIOC_QBUF && request != VIDIOC_DQBUF) ++slow_calls_;
   if (fd != kFd) {
     errno = EBADF;
     return -1;
@@ -122,7 +125,10 @@ int FakeV4l2Device::ioctl(int fd, unsigned long request, void* arg) {
         errno = EINVAL;
         return -1;
       }
-      r->count = std::min(r->count, config_.max_buffers);
+      // count 0 frees the buffers; otherwise the driver's range applies.
+      if (r->count > 0) {
+        r->count = std::max(std::min(r->count, config_.max_buffers), config_.min_buffers);
+      }
       storage_.assign(r->count, std::vector<std::uint8_t>(std::size_t{stride_} * height_));
       queued_.clear();
       done_.clear();

@@ -16,6 +16,7 @@ struct FakeV4l2Config {
   std::uint32_t max_height = 480;
   std::uint32_t stride_padding = 0;  // bytes added to each row (bytesperline)
   std::uint32_t max_buffers = 4;     // REQBUFS grants at most this many
+  std::uint32_t min_buffers = 0;     // ... and at least this many (a driver's minimum)
   bool offers_yuyv = true;           // false: S_FMT answers with MJPEG
   bool capture = true;               // capabilities: VIDEO_CAPTURE
   bool streaming = true;             // capabilities: STREAMING
@@ -50,6 +51,8 @@ class FakeV4l2Device final : public hal_linux::V4l2Io {
   int opens() const { return opens_; }
   int open_fds() const { return open_fds_; }
   std::uint32_t requested_width() const { return requested_width_; }
+  // Calls that may wait on a real device (open, mmap, every ioctl but QBUF and DQBUF).
+  int slow_calls() const { return slow_calls_; }
 
  private:
   static constexpr int kFd = 42;
@@ -59,6 +62,7 @@ class FakeV4l2Device final : public hal_linux::V4l2Io {
   bool streaming_ = false;
   int opens_ = 0;
   int open_fds_ = 0;
+  int slow_calls_ = 0;
   std::uint32_t width_ = 0;
   std::uint32_t height_ = 0;
   std::uint32_t stride_ = 0;

@@ -1,13 +1,16 @@
 // OdriveCanEmulator: ODrive CAN Simple behaviour (states, setpoints, heartbeats, encoder) on a
-// socketpair.
+// socketpair or a raw CAN socket.
 #include "odrive_can_emulator.h"
 
 #include <fcntl.h>
 #include <linux/can.h>
 #include <linux/can/error.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstring>
 
 namespace boticelli::fakes {
@@ -30,6 +33,19 @@ bool OdriveCanEmulator::open() {
   driver_fd_ = sv[1];
   ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK);
   return true;
+}
+
+bool OdriveCanEmulator::open_can(const char* interface) {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+  if (fd_ < 0) return false;
+  ifreq ifr{};
+  std::snprintf(ifr.ifr_name, IFNAMSIZ, "%s", interface);
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  if (::ioctl(fd_, SIOCGIFINDEX, &ifr) != 0) return false;
+  addr.can_ifindex = ifr.ifr_ifindex;
+  return ::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
 }
 
 std::uint32_t OdriveCanEmulator::count(int axis, odrive::Command c) const {
@@ -57,6 +73,13 @@ void OdriveCanEmulator::send_frame(const odrive::CanFrame& f) {
 void OdriveCanEmulator::send_bus_off() {
   can_frame err{};
   err.can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;
+  err.len = CAN_ERR_DLC;
+  send_bytes(&err, sizeof err);
+}
+
+void OdriveCanEmulator::send_error_frame(std::uint32_t error_class) {
+  can_frame err{};
+  err.can_id = CAN_ERR_FLAG | (error_class & CAN_ERR_MASK);
   err.len = CAN_ERR_DLC;
   send_bytes(&err, sizeof err);
 }
@@ -173,7 +196,7 @@ void OdriveCanEmulator::service(std::uint64_t now_us) {
       send_heartbeat(a);
       a.next_heartbeat_us = now_us + config_.heartbeat_period_us;
     }
-    if (config_.encoder_period_us > 0 && now_us >= a.next_encoder_us) {
+    if (config_.encoder_period_us > 0 && !a.encoder_silent && now_us >= a.next_encoder_us) {
       send_encoder(a);
       a.next_encoder_us = now_us + config_.encoder_period_us;
     }

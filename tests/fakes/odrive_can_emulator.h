@@ -1,5 +1,5 @@
 // OdriveCanEmulator: two ODrive axes on the far end of a fake CAN bus (a SOCK_SEQPACKET
-// socketpair).
+// socketpair) or of a real SocketCAN interface (vcan0 in the kernel-in-the-loop test).
 #pragma once
 
 #include <cstdint>
@@ -34,13 +34,21 @@ class OdriveCanEmulator {
 
   // Creates the bus; driver_fd() is handed to the driver (which then owns it).
   bool open();
+  // Speaks through its own raw CAN socket on `interface` instead (the driver opens its own;
+  // driver_fd() stays −1). Called again, it closes the old socket first (an interface that
+  // was deleted and re-added needs a new one).
+  bool open_can(const char* interface);
   int driver_fd() const { return driver_fd_; }
   void service(std::uint64_t now_us);
 
   // Fault injection.
   void silence_heartbeats(int axis, bool silent) { axes_[axis].silent = silent; }
+  // The axis goes on with its heartbeats but stops sending encoder estimates.
+  void silence_encoder(int axis, bool silent) { axes_[axis].encoder_silent = silent; }
   void set_axis_error(int axis, std::uint32_t error);
   void send_bus_off();
+  // Any error frame (CAN_ERR_FLAG is added), e.g. CAN_ERR_PROT | CAN_ERR_BUSERROR.
+  void send_error_frame(std::uint32_t error_class);
   void send_frame(const codec::odrive::CanFrame& frame);
   void send_bytes(const void* data, std::size_t size);  // arbitrary (malformed) datagram
 
@@ -65,6 +73,7 @@ class OdriveCanEmulator {
     float vel_setpoint = 0.0F;
     double pos = 0.0;
     bool silent = false;
+    bool encoder_silent = false;
     bool closed_loop_pending = false;
     std::uint64_t closed_loop_at_us = 0;
     std::uint64_t last_input_us = 0;

@@ -310,3 +310,17 @@ TEST(BaseOdriveCan, TheCyclicCallsDoNotAllocate) {
   CHECK(rig.base->health() == BaseHealth::kReady);
   CHECK_NO_ALLOCATION(rig.base->stop());
 }
+
+TEST(BaseOdriveCan, AWheelWhoseEncoderStreamStopsStopsTheBaseInsteadOfTurningTheOdometry) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 50; ++i) rig.cycle();
+  rig.emu.silence_encoder(kLeft, true);  // its heartbeats go on
+  const double yaw_before = rig.base->odometry().yaw_rad;
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }, 100));
+  STRCMP_CONTAINS("left axis: encoder estimates stopped", rig.base->error());
+  // Integrated with the left wheel standing still, the right one's 0.5 m/s would have
+  // turned the odometry by 0.5/0.5 = 1 rad/s.
+  DOUBLES_EQUAL(yaw_before, rig.base->odometry().yaw_rad, 0.005);
+}

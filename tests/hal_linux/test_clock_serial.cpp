@@ -1,4 +1,5 @@
 // Tests of ClockPosix (CLOCK_MONOTONIC) and SerialTermios / SerialStdio on a pseudo-terminal.
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/time.h>
@@ -11,6 +12,7 @@
 #include <cstring>
 
 #include "hal/linux/clock_posix.h"
+#include "hal/linux/console_port.h"
 #include "hal/linux/serial_termios.h"
 
 #include "CppUTest/TestHarness.h"
@@ -274,7 +276,10 @@ TEST(SerialStdio, UsesRawModeOnATerminalAndRestoresItOnClose) {
     termios during{};
     ::tcgetattr(STDIN_FILENO, &during);
     CHECK_EQUAL(0U, during.c_lflag & (ICANON | ECHO));
-    CHECK(::fcntl(STDIN_FILENO, F_GETFL) & O_NONBLOCK);
+    // The descriptors shared with the parent shell stay blocking (a crash would leave it
+    // with a non-blocking terminal); the port reads through one of its own.
+    const bool in_nonblocking = (::fcntl(STDIN_FILENO, F_GETFL) & O_NONBLOCK) != 0;
+    const bool out_nonblocking = (::fcntl(STDOUT_FILENO, F_GETFL) & O_NONBLOCK) != 0;
     std::uint8_t b[4];
     CHECK_EQUAL(0, s.read(b, sizeof b));  // non-blocking: nothing typed yet
     CHECK_EQUAL(1, ::write(pty.master, "x", 1));
@@ -287,6 +292,8 @@ TEST(SerialStdio, UsesRawModeOnATerminalAndRestoresItOnClose) {
     CHECK_EQUAL('x', b[0]);
     CHECK_EQUAL(3, s.write(reinterpret_cast<const std::uint8_t*>("ok\n"), 3));
     s.close();
+    CHECK_FALSE(in_nonblocking);
+    CHECK_FALSE(out_nonblocking);
     termios after{};
     ::tcgetattr(STDIN_FILENO, &after);
     CHECK(after.c_lflag & ICANON);
@@ -304,8 +311,10 @@ TEST(SerialStdio, WorksOnAPipeWithoutTouchingTermios) {
     StdioRedirect redirect(in_pipe[0], out_pipe[1]);
     SerialStdio s;
     CHECK_TRUE(s.open());
+    const bool in_nonblocking = (::fcntl(STDIN_FILENO, F_GETFL) & O_NONBLOCK) != 0;
     std::uint8_t b[8];
-    CHECK_EQUAL(0, s.read(b, sizeof b));
+    CHECK_EQUAL(0, s.read(b, sizeof b));  // nothing written yet: at once, not blocking
+    CHECK_FALSE(in_nonblocking);
     CHECK_EQUAL(4, ::write(in_pipe[1], "help", 4));
     CHECK_EQUAL(4, s.read(b, sizeof b));
     MEMCMP_EQUAL("help", b, 4);
@@ -315,4 +324,27 @@ TEST(SerialStdio, WorksOnAPipeWithoutTouchingTermios) {
     STRNCMP_EQUAL("ok", out, 2);
   }
   for (int fd : {in_pipe[0], in_pipe[1], out_pipe[0], out_pipe[1]}) ::close(fd);
+}
+
+namespace {
+
+int open_descriptors() {
+  int n = 0;
+  DIR* d = ::opendir("/proc/self/fd");
+  while (d != nullptr && ::readdir(d) != nullptr) ++n;
+  if (d != nullptr) ::closedir(d);
+  return n;
+}
+
+}  // namespace
+
+TEST_GROUP(ConsolePort){};
+
+TEST(ConsolePort, OpeningAPtyConsoleAgainLeavesNoDescriptorBehind) {
+  boticelli::hal_linux::ConsolePort console("/dev/null", 115200);
+  console.select(boticelli::hal_linux::ConsoleMode::kPty, nullptr);
+  CHECK_TRUE_TEXT(console.open(), console.error());
+  const int after_first = open_descriptors();
+  CHECK_TRUE_TEXT(console.open(), console.error());  // a new pair: the old one must go
+  CHECK_EQUAL(after_first, open_descriptors());
 }

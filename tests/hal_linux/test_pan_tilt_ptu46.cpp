@@ -325,3 +325,62 @@ TEST(PanTiltPtu46, ALimitAnswerOutsideTheQueriedRangeIsAStartUpFault) {
   CHECK_FALSE(ptu.ready());
   STRCMP_CONTAINS("inconsistent limits", ptu.error());
 }
+
+TEST(PanTiltPtu46, ALimitReportWhileAMoveIsInFlightDoesNotShiftTheLaterReplies) {
+  FakeSerialPort port;
+  FakeClock clock;
+  PanTiltPtu46 ptu(port, clock);
+  CHECK_TRUE(ptu.init());
+  // The start-up sequence, answered one command at a time.
+  for (const char* reply : {"*", "*", "*", "* 185.1428", "* 46.2857", "* -3090", "* 3090", "* -907",
+                            "* 604", "* 2902", "* 2902", "* 0", "* 0"}) {
+    ptu.update();
+    port.feed(reply);
+    port.feed("\r\n");
+  }
+  ptu.update();
+  CHECK_TRUE(ptu.ready());
+  CHECK_TRUE(ptu.move_to(static_cast<float>(pan_rad(100)), static_cast<float>(tilt_rad(50))));
+  port.clear_written();
+  ptu.update();
+  STRCMP_EQUAL("PP100 ", port.written().c_str());
+  port.feed("!P\r\n");  // the pan axis reports its limit while PP is in flight ...
+  ptu.update();
+  port.feed("*\r\n");  // ... and the unit still answers PP
+  ptu.update();
+  port.feed("*\r\n");  // TP's answer
+  ptu.update();
+  port.feed("* 3090\r\n");  // the position query after the limit report
+  ptu.update();
+  // Had PP's '*' been taken for TP's, TP's '*' would have answered the position query,
+  // which needs a number: a fault and a re-initialisation.
+  STRNCMP_EQUAL("PP100 TP50 PP ", port.written().c_str(), 14);
+  CHECK_TRUE(ptu.ready());
+  STRCMP_CONTAINS("pan axis hit a limit", ptu.error());
+  CHECK_EQUAL(3090, ptu.pan_counts());
+}
+
+TEST(PanTiltPtu46, AMoveCommandedEveryCycleStillHasItsPositionPolled) {
+  Rig rig;
+  CHECK_TRUE(rig.start());
+  const auto target = static_cast<float>(pan_rad(300));
+  // The mission's controller may repeat its target every frame.
+  CHECK_TRUE(rig.run_until(
+      [&] {
+        rig.ptu->move_to(target, 0.0F);
+        return !rig.ptu->state().moving && rig.ptu->pan_counts() == 300;
+      },
+      3000));
+  CHECK_EQUAL(300, rig.emu.pan_counts());
+}
+
+TEST(PanTiltPtu46, AUnitThatFallsSilentWhileIdleIsAFault) {
+  Rig rig;
+  CHECK_TRUE(rig.start());
+  rig.emu.set_silent(true);
+  // No command from the firmware at all: the driver's own liveness query must notice.
+  const std::uint64_t t0 = rig.clock.peek_us();
+  CHECK_TRUE(rig.run_until([&] { return rig.ptu->state().fault; }, 3000));
+  STRCMP_CONTAINS("no reply to 'PP '", rig.ptu->error());
+  CHECK(rig.clock.peek_us() - t0 <= 1300000U);  // idle_query_ms + reply_timeout_ms
+}

@@ -22,6 +22,8 @@ struct BaseOdriveCanConfig {
   std::uint32_t heartbeat_timeout_ms = 300;  // no heartbeat from an axis that long: stop
   std::uint32_t startup_timeout_ms = 3000;   // both axes in closed loop by then, or stop
   std::uint32_t state_resend_ms = 250;       // Set_Axis_State repeated while starting
+  std::uint32_t stop_resend_ms = 100;        // Set_Input_Vel 0 + Estop repeated while stopped
+  std::uint32_t encoder_timeout_ms = 100;    // no encoder estimate from an axis that long: stop
   bool request_encoder = false;              // send an RTR for Get_Encoder_Estimates every update()
                                              // (when the ODrives do not send it cyclically)
 };
@@ -30,8 +32,12 @@ struct BaseOdriveCanConfig {
 // (Clear_Errors, Set_Controller_Mode velocity/passthrough, Set_Input_Vel 0, Set_Axis_State
 // closed loop, then both heartbeats must report closed loop without error), re-sends the
 // velocity setpoint every call (so the ODrive's own watchdog stays fed) and integrates the
-// odometry from Get_Encoder_Estimates. A missing heartbeat, an axis leaving closed loop, an
-// axis error or a bus-off error frame stop the base (Estop to both axes) and set error().
+// odometry from Get_Encoder_Estimates. A missing heartbeat or encoder stream, an axis leaving
+// closed loop, an axis error, a bus-off error frame or a socket error stop the base and set
+// error(); while stopped, Set_Input_Vel(0) and Estop go to both axes every stop_resend_ms (a
+// stop that could not be sent, e.g. with the link down, is sent once the link is back).
+// resume() refuses while the controller is bus-off or the interface is down or gone, and
+// opens a new socket when the interface was deleted and added again.
 class BaseOdriveCan final : public hal::Base {
  public:
   BaseOdriveCan(const BaseOdriveCanConfig& config, hal::Clock& clock);
@@ -50,6 +56,8 @@ class BaseOdriveCan final : public hal::Base {
   std::uint32_t rejected_frames() const { return rejected_frames_; }
   std::uint32_t error_frames() const { return error_frames_; }
   std::uint32_t sent_frames() const { return sent_frames_; }
+  std::uint32_t send_failures() const { return send_failures_; }  // frames the socket refused
+  bool bus_off() const { return bus_off_; }  // bus-off seen and no restart since
 
  private:
   struct Axis {
@@ -60,6 +68,7 @@ class BaseOdriveCan final : public hal::Base {
     codec::odrive::EncoderEstimates encoder{};
     bool encoder_seen = false;
     bool encoder_fresh = false;
+    std::uint64_t last_encoder_us = 0;
   };
   void send(const codec::odrive::CanFrame& frame);
   void receive(std::uint64_t now_us);
@@ -69,6 +78,9 @@ class BaseOdriveCan final : public hal::Base {
   void fault(const char* what, const char* side = nullptr, std::uint32_t value = 0);
   void update_odometry(std::uint64_t now_us);
   void close_socket();
+  bool open_socket();
+  bool interface_usable();
+  bool encoders_current(std::uint64_t now_us) const;
 
   BaseOdriveCanConfig config_;
   hal::Clock& clock_;
@@ -77,6 +89,10 @@ class BaseOdriveCan final : public hal::Base {
   hal::BaseHealth health_ = hal::BaseHealth::kStopped;
   std::uint64_t startup_deadline_us_ = 0;
   std::uint64_t next_state_send_us_ = 0;
+  std::uint64_t next_stop_send_us_ = 0;
+  std::uint64_t ready_since_us_ = 0;
+  bool owns_interface_ = false;  // opened `interface` itself (not a socket handed in)
+  int ifindex_ = 0;              // the interface the socket is bound to
   codec::WheelTurns setpoint_turns_s_{};
   codec::DiffDriveOdometry integrator_;
   hal::Odometry odometry_{};

@@ -25,7 +25,9 @@ struct GpioLineConfig {
 // Requests the line for both-edge events (gpiod::line_request EVENT_BOTH_EDGES).
 // read()/activated_since_last_poll() drain the pending events without blocking (poll on
 // event_get_fd(), then event_read(), which does not allocate, unlike event_wait()) and run
-// them through DebouncedInput (polarity, debounce, latch). libgpiod's exceptions are caught:
+// them through DebouncedInput (polarity, debounce, latch) at the kernel's event timestamps;
+// then the line's level is read and given to DebouncedInput too, because the kernel's event
+// queue (16 events) drops the newest edges of a long bounce. libgpiod's exceptions are caught:
 // a failed line reads inactive, or active when `fail_active` is set (an e-stop input should
 // fail safe); error() says why.
 class DigitalInGpiod final : public hal::DigitalIn {
@@ -35,6 +37,7 @@ class DigitalInGpiod final : public hal::DigitalIn {
   bool read() override;
   bool activated_since_last_poll() override;
   const char* error() const { return error_; }
+  std::uint32_t events() const { return events_; }  // edge events read so far
 
  private:
   void service();
@@ -45,6 +48,8 @@ class DigitalInGpiod final : public hal::DigitalIn {
   gpiod::line line_;
   int event_fd_ = -1;
   bool ok_ = false;
+  std::uint64_t last_event_us_ = 0;
+  std::uint32_t events_ = 0;
   codec::DebouncedInput filter_;
   char error_[160] = "not initialised";
 };

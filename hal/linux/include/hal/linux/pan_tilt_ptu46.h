@@ -16,6 +16,7 @@ struct PanTiltPtu46Config {
   std::uint32_t reply_timeout_ms = 1000;   // a command without an answer by then is a fault
   std::uint32_t reset_timeout_ms = 30000;  // R runs both axes to their limits and back
   std::uint32_t position_poll_ms = 100;    // position queries while a move is in progress
+  std::uint32_t idle_query_ms = 1000;      // a position query after this long quiet (0: none)
   std::uint32_t retry_backoff_ms = 2000;   // wait before re-initialising after a fault
 };
 
@@ -23,9 +24,11 @@ struct PanTiltPtu46Config {
 // reads and parses replies (one command outstanding at a time, as the unit answers in
 // order) and detects timeouts. init() opens the port and queues the start-up sequence
 // FT ED CI PR TR PN PX TN TX PU TU PP TP; the unit is ready when all were answered with
-// sane values. After a fault (timeout, serial error, bad init reply) the driver re-opens the
-// port and re-runs the sequence after retry_backoff_ms. The serial port (SerialTermios at
-// 9600 8N1 for the real unit) and the clock are borrowed and must outlive the driver.
+// sane values. While ready, a quiet line gets a position query every idle_query_ms, so a
+// unit that went away is a fault (reply timeout) before the next move. After a fault (timeout,
+// serial error, bad init reply) the driver re-opens the port and re-runs the sequence after
+// retry_backoff_ms. The serial port (SerialTermios at 9600 8N1 for the real unit) and the clock are
+// borrowed and must outlive the driver.
 class PanTiltPtu46 final : public hal::PanTilt {
  public:
   PanTiltPtu46(hal::SerialPort& port, hal::Clock& clock, const PanTiltPtu46Config& config = {});
@@ -86,6 +89,7 @@ class PanTiltPtu46 final : public hal::PanTilt {
   void start_sequence();
   void enter_fault(const char* what, const char* detail = nullptr);
   void drop_queued(Kind kind);
+  bool queued(Kind kind) const;
   void read_replies(std::uint64_t now_us);
   void handle_line(std::string_view line, std::uint64_t now_us);
   void complete(const codec::ptu46::Reply& reply, std::uint64_t now_us);
@@ -106,6 +110,7 @@ class PanTiltPtu46 final : public hal::PanTilt {
   std::uint64_t sent_at_us_ = 0;
   std::uint64_t retry_at_us_ = 0;
   std::uint64_t next_poll_us_ = 0;
+  std::uint64_t next_liveness_us_ = 0;
   codec::ptu46::LineAssembler lines_;
   std::array<AxisData, 2> axes_{};
   hal::PanTiltState state_{};

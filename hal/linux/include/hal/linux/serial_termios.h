@@ -43,9 +43,11 @@ class SerialTermios final : public hal::SerialPort {
   char error_[128] = "";
 };
 
-// The host console: reads stdin, writes stdout, both switched to non-blocking. Raw mode
-// (no echo, no line buffering) only when stdin is a terminal; everything (termios and the
-// file status flags) is restored by close() and the destructor.
+// The host console: reads stdin, writes stdout, without blocking and without setting
+// O_NONBLOCK on the descriptors it shares with the parent shell (which would keep it after
+// a crash): a terminal or pipe is opened anew through /proc/self/fd, non-blocking; other
+// kinds are read and written only when poll() says so. Raw mode (no echo, no line
+// buffering) only when stdin is a terminal, restored by close() and the destructor.
 class SerialStdio final : public hal::SerialPort {
  public:
   SerialStdio() = default;
@@ -58,11 +60,14 @@ class SerialStdio final : public hal::SerialPort {
   void close();
 
  private:
+  void close_fds();
   bool open_ = false;
   bool eof_ = false;
   bool stdin_tty_ = false;
-  int in_flags_ = -1;
-  int out_flags_ = -1;
+  int in_fd_ = -1;
+  int out_fd_ = -1;
+  bool in_guarded_ = false;
+  bool out_guarded_ = false;
   bool saved_valid_ = false;
   termios saved_{};
   char error_[128] = "";
