@@ -54,6 +54,8 @@ void Console::set_parameter_saver(StateSaver* saver) {
   if (saver != nullptr) {
     seen_parameter_saves_ = saver->parameter_saves();
     seen_parameter_failures_ = saver->parameter_failures();
+    seen_state_saves_ = saver->saved();
+    seen_state_failures_ = saver->failures();
   }
 }
 
@@ -185,6 +187,7 @@ void Console::service(std::uint64_t now_us) {
   }
   check_executive(now_us);
   check_parameter_saves();
+  check_state_saves();
   send_telemetry(now_us);
   flush();
 }
@@ -265,11 +268,13 @@ void Console::cmd_status(const Words& w) {
   const FrameStats& f = executive_.frame_stats();
   const MapCounts m = view_.map_counts();
   reply_.appendf(
-      "status state=%s estop=%s paused=%d healthy=%d cycles=%llu pieces=%u features=%u "
-      "obstacle_points=%u exploration_points=%u",
-      view_.state_name(), stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
-      executive_.all_healthy() ? 1 : 0, static_cast<unsigned long long>(view_.cycles()),
-      view_.pieces(), view_.features(), m.obstacle_points, m.exploration_points);
+      "status state=%s estop=%s paused=%d healthy=%d", view_.state_name(),
+      stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
+      robot_healthy() ? 1 : 0);
+  append_unhealthy(reply_);
+  reply_.appendf(" cycles=%llu pieces=%u features=%u obstacle_points=%u exploration_points=%u",
+                 static_cast<unsigned long long>(view_.cycles()), view_.pieces(), view_.features(),
+                 m.obstacle_points, m.exploration_points);
   append_target(reply_, view_.target());
   reply_.appendf(" frames=%llu uptime_s=%.1f\r\nOK\r\n", static_cast<unsigned long long>(f.frames),
                  static_cast<double>(now_us_ - start_us_) * 1e-6);
@@ -289,11 +294,21 @@ void Console::cmd_stats(const Words& w) {
   for (std::size_t i = 0; i < executive_.task_count(); ++i) {
     const TaskSpec& s = executive_.spec(i);
     const TaskStats& t = executive_.task_stats(i);
+    const char* why = executive_.task_health(i);
     reply_.appendf(
-        "task %-8s period_us=%u budget_us=%u runs=%llu avg_us=%llu worst_us=%u overruns=%llu\r\n",
+        "task %-8s period_us=%u budget_us=%u runs=%llu avg_us=%llu worst_us=%u overruns=%llu "
+        "healthy=%d",
         s.name, s.period_us, s.budget_us, static_cast<unsigned long long>(t.runs),
         static_cast<unsigned long long>(t.average_us()), t.worst_us,
-        static_cast<unsigned long long>(t.overruns));
+        static_cast<unsigned long long>(t.overruns), why == nullptr ? 1 : 0);
+    if (why != nullptr) reply_.appendf(" why=\"%s\"", why);
+    reply_.append(kEol);
+  }
+  if (parameter_saver_ != nullptr) {
+    reply_.appendf("storage saved=%llu failed=%llu healthy=%d\r\n",
+                   static_cast<unsigned long long>(parameter_saver_->saved()),
+                   static_cast<unsigned long long>(parameter_saver_->failures()),
+                   storage_healthy_ ? 1 : 0);
   }
   const FrameStats& f = executive_.frame_stats();
   reply_.appendf(
@@ -606,12 +621,60 @@ void Console::check_executive(std::uint64_t now_us) {
     seen_background_overruns_ = f.background_overruns;
     next_overrun_log_us_ = now_us + 1000000U;
   }
-  const bool healthy = executive_.all_healthy();
-  if (healthy != was_healthy_) {
-    log(healthy ? LogLevel::kInfo : LogLevel::kError, "tasks %s",
-        healthy ? "healthy again" : "unhealthy: watchdog not kicked");
-    was_healthy_ = healthy;
+  // Each task's health on its own line, with the device's reason: which device failed and
+  // why, not only that something did.
+  for (std::size_t i = 0; i < executive_.task_count(); ++i) {
+    const char* why = executive_.task_health(i);
+    TextBufferBase& logged = logged_reason_[i];
+    if (why == nullptr) {
+      if (logged.size() == 0) continue;
+      logged.clear();
+      log(LogLevel::kInfo, "%s healthy again", executive_.spec(i).name);
+      continue;
+    }
+    const bool first = logged.size() == 0;
+    if (!first && (logged.view() == why || now_us < logged_at_us_[i] + 1000000U)) continue;
+    logged.clear();
+    logged.append(why);
+    logged_at_us_[i] = now_us;
+    log(LogLevel::kError, "%s unhealthy: %s (watchdog not kicked)", executive_.spec(i).name, why);
   }
+}
+
+void Console::check_state_saves() {
+  if (parameter_saver_ == nullptr) return;
+  const std::uint64_t failures = parameter_saver_->failures();
+  if (failures != seen_state_failures_) {
+    char why[256] = "";
+    if (!parameter_saver_->try_last_error(why, sizeof why)) return;  // next frame
+    seen_state_failures_ = failures;
+    storage_healthy_ = false;
+    log(LogLevel::kError, "storage unhealthy: state not saved (%llu failed): %s",
+        static_cast<unsigned long long>(failures), why);
+  }
+  const std::uint64_t saves = parameter_saver_->saved();
+  if (saves != seen_state_saves_) {
+    seen_state_saves_ = saves;
+    if (!storage_healthy_ && !parameter_saver_->failing()) {
+      storage_healthy_ = true;
+      log(LogLevel::kInfo, "storage healthy again: state saved");
+    }
+  }
+}
+
+void Console::append_unhealthy(TextBufferBase& out) const {
+  out.append(" unhealthy=");
+  bool any = false;
+  for (std::size_t i = 0; i < executive_.task_count(); ++i) {
+    if (executive_.task_health(i) == nullptr) continue;
+    out.appendf("%s%s", any ? "," : "", executive_.spec(i).name);
+    any = true;
+  }
+  if (!storage_healthy_) {
+    out.appendf("%sstorage", any ? "," : "");
+    any = true;
+  }
+  if (!any) out.append("none");
 }
 
 void Console::send_telemetry(std::uint64_t now_us) {

@@ -27,12 +27,22 @@ void CameraTask::run(std::uint64_t now_us) {
       break;
     case hal::CameraPoll::kFault:
       ++faults_;
-      if (now_us - last_frame_us_ > stall_us_) healthy_ = false;
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled();
       break;
     case hal::CameraPoll::kNoFrame:
-      if (now_us - last_frame_us_ > stall_us_) healthy_ = false;
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled();
       break;
   }
+}
+
+void CameraTask::mark_stalled() {
+  healthy_ = false;
+  // The first words stay put while the stall lasts (the console logs a reason when it
+  // changes), so the time is the stall limit, not the growing age of the last frame.
+  reason_.clear();
+  reason_.appendf("no frame for %.1f s", static_cast<double>(stall_us_) * 1e-6);
+  const char* why = camera_.error();
+  if (why[0] != '\0') reason_.appendf(": %s", why);
 }
 
 const char* led_pattern_name(LedPattern pattern) {

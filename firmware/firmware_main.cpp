@@ -35,6 +35,19 @@ extern "C" void on_signal(int signal) {
   g_signal = signal;
 }
 
+const char* signal_name(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal";
+  }
+}
+
 double wall_seconds() {
   timespec ts{};
   ::clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -172,12 +185,25 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       g_state.seed = options.seed;
       slog.log(LogLevel::kInfo, "%s: starting a new mission", error);
     } else if (loaded != LoadResult::kLoaded) {
-      return fail("cannot resume", error);
+      // Restarting cannot mend the file: the usage code, which the service unit does not
+      // restart on (RestartPreventExitStatus), so an operator looks at it.
+      (void)fail("cannot resume", error);
+      return kExitUsage;
     } else {
       if (!board.place_robot(g_state.pose, error, sizeof error))
         return fail("cannot resume", error);
       slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.path(),
                static_cast<unsigned long long>(g_state.cycle));
+    }
+  } else if (store != nullptr) {
+    // A new mission never overwrites a saved one: it is kept as mission.state.1 (older ones
+    // shift up), so a start without --resume by mistake loses nothing.
+    char kept[520] = "";
+    const LoadResult kept_result = g_store.keep_previous(kept, sizeof kept, error, sizeof error);
+    if (kept_result == LoadResult::kIoError) return fail("state", error);
+    if (kept_result == LoadResult::kLoaded) {
+      slog.log(LogLevel::kWarn, "new mission: the saved one is kept as %s (--resume continues it)",
+               kept);
     }
   }
 
@@ -263,6 +289,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // A hang-up (the controlling terminal or the console's session gone) stops in the same
+  // orderly way: base stopped, MISSION line; the default action would kill the process with
+  // the base still driving.
+  sigaction(SIGHUP, &action, nullptr);
 
   ExecutiveConfig exec_config;
   exec_config.frame_us = config.minor_frame_us;
@@ -280,7 +310,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     executive.run_frame();
     if (hooks != nullptr && hooks->after_frame != nullptr) hooks->after_frame(hooks->context);
     if (g_signal != 0) {
-      stop_reason = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
+      stop_reason = signal_name(g_signal);
       break;
     }
     if (console.shutdown_requested()) {

@@ -31,6 +31,10 @@ class BaseTask final : public Task {
   bool healthy() const override {
     return base_.health() != hal::BaseHealth::kStopped || safety_.engaged();
   }
+  const char* health_reason() const override {
+    const char* why = base_.error();
+    return why[0] != '\0' ? why : "stopped by itself";
+  }
 
  private:
   hal::Base& base_;
@@ -42,6 +46,10 @@ class PanTiltTask final : public Task {
   explicit PanTiltTask(hal::PanTilt& ptu) : ptu_(ptu) {}
   void run(std::uint64_t) override { ptu_.update(); }
   bool healthy() const override { return !ptu_.state().fault; }
+  const char* health_reason() const override {
+    const char* why = ptu_.error();
+    return why[0] != '\0' ? why : "unit fault";
+  }
 
  private:
   hal::PanTilt& ptu_;
@@ -73,6 +81,8 @@ class CameraTask final : public Task {
   void set_consumer(FrameConsumer* consumer) { consumer_ = consumer; }
   void run(std::uint64_t now_us) override;
   bool healthy() const override { return healthy_; }
+  // "no frame for N.N s", with the driver's last error when it gave one.
+  const char* health_reason() const override { return reason_.c_str(); }
   std::uint64_t frames() const { return frames_; }
   std::uint64_t faults() const { return faults_; }
 
@@ -84,7 +94,10 @@ class CameraTask final : public Task {
   FrameConsumer* consumer_ = nullptr;
   std::uint64_t last_frame_us_ = 0;
   bool seen_time_ = false;
+  void mark_stalled();
+
   bool healthy_ = true;
+  TextBuffer<128> reason_;
   std::uint64_t frames_ = 0;
   std::uint64_t faults_ = 0;
 };
@@ -94,6 +107,7 @@ class ConsoleTask final : public Task {
   explicit ConsoleTask(Console& console) : console_(console) {}
   void run(std::uint64_t now_us) override { console_.service(now_us); }
   bool healthy() const override { return console_.healthy(); }
+  const char* health_reason() const override { return "console line fault"; }
 
  private:
   Console& console_;
