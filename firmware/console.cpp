@@ -34,6 +34,8 @@ const Console::Command Console::kCommands[] = {
      &Console::cmd_log},
     {"param", "show|save", "parameters changed from their defaults; save them for restarts",
      &Console::cmd_param},
+    {"fault", "[DEVICE TYPE [SECONDS]]",
+     "inject a device fault (sim board), or list the active ones", &Console::cmd_fault},
     {"ver", "", "firmware version and board", &Console::cmd_ver},
     {"shutdown", "", "stop the firmware in an orderly way", &Console::cmd_shutdown},
     {"quit", "", "same as shutdown", &Console::cmd_shutdown},
@@ -601,6 +603,31 @@ void Console::check_parameter_saves() {
     seen_parameter_failures_ = failures;
     log(LogLevel::kError, "parameters not saved: %s", why);
   }
+}
+
+void Console::cmd_fault(const Words& w) {
+  if (faults_ == nullptr) return reply_error("no fault injection on this board (sim board only)");
+  if (w.count == 1) {
+    faults_->describe_active(reply_);
+    reply_.append("OK\r\n");
+    if (reply_.truncated()) return reply_error("fault reply too long");
+    emit(reply_.view());
+    return;
+  }
+  if (w.count < 3) return reply_error("usage: fault DEVICE TYPE [SECONDS]");
+  float seconds = 0.0F;
+  if (w.count == 4 && (!parse_number(w.word[3], seconds) || !(seconds > 0.0F) ||
+                       !(seconds <= 1e6F))) {
+    return reply_error("SECONDS must be a number in (0, 1e6]");
+  }
+  TextBuffer<200> text;
+  if (!faults_->inject(w.word[1], w.word[2], static_cast<double>(seconds), text)) {
+    return reply_error(text.c_str());
+  }
+  reply_.append(text.view());
+  reply_.append("\r\nOK\r\n");
+  emit(reply_.view());
+  log(LogLevel::kWarn, "%s injected", text.c_str());
 }
 
 void Console::cmd_shutdown(const Words& w) {

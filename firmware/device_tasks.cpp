@@ -19,6 +19,16 @@ void CameraTask::run(std::uint64_t now_us) {
   hal::Frame frame;
   switch (camera_.poll(frame)) {
     case hal::CameraPoll::kFrame:
+      if (have_sequence_ && frame.sequence == last_sequence_) {
+        // The same buffer again (a frozen driver): not a new image, so not used, and it
+        // does not keep the camera healthy.
+        ++stale_frames_;
+        camera_.release();
+        if (now_us - last_frame_us_ > stall_us_) mark_stalled("the same frame again");
+        break;
+      }
+      have_sequence_ = true;
+      last_sequence_ = frame.sequence;
       ++frames_;
       last_frame_us_ = now_us;
       healthy_ = true;
@@ -27,21 +37,21 @@ void CameraTask::run(std::uint64_t now_us) {
       break;
     case hal::CameraPoll::kFault:
       ++faults_;
-      if (now_us - last_frame_us_ > stall_us_) mark_stalled();
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled(nullptr);
       break;
     case hal::CameraPoll::kNoFrame:
-      if (now_us - last_frame_us_ > stall_us_) mark_stalled();
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled(nullptr);
       break;
   }
 }
 
-void CameraTask::mark_stalled() {
+void CameraTask::mark_stalled(const char* what) {
   healthy_ = false;
   // The first words stay put while the stall lasts (the console logs a reason when it
   // changes), so the time is the stall limit, not the growing age of the last frame.
   reason_.clear();
-  reason_.appendf("no frame for %.1f s", static_cast<double>(stall_us_) * 1e-6);
-  const char* why = camera_.error();
+  reason_.appendf("no new frame for %.1f s", static_cast<double>(stall_us_) * 1e-6);
+  const char* why = what != nullptr ? what : camera_.error();
   if (why[0] != '\0') reason_.appendf(": %s", why);
 }
 

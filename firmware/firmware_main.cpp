@@ -242,6 +242,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   Console& console = rt.console;
   console.set_log_ring(&g_log_ring, &hal.clock);
   console.set_board_name(info.name);
+  console.set_fault_injection(board.fault_injection());
 
   // The executive and its tasks.
   Task* const tasks[kTaskCount] = {&rt.estop_task,   &rt.base_task,    &rt.ptu_task,
@@ -373,12 +374,19 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   }
   const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
   const mission::Result result = mission.result();
+  // The reason last, quoted (it has spaces): why the mission ended, with the device's words
+  // when a device ended it ("base stopped by itself: base: left axis: heartbeat lost ...").
+  TextBuffer<160> reason;
+  for (const char* c = mission.end_reason(); *c != '\0'; ++c) {
+    reason.appendf("%c", *c == '"' ? '\'' : *c);
+  }
   std::printf(
       "MISSION result=%s cycles=%llu collisions=%llu sim_time_s=%.3f wall_time_s=%.3f "
-      "target_error_m=%.3f\n",
+      "target_error_m=%.3f reason=\"%s\"\n",
       mission::result_name(result), static_cast<unsigned long long>(g_state.cycle),
       static_cast<unsigned long long>(safety.collisions()), sim_time_s,
-      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()));
+      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()),
+      reason.c_str());
   std::fflush(stdout);
   g_runtime.reset();
   g_signal = 0;

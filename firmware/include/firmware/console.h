@@ -10,6 +10,7 @@
 #include "firmware/console_line.h"
 #include "firmware/console_parser.h"
 #include "firmware/executive.h"
+#include "firmware/fault_injection.h"
 #include "firmware/log.h"
 #include "firmware/mission_view.h"
 #include "firmware/parameters.h"
@@ -48,6 +49,8 @@ class Console {
   // also watches the same saver's mission-state saves: a failed one is a LOG error line at
   // once and makes the storage unhealthy (status, stats) until a save succeeds. At init.
   void set_parameter_saver(StateSaver* saver);
+  // The board's fault injection for the `fault` command (the sim board), or nullptr. At init.
+  void set_fault_injection(FaultInjection* faults) { faults_ = faults; }
   // The console task's body: flushes output, reads and executes input, sends telemetry.
   void service(std::uint64_t now_us);
   // Sends queued output only (no input, telemetry or health lines): for the shutdown drain.
@@ -111,6 +114,7 @@ class Console {
   void check_parameter_saves();
   void cmd_ver(const Words& w);
   void cmd_shutdown(const Words& w);
+  void cmd_fault(const Words& w);
   void append_parameter(const Parameter& p);
 
   static const Command kCommands[];
@@ -142,6 +146,7 @@ class Console {
   std::uint64_t log_end_ = 0;   // one past its last
 
   StateSaver* parameter_saver_ = nullptr;
+  FaultInjection* faults_ = nullptr;
   std::array<char, ParameterTable::kMaxFileBytes> parameter_text_{};  // `param save`'s file
   std::uint64_t seen_parameter_saves_ = 0;
   std::uint64_t seen_parameter_failures_ = 0;

@@ -71,8 +71,10 @@ class FrameConsumer {
   FrameConsumer& operator=(const FrameConsumer&) = default;
 };
 
-// Polls the camera; unhealthy when no frame came for stall_us (a fault the driver recovers
-// from quickly, e.g. a re-opened device, does not count against the watchdog).
+// Polls the camera; unhealthy when no new frame came for stall_us (a fault the driver
+// recovers from quickly, e.g. a re-opened device, does not count against the watchdog). A
+// frame whose sequence number did not advance is the same image again (a frozen driver): it
+// is neither used nor counted as a new frame.
 class CameraTask final : public Task {
  public:
   explicit CameraTask(hal::Camera& camera, std::uint64_t stall_us = 2000000,
@@ -85,6 +87,8 @@ class CameraTask final : public Task {
   const char* health_reason() const override { return reason_.c_str(); }
   std::uint64_t frames() const { return frames_; }
   std::uint64_t faults() const { return faults_; }
+  // Frames whose sequence number did not advance (the driver handed the same image again).
+  std::uint64_t stale_frames() const { return stale_frames_; }
 
  private:
   hal::Camera& camera_;
@@ -94,12 +98,16 @@ class CameraTask final : public Task {
   FrameConsumer* consumer_ = nullptr;
   std::uint64_t last_frame_us_ = 0;
   bool seen_time_ = false;
-  void mark_stalled();
+  // Unhealthy, with the reason: `what` (or the driver's error when nullptr).
+  void mark_stalled(const char* what);
 
   bool healthy_ = true;
   TextBuffer<128> reason_;
   std::uint64_t frames_ = 0;
   std::uint64_t faults_ = 0;
+  std::uint64_t stale_frames_ = 0;
+  std::uint32_t last_sequence_ = 0;
+  bool have_sequence_ = false;
 };
 
 class ConsoleTask final : public Task {
