@@ -648,6 +648,15 @@ void Console::check_executive(std::uint64_t now_us) {
     seen_background_overruns_ = f.background_overruns;
     next_overrun_log_us_ = now_us + 1000000U;
   }
+  // The e-stop latch: which input stopped the base (an e-stop is not a fault of a task).
+  if (safety_.cause() != logged_cause_) {
+    if (safety_.cause() == StopCause::kNone) {
+      log(LogLevel::kInfo, "e-stop released (was %s)", stop_cause_name(logged_cause_));
+    } else {
+      log(LogLevel::kWarn, "e-stop engaged: %s (base stopped)", stop_cause_name(safety_.cause()));
+    }
+    logged_cause_ = safety_.cause();
+  }
   // Each task's health on its own line, with the device's reason: which device failed and
   // why, not only that something did.
   for (std::size_t i = 0; i < executive_.task_count(); ++i) {

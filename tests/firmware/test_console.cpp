@@ -274,7 +274,7 @@ TEST(Console, AnswersHelpWithEveryCommand) {
   CHECK_EQUAL("OK", reply.back());
   for (const char* name :
        {"help", "status", "stats", "pose", "model", "map", "pause", "resume", "estop",
-        "clear-estop", "get", "set", "log", "param", "ver", "shutdown", "quit"}) {
+        "clear-estop", "get", "set", "log", "param", "fault", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);
@@ -380,14 +380,20 @@ TEST(Console, PausesAndResumesTheBackgroundWork) {
 }
 
 TEST(Console, EstopStopsTheBaseAndClearEstopReleasesIt) {
-  CHECK_EQUAL("OK", command("estop").back());
+  auto reply = command("estop");
+  CHECK_EQUAL("OK", reply.at(0));
+  // The latch's change is logged, with the input that stopped the base.
+  CHECK_EQUAL(2U, reply.size());
+  STRCMP_CONTAINS("LOG warn e-stop engaged: console (base stopped)", reply.back().c_str());
   CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
   CHECK(safety.cause() == StopCause::kConsole);
   button.level = true;
   STRCMP_EQUAL("ERR e-stop button still pressed", command("clear-estop").at(0).c_str());
   CHECK(safety.engaged());
   button.level = false;
-  CHECK_EQUAL("OK", command("clear-estop").back());
+  reply = command("clear-estop");
+  CHECK_EQUAL("OK", reply.at(0));
+  STRCMP_CONTAINS("LOG info e-stop released (was console)", reply.back().c_str());
   CHECK_FALSE(safety.engaged());
 }
 

@@ -173,6 +173,7 @@ class Console {
   std::uint64_t seen_state_saves_ = 0;
   std::uint64_t seen_state_failures_ = 0;
   bool storage_healthy_ = true;
+  StopCause logged_cause_ = StopCause::kNone;
 };
 
 }  // namespace boticelli::firmware

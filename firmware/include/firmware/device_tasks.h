@@ -41,18 +41,24 @@ class BaseTask final : public Task {
   const Safety& safety_;
 };
 
+// Services the PTU; unhealthy while the unit reports a fault, or while a move has not
+// changed the reported position for stuck_us (a move that never completes).
 class PanTiltTask final : public Task {
  public:
-  explicit PanTiltTask(hal::PanTilt& ptu) : ptu_(ptu) {}
-  void run(std::uint64_t) override { ptu_.update(); }
-  bool healthy() const override { return !ptu_.state().fault; }
-  const char* health_reason() const override {
-    const char* why = ptu_.error();
-    return why[0] != '\0' ? why : "unit fault";
-  }
+  explicit PanTiltTask(hal::PanTilt& ptu, std::uint64_t stuck_us = 2000000)
+      : ptu_(ptu), stuck_us_(stuck_us) {}
+  void run(std::uint64_t now_us) override;
+  bool healthy() const override;
+  const char* health_reason() const override;
 
  private:
   hal::PanTilt& ptu_;
+  std::uint64_t stuck_us_;
+  std::uint64_t progress_us_ = 0;
+  float last_pan_rad_ = 0.0F;
+  float last_tilt_rad_ = 0.0F;
+  bool seen_ = false;
+  bool stuck_ = false;
 };
 
 // Receives each new camera frame inside the camera task (copy or downsample what is needed:
@@ -106,8 +112,10 @@ class CameraTask final : public Task {
   std::uint64_t frames_ = 0;
   std::uint64_t faults_ = 0;
   std::uint64_t stale_frames_ = 0;
+  std::uint64_t wrong_frames_ = 0;
   std::uint32_t last_sequence_ = 0;
   bool have_sequence_ = false;
+  const char* last_bad_ = nullptr;  // what was wrong with the last unusable frame
 };
 
 class ConsoleTask final : public Task {

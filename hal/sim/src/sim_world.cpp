@@ -72,6 +72,7 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   watchdog_armed_ = false;
   watchdog_expirations_ = 0;
   base_last_update_us_ = 0;
+  last_base_stop_us_ = 0;
   faults_.reset(params.seed);
   const char* model = "";
   const float gap = clearance_m(x_m_, y_m_, &model);
@@ -328,6 +329,7 @@ void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
 }
 
 void SimWorld::base_stop(const char* reason) {
+  if (base_health_ != BaseHealth::kStopped) last_base_stop_us_ = now_us_;
   target_left_m_s_ = target_right_m_s_ = 0.0F;
   wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
   base_health_ = BaseHealth::kStopped;

@@ -99,6 +99,8 @@ class SimWorld {
   void base_stop(const char* reason);
   bool base_resume();
   BaseHealth base_health() const { return base_health_; }
+  // When the base last went from moving or ready to stopped (any cause) [µs]; 0 never.
+  std::uint64_t last_base_stop_us() const { return last_base_stop_us_; }
   const char* base_error() const { return base_error_; }
   Odometry odometry() const { return odometry_; }
   // The true pose at which the odometry frame was fixed (the last base start).
@@ -147,6 +149,7 @@ class SimWorld {
   std::uint64_t base_ready_at_us_ = 0;
   bool base_started_ = false;
   std::uint64_t base_last_update_us_ = 0;
+  std::uint64_t last_base_stop_us_ = 0;
   char base_fault_error_[96] = {};
   Odometry odometry_{};
   core::Pose2 odometry_origin_{};

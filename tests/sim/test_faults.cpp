@@ -1,0 +1,144 @@
+// One test per (device, fault type) pair on the sim board: the fault injected at the HAL
+// boundary, the firmware's device tasks, e-stop latch, console and state saver around a
+// stand-in mission; each run is checked against its expectation (boards/sim/fault_scenario.h)
+// and for zero heap allocations from the first frame to the last.
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "fault_scenario.h"
+#include "hal/sim/fault_plan.h"
+#include "sim_board.h"
+#include "sim_test_worlds.h"
+
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+using boticelli::boards::sim::FaultScenarioConfig;
+using boticelli::boards::sim::FaultScenarioResult;
+using boticelli::hal::sim::FaultDevice;
+using boticelli::hal::sim::FaultType;
+
+namespace {
+
+// The guard lives only between the scenario's first and last frame (set-up allocates).
+struct AllocationWindow {
+  std::optional<boticelli::test::AllocationGuard> guard;
+  std::size_t allocations = 0;
+};
+void start_counting(void* context) {
+  static_cast<AllocationWindow*>(context)->guard.emplace();
+}
+void stop_counting(void* context) {
+  auto* w = static_cast<AllocationWindow*>(context);
+  w->allocations = w->guard->allocations();
+  w->guard.reset();
+}
+
+FaultScenarioResult g_result;  // 16 kB of console text: static
+
+}  // namespace
+
+TEST_GROUP(Faults) {
+  std::unique_ptr<boticelli::boards::sim::SimBoard> board;
+  std::string world;
+  std::string dir;
+  void setup() override {
+    board = std::make_unique<boticelli::boards::sim::SimBoard>();
+    world = boticelli::hal::sim::test::world_path("thesis_room");
+    char templ[] = "/tmp/boticelli-faults-XXXXXX";
+    dir = mkdtemp(templ);
+  }
+  void teardown() override {
+    board.reset();
+    unlink((dir + "/mission.state").c_str());
+    unlink((dir + "/mission.state.tmp").c_str());
+    rmdir(dir.c_str());
+  }
+
+  // Runs the pair and checks it met its expectation without allocating.
+  void check_pair(FaultDevice device, FaultType type) {
+    AllocationWindow window;
+    FaultScenarioConfig config;
+    config.world_file = world.c_str();
+    config.state_dir = dir.c_str();
+    config.loop_started = start_counting;
+    config.loop_ended = stop_counting;
+    config.context = &window;
+    const bool ran = boticelli::boards::sim::run_fault_scenario(*board, device, type, config,
+                                                                g_result);
+    CHECK_TEXT(ran, g_result.error);
+    char summary[512];
+    std::snprintf(summary, sizeof summary,
+                  "%s %s: moving_before=%d stop_latency_ms=%.1f stayed_stopped=%d "
+                  "moving_after=%d says_expected=%d healthy_after=%d collisions=%u "
+                  "state_loadable=%d\n--- console ---\n",
+                  boticelli::hal::sim::fault_device_name(device),
+                  boticelli::hal::sim::fault_type_name(type), g_result.moving_before ? 1 : 0,
+                  g_result.stop_latency_ms, g_result.stayed_stopped ? 1 : 0,
+                  g_result.moving_after ? 1 : 0, g_result.says_expected ? 1 : 0,
+                  g_result.healthy_after ? 1 : 0, g_result.collisions,
+                  g_result.state_loadable ? 1 : 0);
+    CHECK_TEXT(g_result.passed, (std::string(summary) + g_result.console.data()).c_str());
+    UNSIGNED_LONGS_EQUAL_TEXT(0U, window.allocations, "heap allocations during the fault run");
+  }
+};
+
+// The expectation for each pair is in boards/sim/fault_scenario.cpp (docs/reliability.md).
+#define FAULT_PAIR(name, device, type) \
+  TEST(Faults, name) { check_pair(FaultDevice::device, FaultType::type); }
+
+FAULT_PAIR(ACameraThatIsGoneIsReportedAsGoneAndFramesComeBackAfterIt, kCamera, kOff)
+FAULT_PAIR(AFrozenCameraIsNotANewFrameAndIsReportedAsTheSameFrameAgain, kCamera, kStuck)
+FAULT_PAIR(ErrorFlaggedFramesAreDroppedAndAStallOfThemIsReported, kCamera, kGarbage)
+FAULT_PAIR(FramesOfTheWrongSizeAreNotUsedAndAreReportedAsSuch, kCamera, kWrong)
+FAULT_PAIR(ASlowCameraStillDeliversAndStaysHealthy, kCamera, kSlow)
+FAULT_PAIR(LateFramesArriveWithTheirCaptureTimeAndTheCameraStaysHealthy, kCamera, kDelayed)
+FAULT_PAIR(ACameraThatComesAndGoesKeepsDelivering, kCamera, kIntermittent)
+FAULT_PAIR(APtuThatStopsAnsweringIsAFaultHalfASecondLater, kPtu, kOff)
+FAULT_PAIR(APtuMoveThatNeverCompletesIsReportedAsNotProgressing, kPtu, kStuck)
+FAULT_PAIR(GarbledPtuRepliesAreAFaultAtOnce, kPtu, kGarbage)
+FAULT_PAIR(APtuAnsweringErrorsRefusesMovesButStaysHealthy, kPtu, kWrong)
+FAULT_PAIR(ASlowPtuKeepsMoving, kPtu, kSlow)
+FAULT_PAIR(ADelayedPtuKeepsMoving, kPtu, kDelayed)
+FAULT_PAIR(APtuWithIntermittentlyGarbledRepliesIsReported, kPtu, kIntermittent)
+FAULT_PAIR(TheLeftAxisLosingItsHeartbeatStopsTheBaseWithinAFrame, kAxisLeft, kOff)
+FAULT_PAIR(AnErrorOfTheLeftAxisStopsTheBaseWithinAFrame, kAxisLeft, kWrong)
+FAULT_PAIR(TheLeftAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kAxisLeft,
+           kIntermittent)
+FAULT_PAIR(TheRightAxisLosingItsHeartbeatStopsTheBaseWithinAFrame, kAxisRight, kOff)
+FAULT_PAIR(AnErrorOfTheRightAxisStopsTheBaseWithinAFrame, kAxisRight, kWrong)
+FAULT_PAIR(TheRightAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kAxisRight,
+           kIntermittent)
+FAULT_PAIR(ACanBusOffStopsTheBaseWithinAFrame, kCan, kOff)
+FAULT_PAIR(ACanBusGoingOffNowAndThenStopsTheBaseAtTheFirstTime, kCan, kIntermittent)
+FAULT_PAIR(ABrokenEstopLineStopsTheBaseAndTheRobotCarriesOnWhenItIsBack, kEstop, kOff)
+FAULT_PAIR(AStuckEstopStopsTheBaseAndTheRobotCarriesOnAfterTheRelease, kEstop, kStuck)
+FAULT_PAIR(AChatteringEstopKeepsTheBaseStoppedUntilItIsQuiet, kEstop, kIntermittent)
+FAULT_PAIR(ABrokenBumperLineStopsTheBaseForGood, kBumper, kOff)
+FAULT_PAIR(AStuckBumperStopsTheBaseForGood, kBumper, kStuck)
+FAULT_PAIR(AChatteringBumperStopsTheBaseForGood, kBumper, kIntermittent)
+FAULT_PAIR(AnUnwritableStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kOff)
+FAULT_PAIR(AFullStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kWrong)
+FAULT_PAIR(StateSavesFailingNowAndThenAreReportedAndTheLastGoodFileStays, kStorage,
+           kIntermittent)
+FAULT_PAIR(AStalledMainLoopIsCaughtByTheOdrivesWatchdogWithinItsTimeout, kMainLoop, kStuck)
+FAULT_PAIR(ASlowMainLoopOverrunsItsFramesAndKeepsTheBaseUnderControl, kMainLoop, kSlow)
+
+TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
+  int pairs = 0;
+  for (std::size_t d = 0; d < boticelli::hal::sim::kFaultDeviceCount; ++d) {
+    for (std::size_t t = 0; t < boticelli::hal::sim::kFaultTypeCount; ++t) {
+      const auto device = static_cast<FaultDevice>(d);
+      const auto type = static_cast<FaultType>(t);
+      if (!boticelli::hal::sim::fault_applies(device, type)) continue;
+      ++pairs;
+      CHECK_TEXT(boticelli::boards::sim::expectation(device, type).console_says[0] != '\0',
+                 boticelli::hal::sim::fault_device_name(device));
+    }
+  }
+  CHECK_EQUAL(33, pairs);  // the FAULT_PAIR tests above
+}
