@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fault_scenario.h"
+#include "firmware/text_buffer.h"
 #include "hal/sim/fault_plan.h"
 #include "sim_board.h"
 #include "sim_test_worlds.h"
@@ -141,4 +142,37 @@ TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
     }
   }
   CHECK_EQUAL(33, pairs);  // the FAULT_PAIR tests above
+}
+
+TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {
+  boticelli::firmware::Options options;
+  options.world_file = world.c_str();
+  board->settings().camera_fps = 5.0F;
+  CHECK_TEXT(board->init(options, g_result.error, sizeof g_result.error), g_result.error);
+  boticelli::hal::Hal& hal = board->hal();
+  CHECK(hal.camera.init());
+  boticelli::firmware::TextBuffer<200> reply;
+  CHECK_FALSE(board->inject("toaster", "off", 1.0, reply));
+  STRCMP_CONTAINS("unknown device", reply.c_str());
+  reply.clear();
+  CHECK_FALSE(board->inject("estop", "garbage", 1.0, reply));
+  STRCMP_EQUAL("estop cannot be garbage", reply.c_str());
+  reply.clear();
+  CHECK_FALSE(board->inject("main-loop", "stuck", 0.0, reply));
+  STRCMP_CONTAINS("needs SECONDS", reply.c_str());
+  reply.clear();
+  hal.clock.sleep_until_us(500000);
+  CHECK(board->inject("camera", "off", 2.0, reply));
+  STRCMP_EQUAL("fault camera off seconds=2.0 from_t_s=0.50", reply.c_str());
+  boticelli::hal::Frame frame;
+  CHECK(hal.camera.poll(frame) == boticelli::hal::CameraPoll::kFault);
+  STRCMP_CONTAINS("device gone", hal.camera.error());
+  reply.clear();
+  board->describe_active(reply);
+  STRCMP_EQUAL("fault camera off since_t_s=0.50 until_t_s=2.50\r\n", reply.c_str());
+  hal.clock.sleep_until_us(2600000);
+  CHECK(hal.camera.poll(frame) == boticelli::hal::CameraPoll::kFrame);
+  reply.clear();
+  board->describe_active(reply);
+  STRCMP_EQUAL("", reply.c_str());
 }
