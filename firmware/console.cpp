@@ -269,10 +269,9 @@ void Console::cmd_status(const Words& w) {
   if (!no_args(w)) return reply_error("status takes no arguments");
   const FrameStats& f = executive_.frame_stats();
   const MapCounts m = view_.map_counts();
-  reply_.appendf(
-      "status state=%s estop=%s paused=%d healthy=%d", view_.state_name(),
-      stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
-      robot_healthy() ? 1 : 0);
+  reply_.appendf("status state=%s estop=%s paused=%d healthy=%d", view_.state_name(),
+                 stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
+                 robot_healthy() ? 1 : 0);
   append_unhealthy(reply_);
   reply_.appendf(" cycles=%llu pieces=%u features=%u obstacle_points=%u exploration_points=%u",
                  static_cast<unsigned long long>(view_.cycles()), view_.pieces(), view_.features(),
@@ -616,8 +615,8 @@ void Console::cmd_fault(const Words& w) {
   }
   if (w.count < 3) return reply_error("usage: fault DEVICE TYPE [SECONDS]");
   float seconds = 0.0F;
-  if (w.count == 4 && (!parse_number(w.word[3], seconds) || !(seconds > 0.0F) ||
-                       !(seconds <= 1e6F))) {
+  if (w.count == 4 &&
+      (!parse_number(w.word[3], seconds) || !(seconds > 0.0F) || !(seconds <= 1e6F))) {
     return reply_error("SECONDS must be a number in (0, 1e6]");
   }
   TextBuffer<200> text;

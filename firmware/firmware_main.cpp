@@ -385,8 +385,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       "target_error_m=%.3f reason=\"%s\"\n",
       mission::result_name(result), static_cast<unsigned long long>(g_state.cycle),
       static_cast<unsigned long long>(safety.collisions()), sim_time_s,
-      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()),
-      reason.c_str());
+      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()), reason.c_str());
   std::fflush(stdout);
   g_runtime.reset();
   g_signal = 0;

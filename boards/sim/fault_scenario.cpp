@@ -18,6 +18,7 @@
 #include "firmware/service_notify.h"
 #include "firmware/state_saver.h"
 #include "firmware/task_table.h"
+#include "firmware/text_buffer.h"
 #include "sim_board.h"
 
 namespace boticelli::boards::sim {
@@ -34,88 +35,118 @@ struct ExpectationRow {
   FaultExpectation expected;
 };
 
-constexpr const char* kFrameTimeout = "aborted after the 3 s frame timeout: no camera frame";
+constexpr const char* kFrameTimeout =
+    "aborted after the 3 s frame timeout: no camera frame (with the driver's reason)";
 constexpr const char* kBaseAbort =
     "aborted at its next step: base stopped by itself, with the driver's reason";
 constexpr const char* kCarriesOn = "carries on";
 constexpr ExpectationRow kExpectations[] = {
-    {FaultDevice::kCamera, FaultType::kOff,
+    {FaultDevice::kCamera,
+     FaultType::kOff,
      {false, "camera unhealthy: no new frame for 2.0 s: camera: device gone", true,
-      "holds up to the 3 s frame timeout, then aborted: no camera frame"}},
-    {FaultDevice::kCamera, FaultType::kStuck,
-     {false, "camera unhealthy: no new frame for 2.0 s: the same frame again", true,
-      kFrameTimeout}},
-    {FaultDevice::kCamera, FaultType::kGarbage,
-     {false, "camera unhealthy: no new frame for 2.0 s", true, kFrameTimeout}},
-    {FaultDevice::kCamera, FaultType::kWrong,
+      "aborted after the 3 s frame timeout: no camera frame: camera: device gone", true}},
+    {FaultDevice::kCamera,
+     FaultType::kStuck,
+     {false, "camera unhealthy: no new frame for 2.0 s: the same frame again", true, kFrameTimeout,
+      true}},
+    {FaultDevice::kCamera,
+     FaultType::kGarbage,
+     {false, "camera unhealthy: no new frame for 2.0 s", true, kFrameTimeout, true}},
+    {FaultDevice::kCamera,
+     FaultType::kWrong,
      {false, "camera unhealthy: no new frame for 2.0 s: frames of the wrong size", true,
-      kFrameTimeout}},
+      kFrameTimeout, true}},
     {FaultDevice::kCamera, FaultType::kSlow, {false, "unhealthy=none", true, kCarriesOn}},
     {FaultDevice::kCamera, FaultType::kDelayed, {false, "unhealthy=none", true, kCarriesOn}},
-    {FaultDevice::kCamera, FaultType::kIntermittent,
-     {false, "unhealthy=none", true, kCarriesOn}},
-    {FaultDevice::kPtu, FaultType::kOff,
+    {FaultDevice::kCamera, FaultType::kIntermittent, {false, "unhealthy=none", true, kCarriesOn}},
+    {FaultDevice::kPtu,
+     FaultType::kOff,
      {false, "ptu unhealthy: PTU: no reply for 0.5 s", true,
-      "aborted: pan-tilt unit fault: PTU: no reply for 0.5 s"}},
-    {FaultDevice::kPtu, FaultType::kStuck,
+      "aborted: pan-tilt unit fault: PTU: no reply for 0.5 s", true}},
+    {FaultDevice::kPtu,
+     FaultType::kStuck,
      {false, "ptu unhealthy: PTU: a move is not progressing", true,
-      "aborted after the 8 s move timeout: pan-tilt move did not complete"}},
-    {FaultDevice::kPtu, FaultType::kGarbage,
+      "carries on when the move ends within the 8 s move timeout, else aborted: pan-tilt "
+      "move did not complete"}},
+    {FaultDevice::kPtu,
+     FaultType::kGarbage,
      {false, "ptu unhealthy: PTU: garbled reply", true,
-      "aborted: pan-tilt unit fault: PTU: garbled reply"}},
-    {FaultDevice::kPtu, FaultType::kWrong,
+      "aborted: pan-tilt unit fault: PTU: garbled reply", true}},
+    {FaultDevice::kPtu,
+     FaultType::kWrong,
      {false, "unhealthy=none", true,
-      "aborted: pan-tilt unit refused a move: ! PTU refused the command"}},
+      "aborted: pan-tilt unit refused a move: ! PTU refused the command", true}},
     {FaultDevice::kPtu, FaultType::kSlow, {false, "unhealthy=none", true, kCarriesOn}},
     {FaultDevice::kPtu, FaultType::kDelayed, {false, "unhealthy=none", true, kCarriesOn}},
-    {FaultDevice::kPtu, FaultType::kIntermittent,
+    {FaultDevice::kPtu,
+     FaultType::kIntermittent,
      {false, "ptu unhealthy: PTU: garbled reply", true,
-      "aborted: pan-tilt unit fault: PTU: garbled reply"}},
-    {FaultDevice::kAxisLeft, FaultType::kOff,
-     {true, "base unhealthy: base: left axis: heartbeat lost", false, kBaseAbort}},
-    {FaultDevice::kAxisLeft, FaultType::kWrong,
-     {true, "base unhealthy: base: left axis: ODrive reports an axis error", false, kBaseAbort}},
-    {FaultDevice::kAxisLeft, FaultType::kIntermittent,
-     {true, "base unhealthy: base: left axis: heartbeat lost", false, kBaseAbort}},
-    {FaultDevice::kAxisRight, FaultType::kOff,
-     {true, "base unhealthy: base: right axis: heartbeat lost", false, kBaseAbort}},
-    {FaultDevice::kAxisRight, FaultType::kWrong,
-     {true, "base unhealthy: base: right axis: ODrive reports an axis error", false,
-      kBaseAbort}},
-    {FaultDevice::kAxisRight, FaultType::kIntermittent,
-     {true, "base unhealthy: base: right axis: heartbeat lost", false, kBaseAbort}},
-    {FaultDevice::kCan, FaultType::kOff,
-     {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort}},
-    {FaultDevice::kCan, FaultType::kIntermittent,
-     {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort}},
-    {FaultDevice::kEstop, FaultType::kOff,
+      "aborted: pan-tilt unit fault: PTU: garbled reply", true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kOff,
+     {true, "base unhealthy: base: left axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kWrong,
+     {true, "base unhealthy: base: left axis: ODrive reports an axis error", false, kBaseAbort,
+      true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kIntermittent,
+     {true, "base unhealthy: base: left axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kOff,
+     {true, "base unhealthy: base: right axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kWrong,
+     {true, "base unhealthy: base: right axis: ODrive reports an axis error", false, kBaseAbort,
+      true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kIntermittent,
+     {true, "base unhealthy: base: right axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kCan,
+     FaultType::kOff,
+     {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort, true}},
+    {FaultDevice::kCan,
+     FaultType::kIntermittent,
+     {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort, true}},
+    {FaultDevice::kEstop,
+     FaultType::kOff,
      {true, "e-stop engaged: button (base stopped)", true,
       "holds; carries on 0.5 s after the line is back"}},
-    {FaultDevice::kEstop, FaultType::kStuck,
+    {FaultDevice::kEstop,
+     FaultType::kStuck,
      {true, "e-stop engaged: button (base stopped)", true,
       "holds; carries on 0.5 s after the release"}},
-    {FaultDevice::kEstop, FaultType::kIntermittent,
+    {FaultDevice::kEstop,
+     FaultType::kIntermittent,
      {true, "e-stop engaged: button (base stopped)", true,
       "holds; carries on 0.5 s after the last release"}},
-    {FaultDevice::kBumper, FaultType::kOff,
-     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact"}},
-    {FaultDevice::kBumper, FaultType::kStuck,
-     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact"}},
-    {FaultDevice::kBumper, FaultType::kIntermittent,
-     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact"}},
-    {FaultDevice::kStorage, FaultType::kOff,
+    {FaultDevice::kBumper,
+     FaultType::kOff,
+     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
+    {FaultDevice::kBumper,
+     FaultType::kStuck,
+     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
+    {FaultDevice::kBumper,
+     FaultType::kIntermittent,
+     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
+    {FaultDevice::kStorage,
+     FaultType::kOff,
      {false, "storage unhealthy: state not saved (1 failed): cannot create", true,
       "carries on; saves fail while it lasts, the last good state file stays"}},
-    {FaultDevice::kStorage, FaultType::kWrong,
+    {FaultDevice::kStorage,
+     FaultType::kWrong,
      {false, "No space left on device", true,
       "carries on; saves fail while it lasts, the last good state file stays"}},
-    {FaultDevice::kStorage, FaultType::kIntermittent,
+    {FaultDevice::kStorage,
+     FaultType::kIntermittent,
      {false, "storage unhealthy: state not saved", true,
       "carries on; some saves fail, the last good state file stays"}},
-    {FaultDevice::kMainLoop, FaultType::kStuck,
+    {FaultDevice::kMainLoop,
+     FaultType::kStuck,
      {true, "base unhealthy: base: left axis: ODrive reports an axis error (0x00000800)", false,
-      kBaseAbort}},
-    {FaultDevice::kMainLoop, FaultType::kSlow,
+      kBaseAbort, true}},
+    {FaultDevice::kMainLoop,
+     FaultType::kSlow,
      {false, "LOG warn overruns frame=", true, "carries on; frames overrun"}},
 };
 
@@ -279,6 +310,54 @@ bool contains(std::string_view text, const char* what) {
   return what[0] == '\0' || text.find(what) != std::string_view::npos;
 }
 
+// Inits the board (with its default_faults() as the plan) and the rig; false with the reason.
+bool start_rig(SimBoard& board, const FaultScenarioConfig& config, bool wants_frames, char* error,
+               std::size_t error_size) {
+  board.settings().camera_fps = config.camera_fps;
+  fw::Options options;
+  options.world_file = config.world_file;
+  options.seed = config.seed;
+  if (!board.init(options, error, error_size)) return false;
+  hal::Hal& hal = board.hal();
+  if (config.state_dir != nullptr && !g_store.open(config.state_dir, error, error_size)) {
+    return false;
+  }
+  if (!hal.base.init() || !hal.pan_tilt.init() || !hal.camera.init()) {
+    std::snprintf(error, error_size, "device init failed");
+    return false;
+  }
+  (void)hal.watchdog.start(board.config().watchdog_timeout_ms);
+  g_rig.reset();
+  g_rig.emplace(hal, g_store, config.state_dir != nullptr);
+  Rig& rig = *g_rig;
+  rig.state.clear();
+  rig.camera_task.set_consumer(&rig.stand_in);
+  rig.stand_in.set_wants_frames(wants_frames);
+  rig.watchdog_task.set_status_sources(&rig.safety, &rig.stand_in);
+  fw::Task* const tasks[fw::kTaskCount] = {&rig.estop_task,   &rig.base_task, &rig.ptu_task,
+                                           &rig.camera_task,  &rig.stand_in,  &rig.console_task,
+                                           &rig.watchdog_task};
+  const char* why = "";
+  for (std::size_t i = 0; i < fw::kTaskCount; ++i) {
+    if (!rig.executive.add_task(fw::kTaskTable[i], *tasks[i], &why)) {
+      std::snprintf(error, error_size, "executive: %s", why);
+      return false;
+    }
+  }
+  rig.executive.set_background(&rig.stand_in);
+  rig.console.set_telemetry_ms(0.0F);
+  rig.console.set_fault_injection(&board);
+  if (config.state_dir != nullptr) rig.console.set_parameter_saver(&rig.saver);
+  fw::ExecutiveConfig exec_config;
+  exec_config.frame_us = board.config().minor_frame_us;
+  exec_config.background_units_per_slice = board.config().background_units_per_slice;
+  if (!rig.executive.start(exec_config, &why)) {
+    std::snprintf(error, error_size, "executive: %s", why);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 const FaultExpectation& expectation(FaultDevice device, FaultType type) {
@@ -305,49 +384,11 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   fault.duration_us = static_cast<std::uint64_t>(std::llround(config.fault_s * 1e6));
   board.default_faults().clear();
   (void)board.default_faults().add(fault);
-  board.settings().camera_fps = config.camera_fps;
-  fw::Options options;
-  options.world_file = config.world_file;
-  options.seed = config.seed;
-  if (!board.init(options, out.error, sizeof out.error)) return false;
-  hal::Hal& hal = board.hal();
-  if (config.state_dir != nullptr && !g_store.open(config.state_dir, out.error, sizeof out.error)) {
+  if (!start_rig(board, config, device == FaultDevice::kCamera, out.error, sizeof out.error)) {
     return false;
   }
-  if (!hal.base.init() || !hal.pan_tilt.init() || !hal.camera.init()) {
-    std::snprintf(out.error, sizeof out.error, "device init failed");
-    return false;
-  }
-  (void)hal.watchdog.start(board.config().watchdog_timeout_ms);
-  g_rig.reset();
-  g_rig.emplace(hal, g_store, config.state_dir != nullptr);
   Rig& rig = *g_rig;
-  rig.state.clear();
-  rig.camera_task.set_consumer(&rig.stand_in);
-  rig.stand_in.set_wants_frames(device == FaultDevice::kCamera);
-  rig.watchdog_task.set_status_sources(&rig.safety, &rig.stand_in);
-  fw::Task* const tasks[fw::kTaskCount] = {&rig.estop_task,   &rig.base_task,
-                                           &rig.ptu_task,     &rig.camera_task,
-                                           &rig.stand_in,     &rig.console_task,
-                                           &rig.watchdog_task};
-  const char* why = "";
-  for (std::size_t i = 0; i < fw::kTaskCount; ++i) {
-    if (!rig.executive.add_task(fw::kTaskTable[i], *tasks[i], &why)) {
-      std::snprintf(out.error, sizeof out.error, "executive: %s", why);
-      return false;
-    }
-  }
-  rig.executive.set_background(&rig.stand_in);
-  rig.console.set_telemetry_ms(0.0F);
-  rig.console.set_fault_injection(&board);
-  if (config.state_dir != nullptr) rig.console.set_parameter_saver(&rig.saver);
-  fw::ExecutiveConfig exec_config;
-  exec_config.frame_us = board.config().minor_frame_us;
-  exec_config.background_units_per_slice = board.config().background_units_per_slice;
-  if (!rig.executive.start(exec_config, &why)) {
-    std::snprintf(out.error, sizeof out.error, "executive: %s", why);
-    return false;
-  }
+  hal::Hal& hal = board.hal();
   hal::sim::SimWorld& sim = board.sim();
   const std::uint64_t onset_us = fault.start_us;
   const std::uint64_t end_us = fault.end_us();
@@ -382,8 +423,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
       hal::sim::FaultType active = type;
       const bool failing = sim.faults().failing(device, active);
       if (failing && failing_since_us == 0) {
-        const std::uint64_t slot = (now / hal::sim::FaultInjector::kSlotUs) *
-                                   hal::sim::FaultInjector::kSlotUs;
+        const std::uint64_t slot =
+            (now / hal::sim::FaultInjector::kSlotUs) * hal::sim::FaultInjector::kSlotUs;
         failing_since_us = type == FaultType::kIntermittent && slot > onset_us ? slot : onset_us;
       } else if (!failing) {
         failing_since_us = 0;
@@ -406,8 +447,7 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
       moves_at_end = rig.stand_in.ptu_moves();
       continue;
     }
-    if (!stopped_seen && sim.last_base_stop_us() >= onset_us &&
-        sim.last_base_stop_us() < end_us) {
+    if (!stopped_seen && sim.last_base_stop_us() >= onset_us && sim.last_base_stop_us() < end_us) {
       // Stopped while no frame of the firmware ran (the main loop's stall): by the ODrives'
       // own watchdog, and still at rest when the firmware runs again.
       stopped_seen = true;
@@ -440,8 +480,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
     out.save_failures = rig.saver.failures();
     char error[256] = "";
     const fw::LoadResult loaded = g_store.load(g_loaded, error, sizeof error);
-    out.state_loadable = loaded == fw::LoadResult::kLoaded || (loaded == fw::LoadResult::kMissing &&
-                                                               out.saves == 0);
+    out.state_loadable =
+        loaded == fw::LoadResult::kLoaded || (loaded == fw::LoadResult::kMissing && out.saves == 0);
   }
   const std::string_view text = rig.port.written();
   const std::size_t n = text.size() < out.console.size() - 1 ? text.size() : out.console.size() - 1;
@@ -462,6 +502,102 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
     ok = ok && !out.moving_after;
   }
   out.passed = ok;
+  out.ran = true;
+  g_rig.reset();
+  return true;
+}
+
+bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run_s,
+                    const FaultScenarioConfig& config, FaultSoakResult& out) {
+  out = FaultSoakResult{};
+  board.default_faults() = plan;
+  if (!start_rig(board, config, true, out.error, sizeof out.error)) return false;
+  Rig& rig = *g_rig;
+  hal::Hal& hal = board.hal();
+  hal::sim::SimWorld& sim = board.sim();
+  const hal::sim::FaultInjector& faults = sim.faults();
+  const auto end_us = static_cast<std::uint64_t>(std::llround(run_s * 1e6));
+  constexpr std::uint64_t kSettleUs = 1500000;
+  std::uint32_t ended_seen = 0;
+  std::uint64_t check_at_us = 0;  // a quiet check is due then (0: none)
+  std::uint64_t line_active_since_us = 0;
+  if (config.loop_started != nullptr) config.loop_started(config.context);
+  while (hal.clock.now_us() < end_us) {
+    rig.executive.run_frame();
+    ++out.frames;
+    const std::uint64_t now = hal.clock.now_us();
+    bool any_active = false;
+    bool line_active = false;
+    for (std::size_t d = 0; d < hal::sim::kFaultDeviceCount; ++d) {
+      FaultType type = FaultType::kOff;
+      const auto device = static_cast<FaultDevice>(d);
+      if (faults.active(device, type)) any_active = true;
+      if ((device == FaultDevice::kEstop || device == FaultDevice::kBumper) &&
+          faults.failing(device, type)) {
+        line_active = true;
+      }
+    }
+    // The e-stop or bumper line active: the wheels at rest after one frame's grace.
+    if (line_active) {
+      if (line_active_since_us == 0) line_active_since_us = now;
+      if (now - line_active_since_us > 10000U && !wheels_at_rest(sim)) ++out.stop_violations;
+    } else {
+      line_active_since_us = 0;
+    }
+    if (faults.ended() != ended_seen) {
+      ended_seen = faults.ended();
+      check_at_us = now + kSettleUs;
+    }
+    if (any_active) {
+      if (check_at_us != 0 && now >= check_at_us) check_at_us = now + kSettleUs;  // wait on
+      continue;
+    }
+    if (check_at_us == 0 || now < check_at_us) continue;
+    check_at_us = 0;
+    ++out.quiet_checks;
+    const bool healthy = rig.executive.all_healthy() && rig.console.storage_healthy();
+    const bool moving = !wheels_at_rest(sim);
+    bool loads = true;
+    if (config.state_dir != nullptr && rig.saver.saved() > 0) {
+      char error[256] = "";
+      loads = g_store.load(g_loaded, error, sizeof error) == fw::LoadResult::kLoaded;
+      if (!loads) ++out.state_loads_failed;
+    }
+    if (healthy && moving && loads) {
+      ++out.ended_safe;
+    } else {
+      if (out.ended_unsafe == 0) {
+        fw::TextBuffer<200> what;
+        what.appendf("t_s=%.1f moving=%d state_loads=%d storage=%d",
+                     static_cast<double>(now) * 1e-6, moving ? 1 : 0, loads ? 1 : 0,
+                     rig.console.storage_healthy() ? 1 : 0);
+        for (std::size_t i = 0; i < rig.executive.task_count(); ++i) {
+          if (const char* why = rig.executive.task_health(i); why != nullptr) {
+            what.appendf(" %s: %s", rig.executive.spec(i).name, why);
+          }
+        }
+        std::snprintf(out.first_unsafe, sizeof out.first_unsafe, "%s", what.c_str());
+      }
+      ++out.ended_unsafe;
+    }
+  }
+  if (config.loop_ended != nullptr) config.loop_ended(config.context);
+  out.sim_s = static_cast<double>(hal.clock.now_us()) * 1e-6;
+  out.faults_started = faults.started();
+  out.faults_ended = faults.ended();
+  out.collisions = sim.collisions();
+  out.saves = rig.saver.saved();
+  out.save_failures = rig.saver.failures();
+  const fw::FrameStats& f = rig.executive.frame_stats();
+  out.frame_overruns = f.overruns;
+  out.missed_frames = f.missed_frames;
+  out.worst_jitter_us = f.jitter_worst_us;
+  for (std::size_t i = 0; i < rig.executive.task_count(); ++i) {
+    const std::uint32_t w = rig.executive.task_stats(i).worst_us;
+    if (w > out.worst_task_us) out.worst_task_us = w;
+  }
+  out.console_dropped_bytes = rig.console.dropped_bytes();
+  out.watchdog_expirations = sim.watchdog_expirations();
   out.ran = true;
   g_rig.reset();
   return true;

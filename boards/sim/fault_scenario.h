@@ -27,9 +27,15 @@ struct FaultExpectation {
   // False where the firmware does not restart on its own (a base that stopped by itself,
   // the bumper: the mission ends aborted).
   bool recovers = true;
-  // What the mission does (whole missions: the bench's mission column).
+  // What the whole mission does with the fault for kMissionFaultS in its first look (the
+  // bench's mission column), and whether it then ends aborted (else it carries on).
   const char* mission = "";
+  bool mission_aborts = false;
 };
+// The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the
+// mission's 3 s frame timeout, shorter than its 8 s PTU move timeout).
+inline constexpr double kMissionFaultStartS = 5.0;
+inline constexpr double kMissionFaultS = 5.0;
 const FaultExpectation& expectation(hal::sim::FaultDevice device, hal::sim::FaultType type);
 
 struct FaultScenarioConfig {
@@ -77,6 +83,34 @@ struct FaultScenarioResult {
   // Met the expectation in every respect it names.
   bool passed = false;
 };
+
+// A long run under a plan of many faults (generate_fault_plan): the same rig, judged after
+// each fault has ended and nothing else is active for 1.5 s.
+struct FaultSoakResult {
+  bool ran = false;
+  char error[256] = "";
+  double sim_s = 0.0;
+  std::uint64_t frames = 0;
+  std::uint32_t faults_started = 0;
+  std::uint32_t faults_ended = 0;
+  std::uint32_t quiet_checks = 0;     // moments with no fault active, 1.5 s after one ended
+  std::uint32_t ended_safe = 0;       // ... where everything was healthy and moving again
+  std::uint32_t ended_unsafe = 0;     // ... where something was not
+  char first_unsafe[200] = "";        // what, the first time
+  std::uint64_t stop_violations = 0;  // frames moving while the e-stop or bumper line was active
+  std::uint32_t collisions = 0;
+  std::uint64_t saves = 0;
+  std::uint64_t save_failures = 0;
+  std::uint32_t state_loads_failed = 0;  // the state file did not load at a quiet check
+  std::uint64_t frame_overruns = 0;
+  std::uint64_t missed_frames = 0;
+  std::uint32_t worst_jitter_us = 0;
+  std::uint32_t worst_task_us = 0;
+  std::uint64_t console_dropped_bytes = 0;
+  std::uint32_t watchdog_expirations = 0;
+};
+bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run_s,
+                    const FaultScenarioConfig& config, FaultSoakResult& out);
 
 // Runs one pair on `board` (init()ed here with the config's world and seed). Allocates only
 // before loop_started.

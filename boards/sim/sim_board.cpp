@@ -130,8 +130,9 @@ bool SimBoard::inject(std::string_view device, std::string_view type, double sec
   FaultDevice d = FaultDevice::kCamera;
   FaultType t = FaultType::kOff;
   if (!hal::sim::parse_fault_device(device, d)) {
-    reply.append("unknown device (camera, ptu, axis-left, axis-right, can, estop, bumper, "
-                 "storage, main-loop)");
+    reply.append(
+        "unknown device (camera, ptu, axis-left, axis-right, can, estop, bumper, "
+        "storage, main-loop)");
     return false;
   }
   if (!hal::sim::parse_fault_type(type, t)) {

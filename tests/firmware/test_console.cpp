@@ -731,8 +731,8 @@ class RecordingInjection final : public FaultInjection {
       reply.append("unknown device");
       return false;
     }
-    reply.appendf("fault %s %s seconds=%.1f from_t_s=1.00", last_device.c_str(),
-                  last_type.c_str(), seconds);
+    reply.appendf("fault %s %s seconds=%.1f from_t_s=1.00", last_device.c_str(), last_type.c_str(),
+                  seconds);
     return true;
   }
   void describe_active(TextBufferBase& out) const override {

@@ -54,7 +54,7 @@ class FakeBoard final : public Board {
   bool refuse = false;
   const char* default_config = nullptr;       // the board's default configuration file
   std::function<void(FakeBoard&)> after_run;  // looks at the devices after the run
-  const MainHooks* hooks = nullptr;            // handed to firmware_main
+  const MainHooks* hooks = nullptr;           // handed to firmware_main
   BoardConfig config_{};
   boticelli::fakes::FakeClock clock{1000};
   boticelli::fakes::FakeSerialPort console;
@@ -256,9 +256,10 @@ std::string read_all(const std::string& path) {
 }  // namespace
 
 TEST(FirmwareMain, ANewMissionKeepsTheSavedOneInsteadOfOverwritingIt) {
-  CHECK_EQUAL(kExitNotFound, run_firmware({"--state", dir.c_str(), "--seed", "5"}, [](FakeBoard& b) {
-                               b.console.feed("quit\r");
-                             }).exit_code);
+  CHECK_EQUAL(kExitNotFound,
+              run_firmware({"--state", dir.c_str(), "--seed", "5"}, [](FakeBoard& b) {
+                b.console.feed("quit\r");
+              }).exit_code);
   const std::string first = read_all(dir + "/mission.state");
   STRCMP_CONTAINS("seed 5", first.c_str());
   Run r = run_firmware({"--state", dir.c_str(), "--seed", "6"},
@@ -273,12 +274,12 @@ TEST(FirmwareMain, ANewMissionKeepsTheSavedOneInsteadOfOverwritingIt) {
     CHECK_EQUAL(kExitNotFound, r.exit_code);
   }
   // Three more starts: the seed-6 mission has moved up to the last copy, the first is gone.
-  STRCMP_CONTAINS("seed 6", read_all(dir + "/mission.state." +
-                                     std::to_string(StateStore::kKeptStates))
-                                .c_str());
-  STRCMP_EQUAL("(missing)",
-               read_all(dir + "/mission.state." + std::to_string(StateStore::kKeptStates + 1))
-                   .c_str());
+  STRCMP_CONTAINS(
+      "seed 6",
+      read_all(dir + "/mission.state." + std::to_string(StateStore::kKeptStates)).c_str());
+  STRCMP_EQUAL(
+      "(missing)",
+      read_all(dir + "/mission.state." + std::to_string(StateStore::kKeptStates + 1)).c_str());
   // --resume continues the newest one and keeps nothing.
   r = run_firmware({"--state", dir.c_str(), "--resume"},
                    [](FakeBoard& b) { b.console.feed("quit\r"); });

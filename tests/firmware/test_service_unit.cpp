@@ -79,7 +79,7 @@ TEST(ServiceUnit, AHungFirmwareIsRestartedWellInsideTheHardwareWatchdogTimeout) 
   if (keys.count("WatchdogSec") == 0 || keys.count("RestartSec") == 0) return;
   const double watchdog_s = seconds(keys.at("WatchdogSec"));
   // Without TimeoutAbortSec systemd waits TimeoutStopSec (default 90 s) before SIGKILL.
-  const std::string abort_key = keys.count("TimeoutAbortSec") != 0 ? "TimeoutAbortSec"
+  const std::string abort_key = keys.count("TimeoutAbortSec") != 0  ? "TimeoutAbortSec"
                                 : keys.count("TimeoutStopSec") != 0 ? "TimeoutStopSec"
                                                                     : "";
   const double abort_s = abort_key.empty() ? 90.0 : seconds(keys.at(abort_key));

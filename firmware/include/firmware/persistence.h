@@ -56,8 +56,7 @@ class StateStore {
   // oldest is dropped), then fsyncs the directory. kMissing when there was nothing to keep;
   // kLoaded (kept, `kept` holds the new name) or kIoError with the reason in `error`.
   static constexpr int kKeptStates = 3;
-  LoadResult keep_previous(char* kept, std::size_t kept_size, char* error,
-                           std::size_t error_size);
+  LoadResult keep_previous(char* kept, std::size_t kept_size, char* error, std::size_t error_size);
   const char* path() const { return path_.data(); }
   const char* parameters_path() const { return parameters_path_.data(); }
   bool is_open() const { return dir_[0] != '\0'; }

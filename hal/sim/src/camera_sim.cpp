@@ -70,6 +70,10 @@ CameraPoll CameraSim::poll(Frame& frame) {
     delayed_pending_ = false;
     return deliver(frame, delayed_capture_us_, delayed_sequence_, false);
   }
+  // Back from a slow spell: the next frame comes at the normal rate again.
+  if (!(failing && fault == FaultType::kSlow) && next_capture_us_ > now + period_us_) {
+    next_capture_us_ = now;
+  }
   if (now < next_capture_us_) return CameraPoll::kNoFrame;
   // Frames come on the period grid; missed ones are skipped, as a streaming camera drops them.
   const std::uint64_t period = failing && fault == FaultType::kSlow ? 10U * period_us_ : period_us_;

@@ -21,8 +21,8 @@ constexpr std::uint8_t bit(FaultType t) {
 }
 constexpr std::uint8_t kAll = 0x7F;
 constexpr std::array<std::uint8_t, kFaultDeviceCount> kApplies = {
-    kAll,                                                                         // camera
-    kAll,                                                                         // ptu
+    kAll,                                                                           // camera
+    kAll,                                                                           // ptu
     bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),  // left
     bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),  // right
     bit(FaultType::kOff) | bit(FaultType::kIntermittent),                           // can
@@ -194,8 +194,7 @@ bool parse_fault_plan(std::string_view text, const char* name, FaultPlan& out, c
     }
     if (!parse_fault_type(words[2], f.type)) {
       say(error, error_size, name, line_no,
-          "unknown fault type (off, stuck, garbage, wrong, slow, delayed, intermittent)",
-          words[2]);
+          "unknown fault type (off, stuck, garbage, wrong, slow, delayed, intermittent)", words[2]);
       out.clear();
       return false;
     }
@@ -302,10 +301,14 @@ void generate_fault_plan(const PlanGeneratorConfig& config, FaultPlan& out) {
     }
   }
   if (pair_count == 0 || config.run_s <= config.warmup_s) return;
+  // One start per equal window of the run, in time order, so "one fault per device at a
+  // time" only has to look back.
   std::array<std::uint64_t, kFaultDeviceCount> busy_until{};
+  const double window_s =
+      (config.run_s - config.warmup_s) / static_cast<double>(config.count == 0 ? 1 : config.count);
   for (std::size_t k = 0; k < config.count && out.size() < FaultPlan::kMaxFaults; ++k) {
     Fault f = pairs[static_cast<std::size_t>(next_random(state) % pair_count)];
-    const double at_s = config.warmup_s + uniform(state) * (config.run_s - config.warmup_s);
+    const double at_s = config.warmup_s + (static_cast<double>(k) + uniform(state)) * window_s;
     const double max_s = config.max_duration_s > 0.2 ? config.max_duration_s : 0.2;
     const double duration_s = 0.2 + uniform(state) * (max_s - 0.2);
     f.start_us = to_us(at_s);
