@@ -83,12 +83,14 @@ double uniform(std::uint64_t& state) {
 
 const char* fault_device_name(FaultDevice device) {
   const auto i = static_cast<std::size_t>(device);
-  return i < kFaultDeviceCount ? kDeviceNames[i] : "?";
+  if (i >= kFaultDeviceCount) return "?";
+  return kDeviceNames[i];
 }
 
 const char* fault_type_name(FaultType type) {
   const auto i = static_cast<std::size_t>(type);
-  return i < kFaultTypeCount ? kTypeNames[i] : "?";
+  if (i >= kFaultTypeCount) return "?";
+  return kTypeNames[i];
 }
 
 bool parse_fault_device(std::string_view name, FaultDevice& out) {

@@ -62,7 +62,7 @@ struct Fault {
 class FaultPlan {
  public:
   static constexpr std::size_t kMaxFaults = 256;
-  static constexpr std::size_t kMaxFileBytes = 64 * 1024;
+  static constexpr std::size_t kMaxFileBytes = std::size_t{64} * 1024;
   static constexpr std::size_t kMaxLineBytes = 160;
   static constexpr double kMaxTimeS = 1e6;  // latest start and longest duration [s]
 
