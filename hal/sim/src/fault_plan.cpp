@@ -10,9 +10,9 @@
 namespace boticelli::hal::sim {
 namespace {
 
-constexpr std::array<const char*, kFaultDeviceCount> kDeviceNames = {
+constexpr const char* const kDeviceNames[kFaultDeviceCount] = {
     "camera", "ptu", "axis-left", "axis-right", "can", "estop", "bumper", "storage", "main-loop"};
-constexpr std::array<const char*, kFaultTypeCount> kTypeNames = {
+constexpr const char* const kTypeNames[kFaultTypeCount] = {
     "off", "stuck", "garbage", "wrong", "slow", "delayed", "intermittent"};
 
 // Bit t set: type t means something for the device (docs/reliability.md).
