@@ -29,7 +29,20 @@ bool write_all(int fd, const char* data, std::size_t size) {
   return true;
 }
 
+StorageFaultHook g_storage_fault = nullptr;
+void* g_storage_fault_context = nullptr;
+
+// The injected errno for this call, 0 for none.
+int injected(StorageCall call) {
+  return g_storage_fault != nullptr ? g_storage_fault(call, g_storage_fault_context) : 0;
+}
+
 }  // namespace
+
+void set_storage_fault_hook(StorageFaultHook hook, void* context) {
+  g_storage_fault = hook;
+  g_storage_fault_context = context;
+}
 
 bool write_file_atomically(const char* dir, const char* name, std::string_view data, char* error,
                            std::size_t error_size, SaveCrashHook hook, void* hook_context) {
@@ -46,7 +59,10 @@ bool write_file_atomically(const char* dir, const char* name, std::string_view d
     std::snprintf(error, error_size, "save interrupted (test crash hook)");
     return true;
   };
-  const int fd = ::open(tmp_path.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
+  const int fault = injected(StorageCall::kCreate);
+  if (fault != 0) errno = fault;
+  const int fd =
+      fault != 0 ? -1 : ::open(tmp_path.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
   if (fd < 0) {
     set_error(error, error_size, "cannot create", tmp_path.data());
     return false;
@@ -58,7 +74,9 @@ bool write_file_atomically(const char* dir, const char* name, std::string_view d
   for (std::size_t done = 0; done < data.size();) {
     const std::size_t left = data.size() - done;
     const std::size_t n = left < kAtomicWriteChunkBytes ? left : kAtomicWriteChunkBytes;
-    if (!write_all(fd, data.data() + done, n)) {
+    const int write_fault = injected(StorageCall::kWrite);
+    if (write_fault != 0) errno = write_fault;
+    if (write_fault != 0 || !write_all(fd, data.data() + done, n)) {
       set_error(error, error_size, "cannot write", tmp_path.data());
       ::close(fd);
       ::unlink(tmp_path.data());

@@ -34,6 +34,8 @@ const Console::Command Console::kCommands[] = {
      &Console::cmd_log},
     {"param", "show|save", "parameters changed from their defaults; save them for restarts",
      &Console::cmd_param},
+    {"fault", "[DEVICE TYPE [SECONDS]]",
+     "inject a device fault (sim board), or list the active ones", &Console::cmd_fault},
     {"ver", "", "firmware version and board", &Console::cmd_ver},
     {"shutdown", "", "stop the firmware in an orderly way", &Console::cmd_shutdown},
     {"quit", "", "same as shutdown", &Console::cmd_shutdown},
@@ -54,6 +56,8 @@ void Console::set_parameter_saver(StateSaver* saver) {
   if (saver != nullptr) {
     seen_parameter_saves_ = saver->parameter_saves();
     seen_parameter_failures_ = saver->parameter_failures();
+    seen_state_saves_ = saver->saved();
+    seen_state_failures_ = saver->failures();
   }
 }
 
@@ -185,6 +189,7 @@ void Console::service(std::uint64_t now_us) {
   }
   check_executive(now_us);
   check_parameter_saves();
+  check_state_saves();
   send_telemetry(now_us);
   flush();
 }
@@ -264,12 +269,13 @@ void Console::cmd_status(const Words& w) {
   if (!no_args(w)) return reply_error("status takes no arguments");
   const FrameStats& f = executive_.frame_stats();
   const MapCounts m = view_.map_counts();
-  reply_.appendf(
-      "status state=%s estop=%s paused=%d healthy=%d cycles=%llu pieces=%u features=%u "
-      "obstacle_points=%u exploration_points=%u",
-      view_.state_name(), stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
-      executive_.all_healthy() ? 1 : 0, static_cast<unsigned long long>(view_.cycles()),
-      view_.pieces(), view_.features(), m.obstacle_points, m.exploration_points);
+  reply_.appendf("status state=%s estop=%s paused=%d healthy=%d", view_.state_name(),
+                 stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
+                 robot_healthy() ? 1 : 0);
+  append_unhealthy(reply_);
+  reply_.appendf(" cycles=%llu pieces=%u features=%u obstacle_points=%u exploration_points=%u",
+                 static_cast<unsigned long long>(view_.cycles()), view_.pieces(), view_.features(),
+                 m.obstacle_points, m.exploration_points);
   append_target(reply_, view_.target());
   reply_.appendf(" frames=%llu uptime_s=%.1f\r\nOK\r\n", static_cast<unsigned long long>(f.frames),
                  static_cast<double>(now_us_ - start_us_) * 1e-6);
@@ -289,11 +295,21 @@ void Console::cmd_stats(const Words& w) {
   for (std::size_t i = 0; i < executive_.task_count(); ++i) {
     const TaskSpec& s = executive_.spec(i);
     const TaskStats& t = executive_.task_stats(i);
+    const char* why = executive_.task_health(i);
     reply_.appendf(
-        "task %-8s period_us=%u budget_us=%u runs=%llu avg_us=%llu worst_us=%u overruns=%llu\r\n",
+        "task %-8s period_us=%u budget_us=%u runs=%llu avg_us=%llu worst_us=%u overruns=%llu "
+        "healthy=%d",
         s.name, s.period_us, s.budget_us, static_cast<unsigned long long>(t.runs),
         static_cast<unsigned long long>(t.average_us()), t.worst_us,
-        static_cast<unsigned long long>(t.overruns));
+        static_cast<unsigned long long>(t.overruns), why == nullptr ? 1 : 0);
+    if (why != nullptr) reply_.appendf(" why=\"%s\"", why);
+    reply_.append(kEol);
+  }
+  if (parameter_saver_ != nullptr) {
+    reply_.appendf("storage saved=%llu failed=%llu healthy=%d\r\n",
+                   static_cast<unsigned long long>(parameter_saver_->saved()),
+                   static_cast<unsigned long long>(parameter_saver_->failures()),
+                   storage_healthy_ ? 1 : 0);
   }
   const FrameStats& f = executive_.frame_stats();
   reply_.appendf(
@@ -588,6 +604,31 @@ void Console::check_parameter_saves() {
   }
 }
 
+void Console::cmd_fault(const Words& w) {
+  if (faults_ == nullptr) return reply_error("no fault injection on this board (sim board only)");
+  if (w.count == 1) {
+    faults_->describe_active(reply_);
+    reply_.append("OK\r\n");
+    if (reply_.truncated()) return reply_error("fault reply too long");
+    emit(reply_.view());
+    return;
+  }
+  if (w.count < 3) return reply_error("usage: fault DEVICE TYPE [SECONDS]");
+  float seconds = 0.0F;
+  if (w.count == 4 &&
+      (!parse_number(w.word[3], seconds) || !(seconds > 0.0F) || !(seconds <= 1e6F))) {
+    return reply_error("SECONDS must be a number in (0, 1e6]");
+  }
+  TextBuffer<200> text;
+  if (!faults_->inject(w.word[1], w.word[2], static_cast<double>(seconds), text)) {
+    return reply_error(text.c_str());
+  }
+  reply_.append(text.view());
+  reply_.append("\r\nOK\r\n");
+  emit(reply_.view());
+  log(LogLevel::kWarn, "%s injected", text.c_str());
+}
+
 void Console::cmd_shutdown(const Words& w) {
   if (!no_args(w)) return reply_error("shutdown takes no arguments");
   shutdown_requested_ = true;
@@ -606,12 +647,69 @@ void Console::check_executive(std::uint64_t now_us) {
     seen_background_overruns_ = f.background_overruns;
     next_overrun_log_us_ = now_us + 1000000U;
   }
-  const bool healthy = executive_.all_healthy();
-  if (healthy != was_healthy_) {
-    log(healthy ? LogLevel::kInfo : LogLevel::kError, "tasks %s",
-        healthy ? "healthy again" : "unhealthy: watchdog not kicked");
-    was_healthy_ = healthy;
+  // The e-stop latch: which input stopped the base (an e-stop is not a fault of a task).
+  if (safety_.cause() != logged_cause_) {
+    if (safety_.cause() == StopCause::kNone) {
+      log(LogLevel::kInfo, "e-stop released (was %s)", stop_cause_name(logged_cause_));
+    } else {
+      log(LogLevel::kWarn, "e-stop engaged: %s (base stopped)", stop_cause_name(safety_.cause()));
+    }
+    logged_cause_ = safety_.cause();
   }
+  // Each task's health on its own line, with the device's reason: which device failed and
+  // why, not only that something did.
+  for (std::size_t i = 0; i < executive_.task_count(); ++i) {
+    const char* why = executive_.task_health(i);
+    TextBufferBase& logged = logged_reason_[i];
+    if (why == nullptr) {
+      if (logged.size() == 0) continue;
+      logged.clear();
+      log(LogLevel::kInfo, "%s healthy again", executive_.spec(i).name);
+      continue;
+    }
+    const bool first = logged.size() == 0;
+    if (!first && (logged.view() == why || now_us < logged_at_us_[i] + 1000000U)) continue;
+    logged.clear();
+    logged.append(why);
+    logged_at_us_[i] = now_us;
+    log(LogLevel::kError, "%s unhealthy: %s (watchdog not kicked)", executive_.spec(i).name, why);
+  }
+}
+
+void Console::check_state_saves() {
+  if (parameter_saver_ == nullptr) return;
+  const std::uint64_t failures = parameter_saver_->failures();
+  if (failures != seen_state_failures_) {
+    char why[256] = "";
+    if (!parameter_saver_->try_last_error(why, sizeof why)) return;  // next frame
+    seen_state_failures_ = failures;
+    storage_healthy_ = false;
+    log(LogLevel::kError, "storage unhealthy: state not saved (%llu failed): %s",
+        static_cast<unsigned long long>(failures), why);
+  }
+  const std::uint64_t saves = parameter_saver_->saved();
+  if (saves != seen_state_saves_) {
+    seen_state_saves_ = saves;
+    if (!storage_healthy_ && !parameter_saver_->failing()) {
+      storage_healthy_ = true;
+      log(LogLevel::kInfo, "storage healthy again: state saved");
+    }
+  }
+}
+
+void Console::append_unhealthy(TextBufferBase& out) const {
+  out.append(" unhealthy=");
+  bool any = false;
+  for (std::size_t i = 0; i < executive_.task_count(); ++i) {
+    if (executive_.task_health(i) == nullptr) continue;
+    out.appendf("%s%s", any ? "," : "", executive_.spec(i).name);
+    any = true;
+  }
+  if (!storage_healthy_) {
+    out.appendf("%sstorage", any ? "," : "");
+    any = true;
+  }
+  if (!any) out.append("none");
 }
 
 void Console::send_telemetry(std::uint64_t now_us) {

@@ -19,6 +19,26 @@ void CameraTask::run(std::uint64_t now_us) {
   hal::Frame frame;
   switch (camera_.poll(frame)) {
     case hal::CameraPoll::kFrame:
+      if (frame.width_px != camera_.width_px() || frame.height_px != camera_.height_px()) {
+        // Not the negotiated format: unusable, like no frame at all.
+        ++wrong_frames_;
+        camera_.release();
+        last_bad_ = "frames of the wrong size";
+        if (now_us - last_frame_us_ > stall_us_) mark_stalled(last_bad_);
+        break;
+      }
+      if (have_sequence_ && frame.sequence == last_sequence_) {
+        // The same buffer again (a frozen driver): not a new image, so not used, and it
+        // does not keep the camera healthy.
+        ++stale_frames_;
+        camera_.release();
+        last_bad_ = "the same frame again";
+        if (now_us - last_frame_us_ > stall_us_) mark_stalled(last_bad_);
+        break;
+      }
+      have_sequence_ = true;
+      last_sequence_ = frame.sequence;
+      last_bad_ = nullptr;
       ++frames_;
       last_frame_us_ = now_us;
       healthy_ = true;
@@ -27,12 +47,48 @@ void CameraTask::run(std::uint64_t now_us) {
       break;
     case hal::CameraPoll::kFault:
       ++faults_;
-      if (now_us - last_frame_us_ > stall_us_) healthy_ = false;
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled(nullptr);
       break;
     case hal::CameraPoll::kNoFrame:
-      if (now_us - last_frame_us_ > stall_us_) healthy_ = false;
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled(nullptr);
       break;
   }
+}
+
+void CameraTask::mark_stalled(const char* what) {
+  healthy_ = false;
+  // The first words stay put while the stall lasts (the console logs a reason when it
+  // changes), so the time is the stall limit, not the growing age of the last frame.
+  reason_.clear();
+  reason_.appendf("no new frame for %.1f s", static_cast<double>(stall_us_) * 1e-6);
+  // The driver's own error, else what was wrong with the last frames it did deliver.
+  const char* why = what != nullptr ? what : camera_.error();
+  if (why[0] == '\0' && last_bad_ != nullptr) why = last_bad_;
+  if (why[0] != '\0') reason_.appendf(": %s", why);
+}
+
+void PanTiltTask::run(std::uint64_t now_us) {
+  ptu_.update();
+  const hal::PanTiltState s = ptu_.state();
+  if (!s.moving || s.pan_rad != last_pan_rad_ || s.tilt_rad != last_tilt_rad_ || !seen_) {
+    seen_ = true;
+    last_pan_rad_ = s.pan_rad;
+    last_tilt_rad_ = s.tilt_rad;
+    progress_us_ = now_us;
+    stuck_ = false;
+    return;
+  }
+  stuck_ = now_us - progress_us_ > stuck_us_;
+}
+
+bool PanTiltTask::healthy() const {
+  return !stuck_ && !ptu_.state().fault;
+}
+
+const char* PanTiltTask::health_reason() const {
+  if (stuck_) return "PTU: a move is not progressing";
+  const char* why = ptu_.error();
+  return why[0] != '\0' ? why : "unit fault";
 }
 
 const char* led_pattern_name(LedPattern pattern) {

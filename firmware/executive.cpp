@@ -131,16 +131,26 @@ void Executive::run_background(std::uint64_t now_us) {
 }
 
 bool Executive::all_healthy() const {
-  const std::uint64_t now_us = next_start_us_;
   for (std::size_t i = 0; i < count_; ++i) {
-    const Entry& e = entries_[i];
-    if (!e.task->healthy()) return false;
-    if (e.stats.consecutive_overruns >= config_.unhealthy_after_overruns) return false;
-    // Starved: not run for more than two periods (plus one frame of re-anchoring slack).
-    const std::uint64_t allowed_us = 2ULL * e.spec.period_us + config_.frame_us;
-    if (now_us > e.last_run_us && now_us - e.last_run_us > allowed_us) return false;
+    if (task_health(i) != nullptr) return false;
   }
   return true;
+}
+
+const char* Executive::task_health(std::size_t i) const {
+  const Entry& e = entries_[i];
+  if (!e.task->healthy()) {
+    const char* why = e.task->health_reason();
+    return why[0] != '\0' ? why : "unhealthy";
+  }
+  if (e.stats.consecutive_overruns >= config_.unhealthy_after_overruns) {
+    return "overrunning its budget";
+  }
+  // Starved: not run for more than two periods (plus one frame of re-anchoring slack).
+  const std::uint64_t now_us = next_start_us_;
+  const std::uint64_t allowed_us = 2ULL * e.spec.period_us + config_.frame_us;
+  if (now_us > e.last_run_us && now_us - e.last_run_us > allowed_us) return "starved";
+  return nullptr;
 }
 
 std::size_t Executive::find(const char* name) const {

@@ -35,6 +35,19 @@ extern "C" void on_signal(int signal) {
   g_signal = signal;
 }
 
+const char* signal_name(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal";
+  }
+}
+
 double wall_seconds() {
   timespec ts{};
   ::clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -172,12 +185,25 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       g_state.seed = options.seed;
       slog.log(LogLevel::kInfo, "%s: starting a new mission", error);
     } else if (loaded != LoadResult::kLoaded) {
-      return fail("cannot resume", error);
+      // Restarting cannot mend the file: the usage code, which the service unit does not
+      // restart on (RestartPreventExitStatus), so an operator looks at it.
+      (void)fail("cannot resume", error);
+      return kExitUsage;
     } else {
       if (!board.place_robot(g_state.pose, error, sizeof error))
         return fail("cannot resume", error);
       slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.path(),
                static_cast<unsigned long long>(g_state.cycle));
+    }
+  } else if (store != nullptr) {
+    // A new mission never overwrites a saved one: it is kept as mission.state.1 (older ones
+    // shift up), so a start without --resume by mistake loses nothing.
+    char kept[520] = "";
+    const LoadResult kept_result = g_store.keep_previous(kept, sizeof kept, error, sizeof error);
+    if (kept_result == LoadResult::kIoError) return fail("state", error);
+    if (kept_result == LoadResult::kLoaded) {
+      slog.log(LogLevel::kWarn, "new mission: the saved one is kept as %s (--resume continues it)",
+               kept);
     }
   }
 
@@ -216,6 +242,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   Console& console = rt.console;
   console.set_log_ring(&g_log_ring, &hal.clock);
   console.set_board_name(info.name);
+  console.set_fault_injection(board.fault_injection());
 
   // The executive and its tasks.
   Task* const tasks[kTaskCount] = {&rt.estop_task,   &rt.base_task,    &rt.ptu_task,
@@ -263,6 +290,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // A hang-up (the controlling terminal or the console's session gone) stops in the same
+  // orderly way: base stopped, MISSION line; the default action would kill the process with
+  // the base still driving.
+  sigaction(SIGHUP, &action, nullptr);
 
   ExecutiveConfig exec_config;
   exec_config.frame_us = config.minor_frame_us;
@@ -280,7 +311,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     executive.run_frame();
     if (hooks != nullptr && hooks->after_frame != nullptr) hooks->after_frame(hooks->context);
     if (g_signal != 0) {
-      stop_reason = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
+      stop_reason = signal_name(g_signal);
       break;
     }
     if (console.shutdown_requested()) {
@@ -343,12 +374,18 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   }
   const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
   const mission::Result result = mission.result();
+  // The reason last, quoted (it has spaces): why the mission ended, with the device's words
+  // when a device ended it ("base stopped by itself: base: left axis: heartbeat lost ...").
+  TextBuffer<160> reason;
+  for (const char* c = mission.end_reason(); *c != '\0'; ++c) {
+    reason.appendf("%c", *c == '"' ? '\'' : *c);
+  }
   std::printf(
       "MISSION result=%s cycles=%llu collisions=%llu sim_time_s=%.3f wall_time_s=%.3f "
-      "target_error_m=%.3f\n",
+      "target_error_m=%.3f reason=\"%s\"\n",
       mission::result_name(result), static_cast<unsigned long long>(g_state.cycle),
       static_cast<unsigned long long>(safety.collisions()), sim_time_s,
-      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()));
+      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()), reason.c_str());
   std::fflush(stdout);
   g_runtime.reset();
   g_signal = 0;

@@ -54,6 +54,7 @@ bool parse_speed(const char* text, double max, double& out) {
 const char* usage_text() {
   return "usage: boticelli [options]\n"
          "  --world FILE        world to simulate (SDF subset; sim board only)\n"
+         "  --faults FILE       inject the faults planned in FILE (sim board only)\n"
          "  --speed X           simulated time per wall time: 1 = real time, 0 = as fast\n"
          "                      as possible (default; sim board only)\n"
          "  --seed N            random seed for the simulation and training (default 1)\n"
@@ -89,6 +90,11 @@ ParseResult parse_options(int argc, const char* const* argv, bool simulated, Opt
       out.resume = true;
     } else if (std::strcmp(arg, "--world") == 0) {
       if (!value(out.world_file)) return fail("option ", arg, " needs a FILE");
+      if (!simulated) return fail("option ", arg, " is only for the sim board");
+    } else if (std::strcmp(arg, "--faults") == 0) {
+      if (!value(out.faults_file) || *out.faults_file == '\0') {
+        return fail("option ", arg, " needs a FILE");
+      }
       if (!simulated) return fail("option ", arg, " is only for the sim board");
     } else if (std::strcmp(arg, "--speed") == 0) {
       if (!value(v) || !parse_speed(v, 1000.0, out.speed)) {

@@ -325,6 +325,40 @@ bool StateStore::open(const char* dir, char* error, std::size_t error_size) {
   return true;
 }
 
+LoadResult StateStore::keep_previous(char* kept, std::size_t kept_size, char* error,
+                                     std::size_t error_size) {
+  struct stat st {};
+  if (::stat(path_.data(), &st) != 0) {
+    if (errno == ENOENT) return LoadResult::kMissing;
+    set_error(error, error_size, "cannot stat", path_.data());
+    return LoadResult::kIoError;
+  }
+  // Oldest first: .2 -> .3, .1 -> .2, then the file itself -> .1 (a missing copy is skipped).
+  std::array<char, 520> from{};
+  std::array<char, 520> to{};
+  for (int i = kKeptStates - 1; i >= 0; --i) {
+    if (i == 0) {
+      std::snprintf(from.data(), from.size(), "%s", path_.data());
+    } else {
+      std::snprintf(from.data(), from.size(), "%s.%d", path_.data(), i);
+    }
+    std::snprintf(to.data(), to.size(), "%s.%d", path_.data(), i + 1);
+    if (::rename(from.data(), to.data()) != 0 && !(errno == ENOENT && i > 0)) {
+      set_error(error, error_size, "cannot keep", from.data());
+      return LoadResult::kIoError;
+    }
+  }
+  const int dfd = ::open(dir_.data(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd < 0 || ::fsync(dfd) != 0) {
+    set_error(error, error_size, "cannot sync", dir_.data());
+    if (dfd >= 0) ::close(dfd);
+    return LoadResult::kIoError;
+  }
+  ::close(dfd);
+  std::snprintf(kept, kept_size, "%s", to.data());
+  return LoadResult::kLoaded;
+}
+
 bool StateStore::save(const MissionState& state, char* error, std::size_t error_size) {
   const std::size_t size = encode_state(state, buffer_.data(), buffer_.size());
   if (size == 0) {

@@ -35,6 +35,7 @@ bool StateSaver::submit(const MissionState& state) {
     char error[256] = "";
     const bool ok = store_.save(state, error, sizeof error);
     std::lock_guard<std::mutex> lock(mutex_);
+    failing_ = !ok;
     if (ok) {
       ++saved_;
     } else {
@@ -107,6 +108,18 @@ void StateSaver::last_error(char* out, std::size_t size) const {
   std::snprintf(out, size, "%s", error_);
 }
 
+bool StateSaver::try_last_error(char* out, std::size_t size) const {
+  std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return false;
+  std::snprintf(out, size, "%s", error_);
+  return true;
+}
+
+bool StateSaver::failing() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return failing_;
+}
+
 void StateSaver::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
@@ -132,6 +145,7 @@ void StateSaver::run() {
     const bool ok = store_.save(writing_, error, sizeof error);
     lock.lock();
     busy_ = false;
+    failing_ = !ok;
     if (ok) {
       ++saved_;
     } else {

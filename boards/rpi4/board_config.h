@@ -81,7 +81,10 @@ inline firmware::BoardConfig make_config() {
   c.telemetry_period_ms = 1000;
   c.realtime = true;  // mlockall, prefaulted stack, SCHED_FIFO 50
   c.fifo_priority = 50;
-  c.watchdog_timeout_ms = 5000;  // /dev/watchdog; systemd's WatchdogSec=3s acts first
+  // /dev/watchdog: longer than systemd's whole restart chain after a hang (WatchdogSec 2 s,
+  // TimeoutAbortSec 2 s, RestartSec 1 s, start-up to the watchdog's open about 3 s), so the
+  // service restarts before the board resets (docs/flashing.md, "Watchdogs").
+  c.watchdog_timeout_ms = 12000;
   c.background_units_per_slice = 0;
   c.checkpoint_period_ms = 1000;
   return c;

@@ -60,6 +60,8 @@ inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t s
   s.physics.base.track_width_m = c.track_width_m;
   s.physics.base.max_speed_m_s = c.max_speed_m_s;
   s.physics.base.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
+  // The ODrives' watchdog, as configured on the robot: 0.2 s without a setpoint stops them.
+  s.physics.base.command_timeout_us = 200000;
   return s;
 }
 

@@ -3,9 +3,38 @@
 
 #include "../console_mode.h"
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 
+#include "firmware/atomic_file.h"
+
 namespace boticelli::boards::sim {
+namespace {
+
+using hal::sim::FaultDevice;
+using hal::sim::FaultType;
+
+// The state directory's faults at the firmware's file calls: off = unwritable (EACCES when
+// the temporary file is created), wrong = full (ENOSPC on a write), intermittent = I/O
+// errors (EIO on a write) in its failing slots.
+int storage_fault(firmware::StorageCall call, void* context) {
+  const auto* world = static_cast<const hal::sim::SimWorld*>(context);
+  FaultType type = FaultType::kOff;
+  if (!world->faults().failing(FaultDevice::kStorage, type)) return 0;
+  switch (type) {
+    case FaultType::kOff:
+      return call == firmware::StorageCall::kCreate ? EACCES : 0;
+    case FaultType::kWrong:
+      return call == firmware::StorageCall::kWrite ? ENOSPC : 0;
+    case FaultType::kIntermittent:
+      return call == firmware::StorageCall::kWrite ? EIO : 0;
+    default:
+      return 0;
+  }
+}
+
+}  // namespace
 
 SimBoard::SimBoard()
     : config_(make_config()),
@@ -20,6 +49,10 @@ SimBoard::SimBoard()
       watchdog_(sim_),
       console_("/dev/tty", config_.console_baud),
       hal_{camera_, pan_tilt_, base_, estop_, bumper_, status_led_, console_, clock_, watchdog_} {}
+
+SimBoard::~SimBoard() {
+  firmware::set_storage_fault_hook(nullptr, nullptr);  // it points into this board's world
+}
 
 bool SimBoard::reset_config(firmware::ConfigSchema& schema) {
   config_ = make_config();
@@ -55,6 +88,14 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
     return false;
   }
   if (!camera_.setup(settings_.camera_fps, error, error_size)) return false;
+  // Faults: --faults FILE, else the tests' default plan (empty unless a test set one).
+  if (options.faults_file != nullptr) {
+    if (!hal::sim::load_fault_plan(options.faults_file, plan_, error, error_size)) return false;
+  } else {
+    plan_ = default_faults_;
+  }
+  sim_.faults().set_plan(plan_);
+  firmware::set_storage_fault_hook(storage_fault, &sim_);
   console_.set_baud(config_.console_baud);
   console_.select(console_mode(options.console), options.console_path);
   clock_.set_speed(options.speed);
@@ -78,6 +119,67 @@ bool SimBoard::place_robot(const core::Pose2& mission_pose, char* error, std::si
   std::snprintf(error, error_size, "saved pose (%.2f, %.2f) m in the world collides",
                 static_cast<double>(world.x_m), static_cast<double>(world.y_m));
   return false;
+}
+
+}  // namespace boticelli::boards::sim
+
+namespace boticelli::boards::sim {
+
+bool SimBoard::inject(std::string_view device, std::string_view type, double seconds,
+                      firmware::TextBufferBase& reply) {
+  FaultDevice d = FaultDevice::kCamera;
+  FaultType t = FaultType::kOff;
+  if (!hal::sim::parse_fault_device(device, d)) {
+    reply.append(
+        "unknown device (camera, ptu, axis-left, axis-right, can, estop, bumper, "
+        "storage, main-loop)");
+    return false;
+  }
+  if (!hal::sim::parse_fault_type(type, t)) {
+    reply.append("unknown fault type (off, stuck, garbage, wrong, slow, delayed, intermittent)");
+    return false;
+  }
+  if (!hal::sim::fault_applies(d, t)) {
+    reply.appendf("%s cannot be %s", hal::sim::fault_device_name(d), hal::sim::fault_type_name(t));
+    return false;
+  }
+  const auto duration_us = static_cast<std::uint64_t>(std::llround(seconds * 1e6));
+  if (d == FaultDevice::kMainLoop && t == FaultType::kStuck &&
+      (duration_us == 0 || duration_us > hal::sim::kMaxStallUs)) {
+    reply.append("a main-loop stall needs SECONDS, at most 60");
+    return false;
+  }
+  const std::uint64_t now_us = sim_.now_us();
+  if (!sim_.faults().inject(d, t, now_us, duration_us)) {
+    reply.append("fault plan full");
+    return false;
+  }
+  reply.appendf("fault %s %s seconds=", hal::sim::fault_device_name(d),
+                hal::sim::fault_type_name(t));
+  if (duration_us == 0) {
+    reply.append("end");
+  } else {
+    reply.appendf("%.1f", seconds);
+  }
+  reply.appendf(" from_t_s=%.2f", static_cast<double>(now_us) * 1e-6);
+  return true;
+}
+
+void SimBoard::describe_active(firmware::TextBufferBase& out) const {
+  const hal::sim::FaultInjector& faults = sim_.faults();
+  for (std::size_t i = 0; i < hal::sim::kFaultDeviceCount; ++i) {
+    const auto d = static_cast<FaultDevice>(i);
+    FaultType t = FaultType::kOff;
+    if (!faults.active(d, t)) continue;
+    out.appendf("fault %s %s since_t_s=%.2f until_t_s=", hal::sim::fault_device_name(d),
+                hal::sim::fault_type_name(t),
+                static_cast<double>(faults.active_since_us(d)) * 1e-6);
+    if (faults.active_until_us(d) == UINT64_MAX) {
+      out.append("end\r\n");
+    } else {
+      out.appendf("%.2f\r\n", static_cast<double>(faults.active_until_us(d)) * 1e-6);
+    }
+  }
 }
 
 }  // namespace boticelli::boards::sim

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <string_view>
 
 #include "board_config.h"
 #include "firmware/board.h"
@@ -13,6 +14,7 @@
 #include "hal/sim/base_sim.h"
 #include "hal/sim/camera_sim.h"
 #include "hal/sim/clock_sim.h"
+#include "hal/sim/fault_plan.h"
 #include "hal/sim/gpio_sim.h"
 #include "hal/sim/pan_tilt_sim.h"
 #include "hal/sim/renderer.h"
@@ -27,9 +29,14 @@ namespace boticelli::boards::sim {
 // test's. init() loads the world (--world, else the shipped thesis room), builds textures,
 // rig, physics and renderer; the firmware then calls init()/open() of each device. The
 // sim-only accessors give tests the ground truth the firmware never sees.
-class SimBoard final : public firmware::Board, public firmware::TruthSource {
+class SimBoard final : public firmware::Board,
+                       public firmware::TruthSource,
+                       public firmware::FaultInjection {
  public:
   SimBoard();
+  ~SimBoard() override;
+  SimBoard(const SimBoard&) = delete;
+  SimBoard& operator=(const SimBoard&) = delete;
   const firmware::BoardInfo& info() const override { return kInfo; }
   const firmware::BoardConfig& config() const override { return config_; }
   // The keys every board has (add_board_config_keys); no device keys, no default file: the
@@ -38,6 +45,11 @@ class SimBoard final : public firmware::Board, public firmware::TruthSource {
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
   hal::Hal& hal() override { return hal_; }
   const firmware::TruthSource* truth() const override { return this; }
+  firmware::FaultInjection* fault_injection() override { return this; }
+  // FaultInjection: the console's `fault DEVICE TYPE [SECONDS]`, into the world's injector.
+  bool inject(std::string_view device, std::string_view type, double seconds,
+              firmware::TextBufferBase& reply) override;
+  void describe_active(firmware::TextBufferBase& out) const override;
   bool place_robot(const core::Pose2& mission_pose, char* error, std::size_t error_size) override;
   // TruthSource: the simulator's own pose and target (trace, target error).
   core::Pose2 robot_pose() const override { return sim_.true_pose(); }
@@ -58,6 +70,8 @@ class SimBoard final : public firmware::Board, public firmware::TruthSource {
   const stereo::RigModel& rig() const { return *rig_; }
   // Settings used by the next init() (tests may change noise, rates, physics).
   SimSettings& settings() { return settings_; }
+  // The fault plan the next init() starts with when there is no --faults FILE (tests).
+  hal::sim::FaultPlan& default_faults() { return default_faults_; }
 
  private:
   static constexpr firmware::BoardInfo kInfo{"sim", "host simulation board", true};
@@ -79,6 +93,8 @@ class SimBoard final : public firmware::Board, public firmware::TruthSource {
   hal::sim::WatchdogSim watchdog_;
   hal_linux::ConsolePort console_;
   hal::Hal hal_;
+  hal::sim::FaultPlan plan_;
+  hal::sim::FaultPlan default_faults_;
   std::array<std::span<const core::Point2>, hal::sim::kMaxColliders> outlines_{};
   std::size_t outline_count_ = 0;
   std::array<firmware::SnapshotCircle, hal::sim::kMaxColliders> circles_{};

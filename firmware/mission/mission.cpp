@@ -127,7 +127,7 @@ void Mission::start(std::uint64_t now_us) {
   next_trace_us_ = now_us;
   phase_ = Phase::kStart;
   result_ = Result::kRunning;
-  end_reason_ = "";
+  end_reason_.clear();
   cycles_this_run_ = 0;
   failed_cycles_ = 0;
   turned_round_ = false;
@@ -222,7 +222,8 @@ void Mission::view_angles(std::size_t view, float& pan_rad, float& tilt_rad, boo
 void Mission::finish(Result result, const char* why) {
   if (result_ != Result::kRunning) return;
   result_ = result;
-  end_reason_ = why;
+  end_reason_.clear();
+  end_reason_.append(why);
   phase_ = Phase::kDone;
   want_frame_ = false;
   driver_.reset();
@@ -235,6 +236,13 @@ void Mission::finish(Result result, const char* why) {
 
 void Mission::abort(const char* why) {
   finish(Result::kAborted, why);
+}
+
+void Mission::abort_with(const char* why, const char* device_error) {
+  if (device_error == nullptr || device_error[0] == '\0') return abort(why);
+  TextBuffer<160> text;
+  text.appendf("%s: %s", why, device_error);
+  abort(text.c_str());
 }
 
 // ---------------------------------------------------------------- control (mission task)
@@ -266,7 +274,7 @@ void Mission::control(std::uint64_t now_us) {
   switch (phase_) {
     case Phase::kStart: {
       const hal::PanTiltState ptu = hal_.pan_tilt.state();
-      if (ptu.fault) return abort("pan-tilt unit fault");
+      if (ptu.fault) return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
       if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) {
         anchor_frame();  // the odometry as the base reports it once ready
         begin_look(now_us);
@@ -364,13 +372,15 @@ void Mission::aim_at_target() {
 void Mission::control_look(std::uint64_t now_us) {
   hal_.base.set_velocity(0.0F, 0.0F);
   const hal::PanTiltState ptu = hal_.pan_tilt.state();
-  if (ptu.fault) return abort("pan-tilt unit fault");
+  if (ptu.fault) return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
   switch (look_step_) {
     case LookStep::kMove: {
       view_angles(view_, view_pan_rad_, view_tilt_rad_, view_pair_);
       const float tilt =
           second_frame_ ? view_tilt_rad_ - params_.rig.tilt_step_rad : view_tilt_rad_;
-      if (!hal_.pan_tilt.move_to(view_pan_rad_, tilt)) return abort("pan-tilt unit refused a move");
+      if (!hal_.pan_tilt.move_to(view_pan_rad_, tilt)) {
+        return abort_with("pan-tilt unit refused a move", hal_.pan_tilt.error());
+      }
       step_deadline_us_ = now_us + params_.ptu_timeout_us;
       look_step_ = LookStep::kSettle;
       settle_until_us_ = 0;
@@ -390,7 +400,7 @@ void Mission::control_look(std::uint64_t now_us) {
       return;
     case LookStep::kGrab:
       if (!frame_ready_) {
-        if (now_us > step_deadline_us_) abort("no camera frame");
+        if (now_us > step_deadline_us_) abort_with("no camera frame", hal_.camera.error());
         return;
       }
       want_frame_ = false;
@@ -449,7 +459,7 @@ void Mission::control_drive(std::uint64_t now_us) {
   const DriveCommand cmd = driver_.update(odometry_pose(), o.v_m_s, o.omega_rad_s, now_us);
   hal_.base.set_velocity(cmd.v_m_s, cmd.omega_rad_s);
   if (hal_.base.health() == hal::BaseHealth::kStopped && !safety_.engaged()) {
-    return abort("base stopped by itself");
+    return abort_with("base stopped by itself", hal_.base.error());
   }
   if (driver_.busy()) return;
   const bool ok = driver_.status() == DriveStatus::kDone;

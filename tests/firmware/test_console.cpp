@@ -274,7 +274,7 @@ TEST(Console, AnswersHelpWithEveryCommand) {
   CHECK_EQUAL("OK", reply.back());
   for (const char* name :
        {"help", "status", "stats", "pose", "model", "map", "pause", "resume", "estop",
-        "clear-estop", "get", "set", "log", "param", "ver", "shutdown", "quit"}) {
+        "clear-estop", "get", "set", "log", "param", "fault", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);
@@ -380,14 +380,20 @@ TEST(Console, PausesAndResumesTheBackgroundWork) {
 }
 
 TEST(Console, EstopStopsTheBaseAndClearEstopReleasesIt) {
-  CHECK_EQUAL("OK", command("estop").back());
+  auto reply = command("estop");
+  CHECK_EQUAL("OK", reply.at(0));
+  // The latch's change is logged, with the input that stopped the base.
+  CHECK_EQUAL(2U, reply.size());
+  STRCMP_CONTAINS("LOG warn e-stop engaged: console (base stopped)", reply.back().c_str());
   CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
   CHECK(safety.cause() == StopCause::kConsole);
   button.level = true;
   STRCMP_EQUAL("ERR e-stop button still pressed", command("clear-estop").at(0).c_str());
   CHECK(safety.engaged());
   button.level = false;
-  CHECK_EQUAL("OK", command("clear-estop").back());
+  reply = command("clear-estop");
+  CHECK_EQUAL("OK", reply.at(0));
+  STRCMP_CONTAINS("LOG info e-stop released (was console)", reply.back().c_str());
   CHECK_FALSE(safety.engaged());
 }
 
@@ -711,3 +717,61 @@ TEST(Console, ParamSaveThroughTheWriterThreadReportsTheResultAsALogLine) {
   rmdir(dir.c_str());
 }
 #endif
+
+namespace {
+// Records what the console asks the board to inject.
+class RecordingInjection final : public FaultInjection {
+ public:
+  bool inject(std::string_view device, std::string_view type, double seconds,
+              TextBufferBase& reply) override {
+    last_device = std::string(device);
+    last_type = std::string(type);
+    last_seconds = seconds;
+    if (device != "camera") {
+      reply.append("unknown device");
+      return false;
+    }
+    reply.appendf("fault %s %s seconds=%.1f from_t_s=1.00", last_device.c_str(), last_type.c_str(),
+                  seconds);
+    return true;
+  }
+  void describe_active(TextBufferBase& out) const override {
+    out.append("fault camera off since_t_s=1.00 until_t_s=6.00\r\n");
+  }
+  std::string last_device;
+  std::string last_type;
+  double last_seconds = -1.0;
+};
+}  // namespace
+
+TEST(Console, TheFaultCommandNeedsABoardThatInjectsFaults) {
+  STRCMP_EQUAL("ERR no fault injection on this board (sim board only)",
+               command("fault camera off").at(0).c_str());
+}
+
+TEST(Console, TheFaultCommandHandsTheFaultToTheBoardAndListsTheActiveOnes) {
+  RecordingInjection faults;
+  console.set_fault_injection(&faults);
+  auto reply = command("fault camera off 5");
+  STRCMP_EQUAL("fault camera off seconds=5.0 from_t_s=1.00", reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.at(1));
+  STRCMP_CONTAINS("LOG warn fault camera off seconds=5.0 from_t_s=1.00 injected",
+                  reply.back().c_str());
+  CHECK_EQUAL("camera", faults.last_device);
+  CHECK_EQUAL("off", faults.last_type);
+  DOUBLES_EQUAL(5.0, faults.last_seconds, 1e-9);
+  command("fault camera stuck");
+  DOUBLES_EQUAL(0.0, faults.last_seconds, 0.0);  // until the end
+  reply = command("fault");
+  STRCMP_EQUAL("fault camera off since_t_s=1.00 until_t_s=6.00", reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.at(1));
+  // Refusals: the board's reason, or bad arguments; the board is not asked.
+  STRCMP_EQUAL("ERR unknown device", command("fault toaster off").at(0).c_str());
+  faults.last_device.clear();
+  STRCMP_EQUAL("ERR SECONDS must be a number in (0, 1e6]",
+               command("fault camera off -1").at(0).c_str());
+  STRCMP_EQUAL("ERR SECONDS must be a number in (0, 1e6]",
+               command("fault camera off 0x10").at(0).c_str());
+  STRCMP_EQUAL("ERR usage: fault DEVICE TYPE [SECONDS]", command("fault camera").at(0).c_str());
+  CHECK(faults.last_device.empty());
+}

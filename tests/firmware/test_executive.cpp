@@ -440,6 +440,25 @@ TEST(Safety, StopsTheBaseAgainIfSomethingResumesItBehindTheLatch) {
   CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
 }
 
+TEST(Safety, ABaseResumedWhileTheButtonIsHeldIsStoppedAgainAtTheNextPoll) {
+  button.level = true;
+  safety.poll();
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK(base.resume());  // something resumes the base while the button is still held
+  safety.poll();
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK_EQUAL(1U, safety.engagements());  // the same engagement, stopped again
+}
+
+TEST(Safety, EngagingALatchThatIsAlreadyEngagedStopsTheBaseAgainAndKeepsTheFirstCause) {
+  safety.engage(StopCause::kButton);
+  CHECK(base.resume());
+  safety.engage(StopCause::kConsole);
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK(safety.cause() == StopCause::kButton);
+  CHECK_EQUAL(2, base.stops);
+}
+
 TEST_GROUP(WatchdogTask) {
   FakeClock clock{0};
   Executive exec{clock};

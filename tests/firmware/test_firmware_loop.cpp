@@ -2,6 +2,7 @@
 // from the background slot) runs without heap allocation; the mission's own share is proved by
 // the whole-mission test (tests/mission).
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <string>
@@ -87,10 +88,111 @@ TEST_GROUP(FirmwareLoop) {
     dir = mkdtemp(templ);
   }
   void teardown() override {
+    rmdir((dir + "/mission.state.tmp").c_str());
     unlink((dir + "/mission.state").c_str());
     rmdir(dir.c_str());
   }
 };
+
+namespace {
+// The firmware's device tasks, console and checkpoint saver on fakes, as firmware_main wires
+// them (the mission task idle): for the health and storage reports.
+struct LoopRig {
+  boticelli::fakes::FakeClock clock{0};
+  boticelli::fakes::FakeSerialPort port;
+  FakeCamera camera;
+  FakePanTilt ptu;
+  FakeBase base{&clock};
+  FakeInput button, bumper;
+  FakeOutput led;
+  FakeWatchdog watchdog;
+  ServiceNotifier notifier;
+  Executive exec{clock};
+  Safety safety{button, bumper, base};
+  StateSaver saver{g_loop_store};
+  CheckpointWork mission{base, clock, g_loop_state, saver, 1000000};
+  ParameterTable parameters;
+  Console console{port, exec, safety, mission, parameters};
+  EstopTask estop_task{safety};
+  BaseTask base_task{base, safety};
+  PanTiltTask ptu_task{ptu};
+  CameraTask camera_task{camera};
+  ConsoleTask console_task{console};
+  WatchdogTask watchdog_task{exec, watchdog, notifier, led};
+  IdleTask mission_task;
+
+  void start() {
+    Task* tasks[kTaskCount] = {&estop_task,   &base_task,    &ptu_task,     &camera_task,
+                               &mission_task, &console_task, &watchdog_task};
+    const char* why = "";
+    for (std::size_t i = 0; i < kTaskCount; ++i) {
+      CHECK(exec.add_task(kTaskTable[i], *tasks[i], &why));
+    }
+    exec.set_background(&mission);
+    CHECK(console.register_parameters());
+    console.set_telemetry_ms(0.0F);
+    console.set_parameter_saver(&saver);
+    CHECK(exec.start(ExecutiveConfig{}, &why));
+    mission.start(clock.now_us());
+    port.reserve_written(64 * 1024);
+  }
+  void frames(int n) {
+    for (int i = 0; i < n; ++i) exec.run_frame();
+  }
+};
+}  // namespace
+
+TEST(FirmwareLoop, AFailingStateSaveIsLoggedAtOnceAndMakesTheStorageUnhealthyUntilOneSucceeds) {
+  char error[256] = "";
+  CHECK(g_loop_store.open(dir.c_str(), error, sizeof error));
+  g_loop_state.clear();
+  // A directory where the temporary file must go: every save fails (as on a full or
+  // read-only disk), also for root.
+  CHECK_EQUAL(0, mkdir((dir + "/mission.state.tmp").c_str(), 0700));
+  LoopRig rig;
+  rig.start();
+  CHECK_NO_ALLOCATION(rig.frames(103));  // the first checkpoint at 1 s, then 3 frames
+  CHECK_EQUAL(1U, rig.saver.failures());
+  STRCMP_CONTAINS("LOG error storage unhealthy: state not saved (1 failed): ",
+                  rig.port.written().c_str());
+  STRCMP_CONTAINS("mission.state.tmp", rig.port.written().c_str());
+  rig.port.feed("status\rstats\r");
+  rig.frames(2);
+  STRCMP_CONTAINS("healthy=0 unhealthy=storage cycles=1", rig.port.written().c_str());
+  STRCMP_CONTAINS("storage saved=0 failed=1 healthy=0", rig.port.written().c_str());
+  CHECK(rig.watchdog.kicks > 0);  // a restart cannot free a disk: the watchdog is still kicked
+  const int kicks = rig.watchdog.kicks;
+  rig.frames(20);
+  CHECK(rig.watchdog.kicks > kicks);
+  CHECK_EQUAL(0, rmdir((dir + "/mission.state.tmp").c_str()));
+  rig.port.clear_written();
+  rig.frames(100);  // the next checkpoint is saved
+  STRCMP_CONTAINS("LOG info storage healthy again: state saved", rig.port.written().c_str());
+  rig.port.feed("status\r");
+  rig.frames(2);
+  STRCMP_CONTAINS("healthy=1 unhealthy=none", rig.port.written().c_str());
+}
+
+TEST(FirmwareLoop, AnUnhealthyTaskIsLoggedWithItsNameAndReasonAndShownInStatusAndStats) {
+  char error[256] = "";
+  CHECK(g_loop_store.open(dir.c_str(), error, sizeof error));
+  g_loop_state.clear();
+  LoopRig rig;
+  rig.start();
+  rig.frames(10);
+  rig.base.stop();  // stopped by itself (no e-stop): the base task is unhealthy
+  rig.port.feed("status\rstats\r");
+  CHECK_NO_ALLOCATION(rig.frames(5));
+  const std::string out = rig.port.written();
+  STRCMP_CONTAINS("LOG error base unhealthy: stopped by itself (watchdog not kicked)", out.c_str());
+  STRCMP_CONTAINS("healthy=0 unhealthy=base cycles=", out.c_str());
+  STRCMP_CONTAINS("overruns=0 healthy=0 why=\"stopped by itself\"", out.c_str());
+  STRCMP_CONTAINS("task ptu      period_us=20000 budget_us=500 runs=", out.c_str());
+  CHECK(rig.base.resume());
+  rig.port.clear_written();
+  rig.frames(3);
+  STRCMP_CONTAINS("LOG info base healthy again", rig.port.written().c_str());
+}
 
 TEST(FirmwareLoop, RunsTasksConsoleTelemetryAndCheckpointsWithoutAllocating) {
   boticelli::fakes::FakeClock clock{0};

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -53,6 +54,7 @@ class FakeBoard final : public Board {
   bool refuse = false;
   const char* default_config = nullptr;       // the board's default configuration file
   std::function<void(FakeBoard&)> after_run;  // looks at the devices after the run
+  const MainHooks* hooks = nullptr;           // handed to firmware_main
   BoardConfig config_{};
   boticelli::fakes::FakeClock clock{1000};
   boticelli::fakes::FakeSerialPort console;
@@ -104,7 +106,7 @@ Run run_firmware(std::vector<const char*> args, Prepare prepare) {
   {
     auto board = std::make_unique<FakeBoard>();
     prepare(*board);
-    r.exit_code = firmware_main(static_cast<int>(args.size()), args.data(), *board);
+    r.exit_code = firmware_main(static_cast<int>(args.size()), args.data(), *board, board->hooks);
     if (board->after_run) board->after_run(*board);
   }
   std::fflush(stdout);
@@ -141,6 +143,9 @@ TEST_GROUP(FirmwareMain) {
   }
   void teardown() override {
     unlink((dir + "/mission.state").c_str());
+    for (int i = 1; i <= StateStore::kKeptStates; ++i) {
+      unlink((dir + "/mission.state." + std::to_string(i)).c_str());
+    }
     unlink((dir + "/parameters.conf").c_str());
     unlink((dir + "/boticelli.conf").c_str());
     rmdir(dir.c_str());
@@ -231,8 +236,88 @@ TEST(FirmwareMain, RefusesToResumeFromACorruptState) {
   std::fputs("BOTICELLI-STATE 1\ncycle 3\n", f);
   std::fclose(f);
   const Run r = run_firmware({"--state", dir.c_str(), "--resume"});
-  CHECK_EQUAL(kExitFailure, r.exit_code);
+  // The usage code: the service unit does not restart on it (a restart cannot mend a file).
+  CHECK_EQUAL(kExitUsage, r.exit_code);
   STRCMP_CONTAINS("boticelli: cannot resume:", r.err.c_str());
+  CHECK(r.out.find("MISSION") == std::string::npos);
+}
+
+namespace {
+std::string read_all(const std::string& path) {
+  std::string s;
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return "(missing)";
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+}  // namespace
+
+TEST(FirmwareMain, ANewMissionKeepsTheSavedOneInsteadOfOverwritingIt) {
+  CHECK_EQUAL(kExitNotFound,
+              run_firmware({"--state", dir.c_str(), "--seed", "5"}, [](FakeBoard& b) {
+                b.console.feed("quit\r");
+              }).exit_code);
+  const std::string first = read_all(dir + "/mission.state");
+  STRCMP_CONTAINS("seed 5", first.c_str());
+  Run r = run_firmware({"--state", dir.c_str(), "--seed", "6"},
+                       [](FakeBoard& b) { b.console.feed("quit\r"); });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS(("the saved one is kept as " + dir + "/mission.state.1").c_str(), r.err.c_str());
+  CHECK(first == read_all(dir + "/mission.state.1"));
+  STRCMP_CONTAINS("seed 6", read_all(dir + "/mission.state").c_str());
+  // Older copies shift up; the oldest beyond kKeptStates is dropped.
+  for (int i = 0; i < StateStore::kKeptStates; ++i) {
+    r = run_firmware({"--state", dir.c_str()}, [](FakeBoard& b) { b.console.feed("quit\r"); });
+    CHECK_EQUAL(kExitNotFound, r.exit_code);
+  }
+  // Three more starts: the seed-6 mission has moved up to the last copy, the first is gone.
+  STRCMP_CONTAINS(
+      "seed 6",
+      read_all(dir + "/mission.state." + std::to_string(StateStore::kKeptStates)).c_str());
+  STRCMP_EQUAL(
+      "(missing)",
+      read_all(dir + "/mission.state." + std::to_string(StateStore::kKeptStates + 1)).c_str());
+  // --resume continues the newest one and keeps nothing.
+  r = run_firmware({"--state", dir.c_str(), "--resume"},
+                   [](FakeBoard& b) { b.console.feed("quit\r"); });
+  CHECK(r.err.find("is kept as") == std::string::npos);
+}
+
+namespace {
+struct SignalAfter {
+  int frames = 0;
+  int signal = 0;
+  int at_frame = 0;
+};
+void raise_after(void* context) {
+  auto* s = static_cast<SignalAfter*>(context);
+  if (++s->frames == s->at_frame) std::raise(s->signal);
+}
+}  // namespace
+
+TEST(FirmwareMain, ASighupStopsInAnOrderlyWayWithTheBaseStoppedAndTheMissionLine) {
+  static SignalAfter signal_after;
+  signal_after = SignalAfter{0, SIGHUP, 30};
+  static MainHooks hooks;
+  hooks.after_frame = raise_after;
+  hooks.context = &signal_after;
+  std::string console_output;
+  bool stopped = false;
+  const Run r = run_firmware({}, [&](FakeBoard& b) {
+    b.hooks = &hooks;
+    b.after_run = [&](FakeBoard& done) {
+      console_output = done.console.written();
+      stopped = done.base.health() == boticelli::hal::BaseHealth::kStopped;
+    };
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(30, signal_after.frames);  // stopped right after the frame the signal came in
+  CHECK(stopped);
+  STRCMP_CONTAINS("LOG info stopping: SIGHUP", console_output.c_str());
+  STRCMP_CONTAINS("MISSION result=aborted cycles=0", last_line(r.out).c_str());
 }
 
 namespace {

@@ -18,6 +18,15 @@ enum class SaveStep : std::uint8_t {
 // process had been killed (its descriptors closed, nothing cleaned up).
 using SaveCrashHook = bool (*)(SaveStep step, void* context);
 
+// The system calls a board's fault injection can make fail (the sim board's storage faults:
+// a full or unwritable state directory, docs/reliability.md).
+enum class StorageCall : std::uint8_t { kCreate, kWrite };
+// Returns 0 to let the call run, or the errno it fails with instead (EACCES, ENOSPC, EIO).
+using StorageFaultHook = int (*)(StorageCall call, void* context);
+// Installs the process-wide hook (nullptr: none, the default). Set by a board at init,
+// before any save or thread; never on hardware.
+void set_storage_fault_hook(StorageFaultHook hook, void* context);
+
 // Bytes written per write() call (one kChunkWritten step each).
 inline constexpr std::size_t kAtomicWriteChunkBytes = std::size_t{16} * 1024;
 

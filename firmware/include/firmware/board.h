@@ -10,6 +10,7 @@
 
 #include "algo/core/geometry.h"
 #include "firmware/config_file.h"
+#include "firmware/fault_injection.h"
 #include "firmware/options.h"
 #include "firmware/snapshot.h"
 #include "hal/hal.h"
@@ -116,6 +117,8 @@ class Board {
   virtual hal::Hal& hal() = 0;
   // Ground truth, or nullptr (hardware).
   virtual const TruthSource* truth() const { return nullptr; }
+  // The console's `fault` command, or nullptr (hardware: faults cannot be injected).
+  virtual FaultInjection* fault_injection() { return nullptr; }
   // A resumed mission's saved pose, in the mission's frame (the robot's pose when the mission
   // first started), called after init() and before the devices start. The sim board puts the
   // robot there (that frame being the world's start pose) and fails if the pose collides; a

@@ -10,6 +10,7 @@
 #include "firmware/console_line.h"
 #include "firmware/console_parser.h"
 #include "firmware/executive.h"
+#include "firmware/fault_injection.h"
 #include "firmware/log.h"
 #include "firmware/mission_view.h"
 #include "firmware/parameters.h"
@@ -44,8 +45,12 @@ class Console {
   }
   void set_board_name(const char* name) { board_name_ = name; }
   // Where `param save` hands the changed parameters (written into the state directory by
-  // the saver's thread); without one (no --state DIR) `param save` is refused. At init.
+  // the saver's thread); without one (no --state DIR) `param save` is refused. The console
+  // also watches the same saver's mission-state saves: a failed one is a LOG error line at
+  // once and makes the storage unhealthy (status, stats) until a save succeeds. At init.
   void set_parameter_saver(StateSaver* saver);
+  // The board's fault injection for the `fault` command (the sim board), or nullptr. At init.
+  void set_fault_injection(FaultInjection* faults) { faults_ = faults; }
   // The console task's body: flushes output, reads and executes input, sends telemetry.
   void service(std::uint64_t now_us);
   // Sends queued output only (no input, telemetry or health lines): for the shutdown drain.
@@ -55,6 +60,10 @@ class Console {
 
   bool shutdown_requested() const { return shutdown_requested_; }
   bool healthy() const { return !port_fault_; }
+  // False while the newest mission-state save failed (disk full, directory unwritable).
+  bool storage_healthy() const { return storage_healthy_; }
+  // Every task (Executive::all_healthy) and the storage.
+  bool robot_healthy() const { return storage_healthy_ && executive_.all_healthy(); }
   LogLevel log_level() const { return log_level_; }
   void set_echo(bool on) { echo_ = on ? 1.0F : 0.0F; }
   void set_telemetry_ms(float ms) { telemetry_ms_ = ms; }
@@ -84,6 +93,8 @@ class Console {
   void flush();
   void stream_model();
   void check_executive(std::uint64_t now_us);
+  void check_state_saves();
+  void append_unhealthy(TextBufferBase& out) const;
   void send_telemetry(std::uint64_t now_us);
 
   void cmd_help(const Words& w);
@@ -103,6 +114,7 @@ class Console {
   void check_parameter_saves();
   void cmd_ver(const Words& w);
   void cmd_shutdown(const Words& w);
+  void cmd_fault(const Words& w);
   void append_parameter(const Parameter& p);
 
   static const Command kCommands[];
@@ -134,6 +146,7 @@ class Console {
   std::uint64_t log_end_ = 0;   // one past its last
 
   StateSaver* parameter_saver_ = nullptr;
+  FaultInjection* faults_ = nullptr;
   std::array<char, ParameterTable::kMaxFileBytes> parameter_text_{};  // `param save`'s file
   std::uint64_t seen_parameter_saves_ = 0;
   std::uint64_t seen_parameter_failures_ = 0;
@@ -153,7 +166,14 @@ class Console {
   std::uint64_t seen_frame_overruns_ = 0;
   std::uint64_t seen_background_overruns_ = 0;
   std::uint64_t next_overrun_log_us_ = 0;
-  bool was_healthy_ = true;
+  // Per task: the reason last logged while it was unhealthy (empty: logged healthy), and
+  // when, so a reason that keeps changing is logged at most once a second.
+  std::array<TextBuffer<96>, Executive::kMaxTasks> logged_reason_{};
+  std::array<std::uint64_t, Executive::kMaxTasks> logged_at_us_{};
+  std::uint64_t seen_state_saves_ = 0;
+  std::uint64_t seen_state_failures_ = 0;
+  bool storage_healthy_ = true;
+  StopCause logged_cause_ = StopCause::kNone;
 };
 
 }  // namespace boticelli::firmware

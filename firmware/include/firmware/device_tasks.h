@@ -31,20 +31,34 @@ class BaseTask final : public Task {
   bool healthy() const override {
     return base_.health() != hal::BaseHealth::kStopped || safety_.engaged();
   }
+  const char* health_reason() const override {
+    const char* why = base_.error();
+    return why[0] != '\0' ? why : "stopped by itself";
+  }
 
  private:
   hal::Base& base_;
   const Safety& safety_;
 };
 
+// Services the PTU; unhealthy while the unit reports a fault, or while a move has not
+// changed the reported position for stuck_us (a move that never completes).
 class PanTiltTask final : public Task {
  public:
-  explicit PanTiltTask(hal::PanTilt& ptu) : ptu_(ptu) {}
-  void run(std::uint64_t) override { ptu_.update(); }
-  bool healthy() const override { return !ptu_.state().fault; }
+  explicit PanTiltTask(hal::PanTilt& ptu, std::uint64_t stuck_us = 2000000)
+      : ptu_(ptu), stuck_us_(stuck_us) {}
+  void run(std::uint64_t now_us) override;
+  bool healthy() const override;
+  const char* health_reason() const override;
 
  private:
   hal::PanTilt& ptu_;
+  std::uint64_t stuck_us_;
+  std::uint64_t progress_us_ = 0;
+  float last_pan_rad_ = 0.0F;
+  float last_tilt_rad_ = 0.0F;
+  bool seen_ = false;
+  bool stuck_ = false;
 };
 
 // Receives each new camera frame inside the camera task (copy or downsample what is needed:
@@ -63,8 +77,10 @@ class FrameConsumer {
   FrameConsumer& operator=(const FrameConsumer&) = default;
 };
 
-// Polls the camera; unhealthy when no frame came for stall_us (a fault the driver recovers
-// from quickly, e.g. a re-opened device, does not count against the watchdog).
+// Polls the camera; unhealthy when no new frame came for stall_us (a fault the driver
+// recovers from quickly, e.g. a re-opened device, does not count against the watchdog). A
+// frame whose sequence number did not advance is the same image again (a frozen driver): it
+// is neither used nor counted as a new frame.
 class CameraTask final : public Task {
  public:
   explicit CameraTask(hal::Camera& camera, std::uint64_t stall_us = 2000000,
@@ -73,8 +89,12 @@ class CameraTask final : public Task {
   void set_consumer(FrameConsumer* consumer) { consumer_ = consumer; }
   void run(std::uint64_t now_us) override;
   bool healthy() const override { return healthy_; }
+  // "no frame for N.N s", with the driver's last error when it gave one.
+  const char* health_reason() const override { return reason_.c_str(); }
   std::uint64_t frames() const { return frames_; }
   std::uint64_t faults() const { return faults_; }
+  // Frames whose sequence number did not advance (the driver handed the same image again).
+  std::uint64_t stale_frames() const { return stale_frames_; }
 
  private:
   hal::Camera& camera_;
@@ -84,9 +104,18 @@ class CameraTask final : public Task {
   FrameConsumer* consumer_ = nullptr;
   std::uint64_t last_frame_us_ = 0;
   bool seen_time_ = false;
+  // Unhealthy, with the reason: `what` (or the driver's error when nullptr).
+  void mark_stalled(const char* what);
+
   bool healthy_ = true;
+  TextBuffer<128> reason_;
   std::uint64_t frames_ = 0;
   std::uint64_t faults_ = 0;
+  std::uint64_t stale_frames_ = 0;
+  std::uint64_t wrong_frames_ = 0;
+  std::uint32_t last_sequence_ = 0;
+  bool have_sequence_ = false;
+  const char* last_bad_ = nullptr;  // what was wrong with the last unusable frame
 };
 
 class ConsoleTask final : public Task {
@@ -94,6 +123,7 @@ class ConsoleTask final : public Task {
   explicit ConsoleTask(Console& console) : console_(console) {}
   void run(std::uint64_t now_us) override { console_.service(now_us); }
   bool healthy() const override { return console_.healthy(); }
+  const char* health_reason() const override { return "console line fault"; }
 
  private:
   Console& console_;

@@ -25,6 +25,9 @@ class Task {
   virtual void run(std::uint64_t now_us) = 0;
   // False while the task's device or job is faulted (the watchdog then stops being kicked).
   virtual bool healthy() const { return true; }
+  // Why healthy() is false, in the device's words (e.g. "left axis: no heartbeat"); ""
+  // when there is nothing to say. Read by the console (status, stats, LOG lines).
+  virtual const char* health_reason() const { return ""; }
 
  protected:
   Task() = default;
@@ -150,6 +153,9 @@ class Executive {
   // Every task reports healthy, none is over its consecutive-overrun limit, and each has
   // run within two of its periods.
   bool all_healthy() const;
+  // nullptr while task i is healthy by all_healthy()'s three rules, else why not: the task's
+  // own reason ("unhealthy" when it gives none), "overrunning its budget" or "starved".
+  const char* task_health(std::size_t i) const;
 
   std::size_t task_count() const { return count_; }
   const TaskSpec& spec(std::size_t i) const { return entries_[i].spec; }

@@ -9,7 +9,8 @@ namespace boticelli::firmware {
 enum class ConsoleKind : std::uint8_t { kStdio, kPty, kPath };
 
 struct Options {
-  const char* world_file = nullptr;  // --world FILE (sim board only)
+  const char* world_file = nullptr;   // --world FILE (sim board only)
+  const char* faults_file = nullptr;  // --faults FILE: a fault plan (sim board only)
   double speed = 0.0;  // --speed X (sim board only): simulated/wall time, 0 = as fast as possible
   std::uint64_t seed = 1;                     // --seed N
   std::uint64_t max_cycles = 0;               // --max-cycles N; 0 = no limit

@@ -51,6 +51,12 @@ class StateStore {
   // kLoaded fills `out`; kMissing when there is no state file; kCorrupt (out cleared) when
   // the file is truncated, altered or from another version; the reason goes to `error`.
   LoadResult load(MissionState& out, char* error, std::size_t error_size);
+  // A new mission (no --resume) keeps the saved one instead of overwriting it: renames
+  // `mission.state` to `mission.state.1`, shifting older copies up to `.kKeptStates` (the
+  // oldest is dropped), then fsyncs the directory. kMissing when there was nothing to keep;
+  // kLoaded (kept, `kept` holds the new name) or kIoError with the reason in `error`.
+  static constexpr int kKeptStates = 3;
+  LoadResult keep_previous(char* kept, std::size_t kept_size, char* error, std::size_t error_size);
   const char* path() const { return path_.data(); }
   const char* parameters_path() const { return parameters_path_.data(); }
   bool is_open() const { return dir_[0] != '\0'; }

@@ -41,6 +41,11 @@ class StateSaver {
   std::uint64_t failures() const;
   // The last failure's reason, copied into `out`.
   void last_error(char* out, std::size_t size) const;
+  // The same without waiting (the executive's thread): false, nothing copied, while the
+  // writer holds the lock; try again in a later frame.
+  bool try_last_error(char* out, std::size_t size) const;
+  // True while the newest save attempt failed (storage unhealthy); a later success clears it.
+  bool failing() const;
 
   enum class Submitted : std::uint8_t {
     kQueued,  // handed to the writer thread; parameter_saves() or parameter_failures() counts it
@@ -73,6 +78,7 @@ class StateSaver {
   bool stop_ = false;
   std::uint64_t saved_ = 0;
   std::uint64_t failures_ = 0;
+  bool failing_ = false;  // guarded by mutex_
   char error_[256] = "";
   MissionState writing_;  // the writer thread's own copy
   std::array<char, ParameterTable::kMaxFileBytes> parameters_pending_{};  // guarded by mutex_

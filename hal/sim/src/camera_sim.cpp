@@ -27,29 +27,73 @@ bool CameraSim::init() {
   }
   streaming_ = true;
   error_ = "";
+  has_frame_ = false;
+  delayed_pending_ = false;
   next_capture_us_ = world_.now_us();
   return true;
+}
+
+void CameraSim::capture() {
+  last_pose_ = world_.camera_pose();
+  const std::uint32_t width = renderer_.width_px();
+  renderer_.render(last_pose_, sequence_, image_.get(), std::size_t{2} * width,
+                   depth_enabled_ ? depth_.get() : nullptr);
+  has_frame_ = true;
+}
+
+CameraPoll CameraSim::deliver(Frame& frame, std::uint64_t timestamp_us, std::uint32_t sequence,
+                              bool half_size) {
+  const std::uint32_t width = renderer_.width_px();
+  frame.data = image_.get();
+  frame.width_px = half_size ? width / 2U : width;
+  frame.height_px = half_size ? renderer_.height_px() / 2U : renderer_.height_px();
+  frame.stride_bytes = 2U * frame.width_px;
+  frame.format = PixelFormat::kYuyv;
+  frame.timestamp_us = timestamp_us;
+  frame.sequence = sequence;
+  return CameraPoll::kFrame;
 }
 
 CameraPoll CameraSim::poll(Frame& frame) {
   if (!streaming_) return CameraPoll::kFault;
   const std::uint64_t now = world_.now_us();
+  FaultType fault = FaultType::kOff;
+  const bool failing = world_.faults().failing(FaultDevice::kCamera, fault);
+  if (failing && (fault == FaultType::kOff || fault == FaultType::kIntermittent)) {
+    error_ = "camera: device gone (ENODEV), re-opening";
+    delayed_pending_ = false;
+    return CameraPoll::kFault;
+  }
+  error_ = "";
+  if (delayed_pending_) {
+    if (now < delayed_capture_us_ + kDelayUs) return CameraPoll::kNoFrame;
+    delayed_pending_ = false;
+    return deliver(frame, delayed_capture_us_, delayed_sequence_, false);
+  }
+  // Back from a slow spell: the next frame comes at the normal rate again.
+  if (!(failing && fault == FaultType::kSlow) && next_capture_us_ > now + period_us_) {
+    next_capture_us_ = now;
+  }
   if (now < next_capture_us_) return CameraPoll::kNoFrame;
   // Frames come on the period grid; missed ones are skipped, as a streaming camera drops them.
-  const std::uint64_t late = (now - next_capture_us_) / period_us_;
-  next_capture_us_ += (late + 1) * period_us_;
-  last_pose_ = world_.camera_pose();
-  const std::uint32_t width = renderer_.width_px();
-  renderer_.render(last_pose_, sequence_, image_.get(), std::size_t{2} * width,
-                   depth_enabled_ ? depth_.get() : nullptr);
-  frame.data = image_.get();
-  frame.width_px = width;
-  frame.height_px = renderer_.height_px();
-  frame.stride_bytes = 2U * width;
-  frame.format = PixelFormat::kYuyv;
-  frame.timestamp_us = now;
-  frame.sequence = sequence_++;
-  return CameraPoll::kFrame;
+  const std::uint64_t period = failing && fault == FaultType::kSlow ? 10U * period_us_ : period_us_;
+  const std::uint64_t late = (now - next_capture_us_) / period;
+  next_capture_us_ += (late + 1) * period;
+  if (failing && fault == FaultType::kGarbage) {
+    ++sequence_;  // an error-flagged buffer: the driver drops and re-queues it
+    return CameraPoll::kNoFrame;
+  }
+  if (failing && fault == FaultType::kStuck && has_frame_ && sequence_ > 0) {
+    return deliver(frame, now, sequence_ - 1U, false);  // the same buffer again
+  }
+  capture();
+  if (failing && fault == FaultType::kDelayed) {
+    delayed_pending_ = true;
+    delayed_capture_us_ = now;
+    delayed_sequence_ = sequence_++;
+    return CameraPoll::kNoFrame;
+  }
+  return deliver(frame, now, sequence_++, failing && fault == FaultType::kWrong);
 }
 
 }  // namespace boticelli::hal::sim

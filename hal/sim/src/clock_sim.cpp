@@ -27,6 +27,17 @@ void ClockSim::set_speed(double speed) {
 
 void ClockSim::sleep_until_us(std::uint64_t deadline_us) {
   world_.advance_to(deadline_us);
+  FaultType fault = FaultType::kOff;
+  if (world_.faults().failing(FaultDevice::kMainLoop, fault)) {
+    const FaultInjector& faults = world_.faults();
+    if (fault == FaultType::kStuck &&
+        faults.active_since_us(FaultDevice::kMainLoop) != stalled_since_us_) {
+      stalled_since_us_ = faults.active_since_us(FaultDevice::kMainLoop);
+      world_.advance_to(faults.active_until_us(FaultDevice::kMainLoop));
+    } else if (fault == FaultType::kSlow) {
+      world_.advance_to(world_.now_us() + kSlowUs);
+    }
+  }
   if (speed_ <= 0.0) return;
   const std::uint64_t now_ns = monotonic_ns();
   const std::uint64_t sim_us = world_.now_us();

@@ -17,6 +17,7 @@ bool PanTiltSim::init() {
   // Like the D46 after a reset: ready once update() has run (limits, resolution read back).
   initialising_ = true;
   ready_ = false;
+  delayed_pending_ = false;
   error_[0] = '\0';
   return true;
 }
@@ -26,11 +27,42 @@ void PanTiltSim::update() {
     initialising_ = false;
     ready_ = true;
   }
+  if (delayed_pending_ && world_.now_us() >= delayed_due_us_) {
+    delayed_pending_ = false;
+    world_.pan().target_rad = delayed_pan_rad_;
+    world_.tilt().target_rad = delayed_tilt_rad_;
+  }
+}
+
+bool PanTiltSim::faulted() const {
+  FaultType type = FaultType::kOff;
+  if (!world_.faults().failing(FaultDevice::kPtu, type)) return false;
+  switch (type) {
+    case FaultType::kOff:
+      if (world_.now_us() - world_.faults().active_since_us(FaultDevice::kPtu) < kSilenceUs) {
+        return false;  // not noticed yet: the driver waits for its reply timeout
+      }
+      std::snprintf(error_, sizeof error_, "PTU: no reply for %.1f s",
+                    static_cast<double>(kSilenceUs) * 1e-6);
+      return true;
+    case FaultType::kGarbage:
+    case FaultType::kIntermittent:
+      std::snprintf(error_, sizeof error_, "PTU: garbled reply (not * or !)");
+      return true;
+    default:
+      return false;
+  }
 }
 
 bool PanTiltSim::move_to(float pan_rad, float tilt_rad) {
   if (!ready_) {
     std::snprintf(error_, sizeof error_, "PTU not initialised");
+    return false;
+  }
+  if (faulted()) return false;
+  FaultType type = FaultType::kOff;
+  if (world_.faults().failing(FaultDevice::kPtu, type) && type == FaultType::kWrong) {
+    std::snprintf(error_, sizeof error_, "! PTU refused the command (error reply)");
     return false;
   }
   const PanTiltLimits l = limits();
@@ -53,9 +85,19 @@ bool PanTiltSim::move_to(float pan_rad, float tilt_rad) {
                   static_cast<double>(l.tilt_max_rad));
     return false;
   }
-  world_.pan().target_rad = std::clamp(pan, l.pan_min_rad, l.pan_max_rad);
-  world_.tilt().target_rad = std::clamp(tilt, l.tilt_min_rad, l.tilt_max_rad);
+  const float pan_target = std::clamp(pan, l.pan_min_rad, l.pan_max_rad);
+  const float tilt_target = std::clamp(tilt, l.tilt_min_rad, l.tilt_max_rad);
   error_[0] = '\0';
+  if (world_.faults().failing(FaultDevice::kPtu, type) && type == FaultType::kDelayed) {
+    delayed_pending_ = true;
+    delayed_due_us_ = world_.now_us() + kDelayUs;
+    delayed_pan_rad_ = pan_target;
+    delayed_tilt_rad_ = tilt_target;
+    return true;
+  }
+  delayed_pending_ = false;
+  world_.pan().target_rad = pan_target;
+  world_.tilt().target_rad = tilt_target;
   return true;
 }
 
@@ -78,8 +120,8 @@ PanTiltState PanTiltSim::state() const {
   // Positions are reported in whole steps, as the unit does.
   s.pan_rad = quantise(world_.pan().position_rad, l.pan_resolution_rad);
   s.tilt_rad = quantise(world_.tilt().position_rad, l.tilt_resolution_rad);
-  s.moving = world_.pan().moving() || world_.tilt().moving() || initialising_;
-  s.fault = false;
+  s.moving = world_.pan().moving() || world_.tilt().moving() || initialising_ || delayed_pending_;
+  s.fault = faulted();
   return s;
 }
 

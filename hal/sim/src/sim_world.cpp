@@ -71,6 +71,9 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   led_changes_ = 0;
   watchdog_armed_ = false;
   watchdog_expirations_ = 0;
+  base_last_update_us_ = 0;
+  last_base_stop_us_ = 0;
+  faults_.reset(params.seed);
   const char* model = "";
   const float gap = clearance_m(x_m_, y_m_, &model);
   if (gap < 0.0F) {
@@ -147,11 +150,30 @@ void SimWorld::step(std::uint32_t dt_us) {
       estop_scripted_ = false;
     }
   }
-  step_axis(pan_, dt_s);
-  step_axis(tilt_, dt_s);
+  faults_.update(now_us_);
+  // PTU faults that act on the axes: a move that never ends (stuck), or at a tenth of its
+  // speed (slow).
+  FaultType ptu_fault = FaultType::kOff;
+  const bool ptu_failing = faults_.failing(FaultDevice::kPtu, ptu_fault);
+  if (!(ptu_failing && (ptu_fault == FaultType::kStuck || ptu_fault == FaultType::kOff ||
+                        ptu_fault == FaultType::kIntermittent))) {
+    const float speed_scale = ptu_failing && ptu_fault == FaultType::kSlow ? 0.1F : 1.0F;
+    step_axis(pan_, dt_s * speed_scale);
+    step_axis(tilt_, dt_s * speed_scale);
+  }
   if (base_started_ && base_health_ == BaseHealth::kStarting && now_us_ >= base_ready_at_us_) {
-    base_health_ = BaseHealth::kReady;
-    base_error_ = "";
+    if (const char* why = base_fault(); why != nullptr) {
+      base_stop(why);  // the start-up fails on an axis that is not there
+    } else {
+      base_health_ = BaseHealth::kReady;
+      base_error_ = "";
+    }
+  }
+  if (params_.base.command_timeout_us != 0 && base_health_ == BaseHealth::kReady &&
+      now_us_ - base_last_update_us_ > params_.base.command_timeout_us) {
+    // The ODrive's watchdog (WATCHDOG_TIMER_EXPIRED, 0x800): no setpoint came in time, e.g.
+    // the executive stalled. The driver then reports the axis error.
+    base_stop("base: left axis: ODrive reports an axis error (0x00000800)");
   }
   step_base(dt_s);
   if (watchdog_armed_ && now_us_ - last_kick_us_ > watchdog_timeout_us_) {
@@ -261,9 +283,38 @@ void SimWorld::base_start() {
   base_health_ = BaseHealth::kStarting;
   base_error_ = "starting";
   base_ready_at_us_ = now_us_ + params_.base.startup_us;
+  base_last_update_us_ = now_us_;
   odometry_origin_ = true_pose();
   odometry_ = Odometry{};
   odometry_.timestamp_us = now_us_;
+}
+
+const char* SimWorld::base_fault() const {
+  FaultType type = FaultType::kOff;
+  if (faults_.failing(FaultDevice::kCan, type)) {
+    return "base: CAN bus-off (controller stopped transmitting)";
+  }
+  for (const FaultDevice d : {FaultDevice::kAxisLeft, FaultDevice::kAxisRight}) {
+    if (!faults_.failing(d, type)) continue;
+    const bool left = d == FaultDevice::kAxisLeft;
+    if (type == FaultType::kWrong) {
+      // MOTOR_FAILED in the heartbeat's axis error.
+      return left ? "base: left axis: ODrive reports an axis error (0x00000040)"
+                  : "base: right axis: ODrive reports an axis error (0x00000040)";
+    }
+    return left ? "base: left axis: heartbeat lost (0x00000000)"
+                : "base: right axis: heartbeat lost (0x00000000)";
+  }
+  return nullptr;
+}
+
+void SimWorld::base_update() {
+  base_last_update_us_ = now_us_;
+  if (base_health_ == BaseHealth::kStopped) return;
+  const char* why = base_fault();
+  if (why == nullptr) return;
+  std::snprintf(base_fault_error_, sizeof base_fault_error_, "%s", why);
+  base_stop(base_fault_error_);
 }
 
 void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
@@ -278,6 +329,7 @@ void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
 }
 
 void SimWorld::base_stop(const char* reason) {
+  if (base_health_ != BaseHealth::kStopped) last_base_stop_us_ = now_us_;
   target_left_m_s_ = target_right_m_s_ = 0.0F;
   wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
   base_health_ = BaseHealth::kStopped;
@@ -286,6 +338,7 @@ void SimWorld::base_stop(const char* reason) {
 
 bool SimWorld::base_resume() {
   if (!base_started_) return false;
+  if (base_fault() != nullptr) return false;  // the axis or the bus is still gone
   if (base_health_ == BaseHealth::kStopped) {
     base_health_ = now_us_ >= base_ready_at_us_ ? BaseHealth::kReady : BaseHealth::kStarting;
     base_error_ = base_health_ == BaseHealth::kReady ? "" : "starting";

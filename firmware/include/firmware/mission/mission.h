@@ -120,12 +120,14 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
 
   [[nodiscard]] Result result() const { return result_; }
   [[nodiscard]] bool finished() const { return result_ != Result::kRunning; }
-  [[nodiscard]] const char* end_reason() const { return end_reason_; }
+  [[nodiscard]] const char* end_reason() const { return end_reason_.c_str(); }
   [[nodiscard]] std::uint64_t cycles_this_run() const { return cycles_this_run_; }
   // Distance between the target estimate and the true target (NaN without either).
   [[nodiscard]] float target_error_m() const;
   // Ends the mission from outside: shutdown (aborted) or --max-cycles (not found).
   void abort(const char* why);
+  // abort() with the device's own words: "WHY: DEVICE_ERROR" (just WHY when it gave none).
+  void abort_with(const char* why, const char* device_error);
   void finish_not_found(const char* why) { finish(Result::kNotFound, why); }
   // Shutdown: saves the pose where the base came to rest and waits until the state is written.
   void finish_saving();
@@ -195,7 +197,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   Phase phase_ = Phase::kStart;
   Phase held_phase_ = Phase::kStart;
   Result result_ = Result::kRunning;
-  const char* end_reason_ = "";
+  TextBuffer<160> end_reason_;  // a copy: a device's reason may change after the end
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;
   std::uint64_t next_trace_us_ = 0;

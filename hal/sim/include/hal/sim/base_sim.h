@@ -7,7 +7,9 @@
 namespace boticelli::hal::sim {
 
 // Start-up takes BaseParams::startup_us of simulated time (closed-loop entry); a collision
-// stops the base (health kStopped, error "collision with 'model'") until resume().
+// stops the base (health kStopped, error "collision with 'model'") until resume(). Injected
+// axis and CAN faults stop it at the next update() with the ODrive driver's words, and
+// resume() fails while they last.
 class BaseSim final : public Base {
  public:
   explicit BaseSim(SimWorld& world) : world_(world) {}
@@ -15,7 +17,7 @@ class BaseSim final : public Base {
     world_.base_start();
     return true;
   }
-  void update() override {}
+  void update() override { world_.base_update(); }
   void set_velocity(float v_m_s, float omega_rad_s) override {
     world_.base_set_velocity(v_m_s, omega_rad_s);
   }

@@ -10,6 +10,11 @@
 
 namespace boticelli::hal::sim {
 
+// Injected faults (FaultDevice::kCamera): off = the device is gone (kFault) until the fault
+// ends, stuck = the same frame again (same sequence number, a new timestamp), garbage =
+// frames with the error flag (dropped, as the V4L2 driver does), wrong = frames of half the
+// negotiated size, slow = a tenth of the frame rate, delayed = each frame delivered 0.5 s
+// after its capture (with its capture time), intermittent = gone in its failing slots.
 class CameraSim final : public Camera {
  public:
   CameraSim(SimWorld& world, Renderer& renderer) : world_(world), renderer_(renderer) {}
@@ -43,8 +48,18 @@ class CameraSim final : public Camera {
   std::uint32_t sequence_ = 0;
   bool streaming_ = false;
   bool depth_enabled_ = false;
+  static constexpr std::uint64_t kDelayUs = 500000;
+  // Renders the frame captured now into image_ (and depth_).
+  void capture();
+  CameraPoll deliver(Frame& frame, std::uint64_t timestamp_us, std::uint32_t sequence,
+                     bool half_size);
+
   RigidTransform last_pose_{};
   const char* error_ = "";
+  bool has_frame_ = false;  // image_ holds a rendered frame (for a stuck camera)
+  bool delayed_pending_ = false;
+  std::uint64_t delayed_capture_us_ = 0;
+  std::uint32_t delayed_sequence_ = 0;
 };
 
 }  // namespace boticelli::hal::sim

@@ -15,6 +15,9 @@ class ClockSim final : public Clock {
   std::uint64_t now_us() override { return world_.now_us(); }
   // Advances simulated time (and the PTU, base and contacts) to the deadline at once; with a
   // speed, then waits until as much wall time has passed as simulated time, divided by the speed.
+  // Injected main-loop faults act here, where the executive hands over its time: stuck =
+  // the executive stalls for the fault's whole duration once (time runs on, nothing of the
+  // firmware runs), slow = every sleep ends 12 ms late (every frame overruns).
   void sleep_until_us(std::uint64_t deadline_us) override;
   // Simulated seconds per wall second: 1 = real time, 0 = as fast as possible (the default).
   void set_speed(double speed);
@@ -22,7 +25,9 @@ class ClockSim final : public Clock {
 
  private:
   SimWorld& world_;
+  static constexpr std::uint64_t kSlowUs = 12000;
   double speed_ = 0.0;
+  std::uint64_t stalled_since_us_ = UINT64_MAX;  // start of the stall already served
   bool anchored_ = false;
   std::uint64_t anchor_sim_us_ = 0;   // simulated time at the anchor
   std::uint64_t anchor_wall_ns_ = 0;  // CLOCK_MONOTONIC at the anchor

@@ -9,6 +9,7 @@
 #include "algo/stereo/rig.h"
 #include "hal/base.h"
 #include "hal/pan_tilt.h"
+#include "hal/sim/fault_injector.h"
 #include "hal/sim/world.h"
 
 namespace boticelli::hal::sim {
@@ -32,6 +33,9 @@ struct BaseParams {
   std::uint32_t startup_us = 50000;  // start-up until closed-loop control [µs]
   float contact_margin_m = 0.01F;    // the bumper closes within this gap [m]
   float floor_clearance_m = 0.01F;   // obstacles lower than this are driven over [m]
+  // The ODrives' own watchdog: without a setpoint (BaseSim::update) for this long the axes
+  // stop with an error, as on the robot [µs]; 0 = off (device tests that never update()).
+  std::uint32_t command_timeout_us = 0;
 };
 
 struct SimParams {
@@ -82,12 +86,21 @@ class SimWorld {
   // Distance from the robot's cylinder to the nearest obstacle it can hit [m] (< 0: overlap).
   float clearance_m(double x_m, double y_m, const char** model = nullptr) const;
 
+  // ---- injected faults (FaultInjector; the devices consult it) ----
+  FaultInjector& faults() { return faults_; }
+  const FaultInjector& faults() const { return faults_; }
+
   // ---- base (driven through BaseSim) ----
   void base_start();
+  // The base's service call each frame: a setpoint for the ODrives' watchdog, and the
+  // injected axis and CAN faults, which stop the base as the ODrive driver does.
+  void base_update();
   void base_set_velocity(float v_m_s, float omega_rad_s);
   void base_stop(const char* reason);
   bool base_resume();
   BaseHealth base_health() const { return base_health_; }
+  // When the base last went from moving or ready to stopped (any cause) [µs]; 0 never.
+  std::uint64_t last_base_stop_us() const { return last_base_stop_us_; }
   const char* base_error() const { return base_error_; }
   Odometry odometry() const { return odometry_; }
   // The true pose at which the odometry frame was fixed (the last base start).
@@ -135,6 +148,9 @@ class SimWorld {
   const char* base_error_ = "not started";
   std::uint64_t base_ready_at_us_ = 0;
   bool base_started_ = false;
+  std::uint64_t base_last_update_us_ = 0;
+  std::uint64_t last_base_stop_us_ = 0;
+  char base_fault_error_[96] = {};
   Odometry odometry_{};
   core::Pose2 odometry_origin_{};
   std::uint32_t collisions_ = 0;
@@ -156,6 +172,10 @@ class SimWorld {
   bool watchdog_armed_ = false;
   std::uint64_t watchdog_timeout_us_ = 0, last_kick_us_ = 0;
   std::uint32_t watchdog_expirations_ = 0;
+  // Faults.
+  FaultInjector faults_;
+  // Why the base cannot leave kStopped now (an axis or CAN fault is active), or nullptr.
+  const char* base_fault() const;
 };
 
 }  // namespace boticelli::hal::sim

@@ -1,0 +1,606 @@
+// FaultScenario: the firmware's device tasks on the sim board around a stand-in mission, with
+// one injected fault, measured frame by frame (see fault_scenario.h).
+#include "fault_scenario.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <string_view>
+
+#include "firmware/console.h"
+#include "firmware/device_tasks.h"
+#include "firmware/executive.h"
+#include "firmware/mission_view.h"
+#include "firmware/parameters.h"
+#include "firmware/persistence.h"
+#include "firmware/safety.h"
+#include "firmware/service_notify.h"
+#include "firmware/state_saver.h"
+#include "firmware/task_table.h"
+#include "firmware/text_buffer.h"
+#include "sim_board.h"
+
+namespace boticelli::boards::sim {
+namespace {
+
+using hal::sim::FaultDevice;
+using hal::sim::FaultType;
+namespace fw = firmware;
+
+// The pairs' expectations, by device then type (docs/reliability.md).
+struct ExpectationRow {
+  FaultDevice device;
+  FaultType type;
+  FaultExpectation expected;
+};
+
+constexpr const char* kFrameTimeout =
+    "aborted after the 3 s frame timeout: no camera frame (with the driver's reason)";
+constexpr const char* kBaseAbort =
+    "aborted at its next step: base stopped by itself, with the driver's reason";
+constexpr const char* kCarriesOn = "carries on";
+constexpr ExpectationRow kExpectations[] = {
+    {FaultDevice::kCamera,
+     FaultType::kOff,
+     {false, "camera unhealthy: no new frame for 2.0 s: camera: device gone", true,
+      "aborted after the 3 s frame timeout: no camera frame: camera: device gone", true}},
+    {FaultDevice::kCamera,
+     FaultType::kStuck,
+     {false, "camera unhealthy: no new frame for 2.0 s: the same frame again", true, kFrameTimeout,
+      true}},
+    {FaultDevice::kCamera,
+     FaultType::kGarbage,
+     {false, "camera unhealthy: no new frame for 2.0 s", true, kFrameTimeout, true}},
+    {FaultDevice::kCamera,
+     FaultType::kWrong,
+     {false, "camera unhealthy: no new frame for 2.0 s: frames of the wrong size", true,
+      kFrameTimeout, true}},
+    {FaultDevice::kCamera, FaultType::kSlow, {false, "unhealthy=none", true, kCarriesOn}},
+    {FaultDevice::kCamera, FaultType::kDelayed, {false, "unhealthy=none", true, kCarriesOn}},
+    {FaultDevice::kCamera, FaultType::kIntermittent, {false, "unhealthy=none", true, kCarriesOn}},
+    {FaultDevice::kPtu,
+     FaultType::kOff,
+     {false, "ptu unhealthy: PTU: no reply for 0.5 s", true,
+      "aborted: pan-tilt unit fault: PTU: no reply for 0.5 s", true}},
+    {FaultDevice::kPtu,
+     FaultType::kStuck,
+     {false, "ptu unhealthy: PTU: a move is not progressing", true,
+      "carries on when the move ends within the 8 s move timeout, else aborted: pan-tilt "
+      "move did not complete"}},
+    {FaultDevice::kPtu,
+     FaultType::kGarbage,
+     {false, "ptu unhealthy: PTU: garbled reply", true,
+      "aborted: pan-tilt unit fault: PTU: garbled reply", true}},
+    {FaultDevice::kPtu,
+     FaultType::kWrong,
+     {false, "unhealthy=none", true,
+      "aborted: pan-tilt unit refused a move: ! PTU refused the command", true}},
+    {FaultDevice::kPtu, FaultType::kSlow, {false, "unhealthy=none", true, kCarriesOn}},
+    {FaultDevice::kPtu, FaultType::kDelayed, {false, "unhealthy=none", true, kCarriesOn}},
+    {FaultDevice::kPtu,
+     FaultType::kIntermittent,
+     {false, "ptu unhealthy: PTU: garbled reply", true,
+      "aborted: pan-tilt unit fault: PTU: garbled reply", true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kOff,
+     {true, "base unhealthy: base: left axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kWrong,
+     {true, "base unhealthy: base: left axis: ODrive reports an axis error", false, kBaseAbort,
+      true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kIntermittent,
+     {true, "base unhealthy: base: left axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kOff,
+     {true, "base unhealthy: base: right axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kWrong,
+     {true, "base unhealthy: base: right axis: ODrive reports an axis error", false, kBaseAbort,
+      true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kIntermittent,
+     {true, "base unhealthy: base: right axis: heartbeat lost", false, kBaseAbort, true}},
+    {FaultDevice::kCan,
+     FaultType::kOff,
+     {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort, true}},
+    {FaultDevice::kCan,
+     FaultType::kIntermittent,
+     {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort, true}},
+    {FaultDevice::kEstop,
+     FaultType::kOff,
+     {true, "e-stop engaged: button (base stopped)", true,
+      "holds; carries on 0.5 s after the line is back"}},
+    {FaultDevice::kEstop,
+     FaultType::kStuck,
+     {true, "e-stop engaged: button (base stopped)", true,
+      "holds; carries on 0.5 s after the release"}},
+    {FaultDevice::kEstop,
+     FaultType::kIntermittent,
+     {true, "e-stop engaged: button (base stopped)", true,
+      "holds; carries on 0.5 s after the last release"}},
+    {FaultDevice::kBumper,
+     FaultType::kOff,
+     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
+    {FaultDevice::kBumper,
+     FaultType::kStuck,
+     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
+    {FaultDevice::kBumper,
+     FaultType::kIntermittent,
+     {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
+    {FaultDevice::kStorage,
+     FaultType::kOff,
+     {false, "storage unhealthy: state not saved (1 failed): cannot create", true,
+      "carries on; saves fail while it lasts, the last good state file stays"}},
+    {FaultDevice::kStorage,
+     FaultType::kWrong,
+     {false, "No space left on device", true,
+      "carries on; saves fail while it lasts, the last good state file stays"}},
+    {FaultDevice::kStorage,
+     FaultType::kIntermittent,
+     {false, "storage unhealthy: state not saved", true,
+      "carries on; some saves fail, the last good state file stays"}},
+    {FaultDevice::kMainLoop,
+     FaultType::kStuck,
+     {true, "base unhealthy: base: left axis: ODrive reports an axis error (0x00000800)", false,
+      kBaseAbort, true}},
+    {FaultDevice::kMainLoop,
+     FaultType::kSlow,
+     {false, "LOG warn overruns frame=", true, "carries on; frames overrun"}},
+};
+
+constexpr FaultExpectation kNoExpectation{};
+
+// The console's output, kept in a fixed buffer (beyond it the rest is dropped); input fed
+// by the scenario.
+class CapturePort final : public hal::SerialPort {
+ public:
+  bool open() override { return true; }
+  std::ptrdiff_t read(std::uint8_t* buffer, std::size_t max) override {
+    std::size_t n = 0;
+    while (n < max && in_pos_ < in_len_) buffer[n++] = static_cast<std::uint8_t>(in_[in_pos_++]);
+    return static_cast<std::ptrdiff_t>(n);
+  }
+  std::ptrdiff_t write(const std::uint8_t* data, std::size_t size) override {
+    for (std::size_t i = 0; i < size; ++i) {
+      if (out_len_ + 1 < out_.size()) out_[out_len_++] = static_cast<char>(data[i]);
+    }
+    out_[out_len_] = '\0';
+    return static_cast<std::ptrdiff_t>(size);
+  }
+  void feed(std::string_view text) {
+    for (const char c : text) {
+      if (in_len_ < in_.size()) in_[in_len_++] = c;
+    }
+  }
+  std::string_view written() const { return {out_.data(), out_len_}; }
+  void clear() {
+    out_len_ = in_len_ = in_pos_ = 0;
+    out_[0] = '\0';
+  }
+
+ private:
+  std::array<char, 32768> out_{};
+  std::size_t out_len_ = 0;
+  std::array<char, 256> in_{};
+  std::size_t in_len_ = 0;
+  std::size_t in_pos_ = 0;
+};
+
+// In the mission's place: keeps the base turning in place (no contact possible) and the PTU
+// scanning, takes frames, clears a button stop 0.5 s after the release (as the mission
+// does), and saves a state every half second.
+class StandIn final : public fw::Task,
+                      public fw::MissionView,
+                      public fw::FrameConsumer,
+                      public fw::BackgroundWork {
+ public:
+  StandIn(hal::Hal& hal, fw::Safety& safety, fw::MissionState& state, fw::StateSaver* saver)
+      : hal_(hal), safety_(safety), state_(state), saver_(saver) {}
+  // Frames are taken (rendered) only when the camera is what is tested.
+  void set_wants_frames(bool wants) { wants_frames_ = wants; }
+  bool wants_frames() const override { return wants_frames_; }
+
+  void run(std::uint64_t now_us) override {
+    now_us_ = now_us;
+    if (safety_.engaged()) {
+      if (safety_.cause() == fw::StopCause::kButton && !hal_.estop.read()) {
+        if (released_since_us_ == 0) released_since_us_ = now_us;
+        if (now_us - released_since_us_ >= 500000U) (void)safety_.clear();
+      } else {
+        released_since_us_ = 0;
+      }
+    } else if (hal_.base.health() == hal::BaseHealth::kReady) {
+      hal_.base.set_velocity(0.0F, 0.4F);
+    }
+    const hal::PanTiltState ptu = hal_.pan_tilt.state();
+    if (!ptu.moving && !ptu.fault) {
+      pan_sign_ = -pan_sign_;
+      if (hal_.pan_tilt.move_to(0.6F * pan_sign_, 0.0F)) ++ptu_moves_;
+    }
+  }
+  void on_frame(const hal::Frame& frame) override {
+    ++frames_;
+    const double lag_ms = static_cast<double>(now_us_ - frame.timestamp_us) * 1e-3;
+    if (lag_ms > worst_lag_ms_) worst_lag_ms_ = lag_ms;
+  }
+  fw::StepResult step(fw::SliceBudget& budget) override {
+    if (saver_ == nullptr || now_us_ < next_save_us_ || !budget.next_unit()) {
+      return fw::StepResult::kMore;
+    }
+    next_save_us_ = now_us_ + 500000U;
+    ++state_.cycle;
+    const hal::Odometry o = hal_.base.odometry();
+    state_.pose = {static_cast<float>(o.x_m), static_cast<float>(o.y_m),
+                   static_cast<float>(o.yaw_rad)};
+    (void)saver_->submit(state_);  // no writer thread on the sim board: saved here
+    return fw::StepResult::kDone;
+  }
+  const char* state_name() const override { return "exercise"; }
+  core::Pose2 pose() const override {
+    const hal::Odometry o = hal_.base.odometry();
+    return {static_cast<float>(o.x_m), static_cast<float>(o.y_m), static_cast<float>(o.yaw_rad)};
+  }
+  float pan_rad() const override { return hal_.pan_tilt.state().pan_rad; }
+  std::uint64_t cycles() const override { return state_.cycle; }
+
+  std::uint64_t frames() const { return frames_; }
+  std::uint64_t ptu_moves() const { return ptu_moves_; }
+  double worst_lag_ms() const { return worst_lag_ms_; }
+
+ private:
+  hal::Hal& hal_;
+  fw::Safety& safety_;
+  fw::MissionState& state_;
+  fw::StateSaver* saver_;
+  std::uint64_t now_us_ = 0;
+  std::uint64_t released_since_us_ = 0;
+  std::uint64_t next_save_us_ = 0;
+  std::uint64_t frames_ = 0;
+  std::uint64_t ptu_moves_ = 0;
+  double worst_lag_ms_ = 0.0;
+  float pan_sign_ = 1.0F;
+  bool wants_frames_ = true;
+};
+
+// The firmware's pieces around the stand-in, wired as firmware_main wires them (static
+// storage: a few hundred kB, one scenario at a time).
+struct Rig {
+  Rig(hal::Hal& hal, fw::StateStore& store, bool saving)
+      : saver(store),
+        executive(hal.clock),
+        safety(hal.estop, hal.bumper, hal.base),
+        stand_in(hal, safety, state, saving ? &saver : nullptr),
+        console(port, executive, safety, stand_in, parameters),
+        estop_task(safety),
+        base_task(hal.base, safety),
+        ptu_task(hal.pan_tilt),
+        camera_task(hal.camera),
+        console_task(console),
+        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {}
+
+  fw::MissionState state;
+  fw::StateSaver saver;
+  fw::ServiceNotifier notifier;
+  fw::Executive executive;
+  fw::Safety safety;
+  StandIn stand_in;
+  CapturePort port;
+  fw::ParameterTable parameters;
+  fw::Console console;
+  fw::EstopTask estop_task;
+  fw::BaseTask base_task;
+  fw::PanTiltTask ptu_task;
+  fw::CameraTask camera_task;
+  fw::ConsoleTask console_task;
+  fw::WatchdogTask watchdog_task;
+};
+
+fw::StateStore g_store;
+std::optional<Rig> g_rig;
+fw::MissionState g_loaded;
+
+bool wheels_at_rest(const hal::sim::SimWorld& sim) {
+  const hal::Odometry o = sim.odometry();
+  return std::fabs(o.v_m_s) < 1e-6F && std::fabs(o.omega_rad_s) < 1e-6F;
+}
+
+bool contains(std::string_view text, const char* what) {
+  return what[0] == '\0' || text.find(what) != std::string_view::npos;
+}
+
+// Inits the board (with its default_faults() as the plan) and the rig; false with the reason.
+bool start_rig(SimBoard& board, const FaultScenarioConfig& config, bool wants_frames, char* error,
+               std::size_t error_size) {
+  board.settings().camera_fps = config.camera_fps;
+  fw::Options options;
+  options.world_file = config.world_file;
+  options.seed = config.seed;
+  if (!board.init(options, error, error_size)) return false;
+  hal::Hal& hal = board.hal();
+  if (config.state_dir != nullptr && !g_store.open(config.state_dir, error, error_size)) {
+    return false;
+  }
+  if (!hal.base.init() || !hal.pan_tilt.init() || !hal.camera.init()) {
+    std::snprintf(error, error_size, "device init failed");
+    return false;
+  }
+  (void)hal.watchdog.start(board.config().watchdog_timeout_ms);
+  g_rig.reset();
+  g_rig.emplace(hal, g_store, config.state_dir != nullptr);
+  Rig& rig = *g_rig;
+  rig.state.clear();
+  rig.camera_task.set_consumer(&rig.stand_in);
+  rig.stand_in.set_wants_frames(wants_frames);
+  rig.watchdog_task.set_status_sources(&rig.safety, &rig.stand_in);
+  fw::Task* const tasks[fw::kTaskCount] = {&rig.estop_task,   &rig.base_task, &rig.ptu_task,
+                                           &rig.camera_task,  &rig.stand_in,  &rig.console_task,
+                                           &rig.watchdog_task};
+  const char* why = "";
+  for (std::size_t i = 0; i < fw::kTaskCount; ++i) {
+    if (!rig.executive.add_task(fw::kTaskTable[i], *tasks[i], &why)) {
+      std::snprintf(error, error_size, "executive: %s", why);
+      return false;
+    }
+  }
+  rig.executive.set_background(&rig.stand_in);
+  rig.console.set_telemetry_ms(0.0F);
+  rig.console.set_fault_injection(&board);
+  if (config.state_dir != nullptr) rig.console.set_parameter_saver(&rig.saver);
+  fw::ExecutiveConfig exec_config;
+  exec_config.frame_us = board.config().minor_frame_us;
+  exec_config.background_units_per_slice = board.config().background_units_per_slice;
+  if (!rig.executive.start(exec_config, &why)) {
+    std::snprintf(error, error_size, "executive: %s", why);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+const FaultExpectation& expectation(FaultDevice device, FaultType type) {
+  for (const ExpectationRow& row : kExpectations) {
+    if (row.device == device && row.type == type) return row.expected;
+  }
+  return kNoExpectation;
+}
+
+bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
+                        const FaultScenarioConfig& config, FaultScenarioResult& out) {
+  out = FaultScenarioResult{};
+  if (!hal::sim::fault_applies(device, type)) {
+    std::snprintf(out.error, sizeof out.error, "%s cannot be %s",
+                  hal::sim::fault_device_name(device), hal::sim::fault_type_name(type));
+    return false;
+  }
+  const FaultExpectation& expected = expectation(device, type);
+  // The plan: the one fault.
+  hal::sim::Fault fault;
+  fault.device = device;
+  fault.type = type;
+  fault.start_us = static_cast<std::uint64_t>(std::llround(config.fault_start_s * 1e6));
+  fault.duration_us = static_cast<std::uint64_t>(std::llround(config.fault_s * 1e6));
+  board.default_faults().clear();
+  (void)board.default_faults().add(fault);
+  if (!start_rig(board, config, device == FaultDevice::kCamera, out.error, sizeof out.error)) {
+    return false;
+  }
+  Rig& rig = *g_rig;
+  hal::Hal& hal = board.hal();
+  hal::sim::SimWorld& sim = board.sim();
+  const std::uint64_t onset_us = fault.start_us;
+  const std::uint64_t end_us = fault.end_us();
+  const std::uint64_t stop_us =
+      end_us + static_cast<std::uint64_t>(std::llround(config.after_s * 1e6));
+  // The main loop's stall stops the wheels through the ODrives' own watchdog.
+  const std::uint64_t allowed_us = device == FaultDevice::kMainLoop ? 210000U : 10000U;
+  const std::uint64_t mid_us = onset_us + fault.duration_us * 3U / 4U;
+  bool asked_mid = false;
+  bool stopped_seen = false;
+  bool broke_stop = false;
+  bool after_seen = false;
+  std::uint64_t failing_since_us = 0;
+  std::uint64_t frames_at_end = 0;
+  std::uint64_t moves_at_end = 0;
+  if (config.loop_started != nullptr) config.loop_started(config.context);
+  while (hal.clock.now_us() < stop_us) {
+    rig.executive.run_frame();
+    ++out.frames;
+    const std::uint64_t now = hal.clock.now_us();
+    const bool at_rest = wheels_at_rest(sim);
+    if (now < onset_us) {
+      out.moving_before = !at_rest;
+      continue;
+    }
+    if (now < end_us) {
+      if (!rig.executive.all_healthy() || !rig.console.storage_healthy()) {
+        out.unhealthy_during = true;
+      }
+      // When the device began to misbehave: the onset, or for an intermittent fault the
+      // start of its failing slot (slots are whole frames).
+      hal::sim::FaultType active = type;
+      const bool failing = sim.faults().failing(device, active);
+      if (failing && failing_since_us == 0) {
+        const std::uint64_t slot =
+            (now / hal::sim::FaultInjector::kSlotUs) * hal::sim::FaultInjector::kSlotUs;
+        failing_since_us = type == FaultType::kIntermittent && slot > onset_us ? slot : onset_us;
+      } else if (!failing) {
+        failing_since_us = 0;
+      }
+      if (at_rest && !stopped_seen && failing_since_us != 0 &&
+          sim.last_base_stop_us() >= failing_since_us) {
+        stopped_seen = true;
+        out.stop_latency_ms =
+            static_cast<double>(sim.last_base_stop_us() - failing_since_us) * 1e-3;
+      }
+      // While the device misbehaves (after one frame's grace), the wheels must be at rest.
+      if (failing && failing_since_us != 0 && now - failing_since_us > allowed_us && !at_rest) {
+        broke_stop = true;
+      }
+      if (!asked_mid && now >= mid_us) {
+        asked_mid = true;
+        rig.port.feed("status\rstats\rfault\r");
+      }
+      frames_at_end = rig.stand_in.frames();
+      moves_at_end = rig.stand_in.ptu_moves();
+      continue;
+    }
+    if (!stopped_seen && sim.last_base_stop_us() >= onset_us && sim.last_base_stop_us() < end_us) {
+      // Stopped while no frame of the firmware ran (the main loop's stall): by the ODrives'
+      // own watchdog, and still at rest when the firmware runs again.
+      stopped_seen = true;
+      out.stop_latency_ms = static_cast<double>(sim.last_base_stop_us() - onset_us) * 1e-3;
+      broke_stop = !at_rest;
+    }
+    if (!after_seen) {
+      after_seen = true;
+      frames_at_end = rig.stand_in.frames();
+      moves_at_end = rig.stand_in.ptu_moves();
+    }
+  }
+  rig.port.feed("status\r");
+  rig.executive.run_frame();
+  rig.executive.run_frame();
+  if (config.loop_ended != nullptr) config.loop_ended(config.context);
+  out.stayed_stopped = stopped_seen && !broke_stop;
+  out.moving_after = !wheels_at_rest(sim);
+  out.healthy_after = rig.executive.all_healthy() && rig.console.storage_healthy();
+  out.camera_frames_during = frames_at_end;
+  out.camera_frames_after = rig.stand_in.frames() - frames_at_end;
+  out.ptu_moves_after = rig.stand_in.ptu_moves() - moves_at_end;
+  out.worst_frame_lag_ms = rig.stand_in.worst_lag_ms();
+  out.frame_overruns = rig.executive.frame_stats().overruns;
+  out.missed_frames = rig.executive.frame_stats().missed_frames;
+  out.watchdog_expirations = sim.watchdog_expirations();
+  out.collisions = sim.collisions();
+  if (config.state_dir != nullptr) {
+    out.saves = rig.saver.saved();
+    out.save_failures = rig.saver.failures();
+    char error[256] = "";
+    const fw::LoadResult loaded = g_store.load(g_loaded, error, sizeof error);
+    out.state_loadable =
+        loaded == fw::LoadResult::kLoaded || (loaded == fw::LoadResult::kMissing && out.saves == 0);
+  }
+  const std::string_view text = rig.port.written();
+  const std::size_t n = text.size() < out.console.size() - 1 ? text.size() : out.console.size() - 1;
+  std::memcpy(out.console.data(), text.data(), n);
+  out.console[n] = '\0';
+  out.says_expected = contains(text, expected.console_says);
+  // The verdict, on everything the expectation names.
+  bool ok = out.collisions == 0 && out.state_loadable && out.says_expected;
+  if (expected.stops_base) {
+    ok = ok && out.moving_before && out.stayed_stopped && out.stop_latency_ms >= 0.0 &&
+         out.stop_latency_ms * 1e3 <= static_cast<double>(allowed_us);
+  } else {
+    ok = ok && out.moving_before && !stopped_seen;  // nothing made a stop necessary
+  }
+  if (expected.recovers) {
+    ok = ok && out.healthy_after && out.moving_after;
+  } else {
+    ok = ok && !out.moving_after;
+  }
+  out.passed = ok;
+  out.ran = true;
+  g_rig.reset();
+  return true;
+}
+
+bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run_s,
+                    const FaultScenarioConfig& config, FaultSoakResult& out) {
+  out = FaultSoakResult{};
+  board.default_faults() = plan;
+  if (!start_rig(board, config, true, out.error, sizeof out.error)) return false;
+  Rig& rig = *g_rig;
+  hal::Hal& hal = board.hal();
+  hal::sim::SimWorld& sim = board.sim();
+  const hal::sim::FaultInjector& faults = sim.faults();
+  const auto end_us = static_cast<std::uint64_t>(std::llround(run_s * 1e6));
+  constexpr std::uint64_t kSettleUs = 1500000;
+  std::uint32_t ended_seen = 0;
+  std::uint64_t check_at_us = 0;  // a quiet check is due then (0: none)
+  std::uint64_t line_active_since_us = 0;
+  if (config.loop_started != nullptr) config.loop_started(config.context);
+  while (hal.clock.now_us() < end_us) {
+    rig.executive.run_frame();
+    ++out.frames;
+    const std::uint64_t now = hal.clock.now_us();
+    bool any_active = false;
+    bool line_active = false;
+    for (std::size_t d = 0; d < hal::sim::kFaultDeviceCount; ++d) {
+      FaultType type = FaultType::kOff;
+      const auto device = static_cast<FaultDevice>(d);
+      if (faults.active(device, type)) any_active = true;
+      if ((device == FaultDevice::kEstop || device == FaultDevice::kBumper) &&
+          faults.failing(device, type)) {
+        line_active = true;
+      }
+    }
+    // The e-stop or bumper line active: the wheels at rest after one frame's grace.
+    if (line_active) {
+      if (line_active_since_us == 0) line_active_since_us = now;
+      if (now - line_active_since_us > 10000U && !wheels_at_rest(sim)) ++out.stop_violations;
+    } else {
+      line_active_since_us = 0;
+    }
+    if (faults.ended() != ended_seen) {
+      ended_seen = faults.ended();
+      check_at_us = now + kSettleUs;
+    }
+    if (any_active) {
+      if (check_at_us != 0 && now >= check_at_us) check_at_us = now + kSettleUs;  // wait on
+      continue;
+    }
+    if (check_at_us == 0 || now < check_at_us) continue;
+    check_at_us = 0;
+    ++out.quiet_checks;
+    const bool healthy = rig.executive.all_healthy() && rig.console.storage_healthy();
+    const bool moving = !wheels_at_rest(sim);
+    bool loads = true;
+    if (config.state_dir != nullptr && rig.saver.saved() > 0) {
+      char error[256] = "";
+      loads = g_store.load(g_loaded, error, sizeof error) == fw::LoadResult::kLoaded;
+      if (!loads) ++out.state_loads_failed;
+    }
+    if (healthy && moving && loads) {
+      ++out.ended_safe;
+    } else {
+      if (out.ended_unsafe == 0) {
+        fw::TextBuffer<200> what;
+        what.appendf("t_s=%.1f moving=%d state_loads=%d storage=%d",
+                     static_cast<double>(now) * 1e-6, moving ? 1 : 0, loads ? 1 : 0,
+                     rig.console.storage_healthy() ? 1 : 0);
+        for (std::size_t i = 0; i < rig.executive.task_count(); ++i) {
+          if (const char* why = rig.executive.task_health(i); why != nullptr) {
+            what.appendf(" %s: %s", rig.executive.spec(i).name, why);
+          }
+        }
+        std::snprintf(out.first_unsafe, sizeof out.first_unsafe, "%s", what.c_str());
+      }
+      ++out.ended_unsafe;
+    }
+  }
+  if (config.loop_ended != nullptr) config.loop_ended(config.context);
+  out.sim_s = static_cast<double>(hal.clock.now_us()) * 1e-6;
+  out.faults_started = faults.started();
+  out.faults_ended = faults.ended();
+  out.collisions = sim.collisions();
+  out.saves = rig.saver.saved();
+  out.save_failures = rig.saver.failures();
+  const fw::FrameStats& f = rig.executive.frame_stats();
+  out.frame_overruns = f.overruns;
+  out.missed_frames = f.missed_frames;
+  out.worst_jitter_us = f.jitter_worst_us;
+  for (std::size_t i = 0; i < rig.executive.task_count(); ++i) {
+    const std::uint32_t w = rig.executive.task_stats(i).worst_us;
+    if (w > out.worst_task_us) out.worst_task_us = w;
+  }
+  out.console_dropped_bytes = rig.console.dropped_bytes();
+  out.watchdog_expirations = sim.watchdog_expirations();
+  out.ran = true;
+  g_rig.reset();
+  return true;
+}
+
+}  // namespace boticelli::boards::sim

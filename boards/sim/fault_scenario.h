@@ -1,0 +1,120 @@
+// FaultScenario: one injected (device, fault type) pair on the sim board with the firmware's
+// device tasks, e-stop latch, console and state saver running around a stand-in for the
+// mission that keeps the base turning and the PTU scanning — what the firmware does within
+// each frame of the fault, measured. Tests assert on it; boticelli-bench's `faults` suite
+// writes docs/reliability.md's table from it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "hal/sim/fault_plan.h"
+
+namespace boticelli::boards::sim {
+
+class SimBoard;
+
+// What the firmware is expected to do about a pair (docs/reliability.md, "Expected").
+struct FaultExpectation {
+  // Motion safety in doubt: the base is stopped within one 10 ms frame of the fault's onset
+  // and stays stopped while it lasts (the main loop's stall: within the ODrives' 0.2 s
+  // watchdog, as nothing of the firmware runs).
+  bool stops_base = false;
+  // Console text naming the device and why (a LOG line, or the reply to `status`).
+  const char* console_says = "";
+  // After the fault: every task and the storage healthy again, the stand-in moving again.
+  // False where the firmware does not restart on its own (a base that stopped by itself,
+  // the bumper: the mission ends aborted).
+  bool recovers = true;
+  // What the whole mission does with the fault for kMissionFaultS in its first look (the
+  // bench's mission column), and whether it then ends aborted (else it carries on).
+  const char* mission = "";
+  bool mission_aborts = false;
+};
+// The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the
+// mission's 3 s frame timeout, shorter than its 8 s PTU move timeout).
+inline constexpr double kMissionFaultStartS = 5.0;
+inline constexpr double kMissionFaultS = 5.0;
+const FaultExpectation& expectation(hal::sim::FaultDevice device, hal::sim::FaultType type);
+
+struct FaultScenarioConfig {
+  const char* world_file = nullptr;  // the world (thesis room when nullptr)
+  const char* state_dir = nullptr;   // state saves every second into this directory (or none)
+  std::uint64_t seed = 1;
+  double fault_start_s = 1.0;  // after the base is ready and turning
+  double fault_s = 3.0;        // the fault's duration (health reports need 2 s of stall)
+  double after_s = 1.5;        // watched after it ended
+  float camera_fps = 10.0F;
+  // Called once everything is set up and before the first frame, and after the last frame
+  // (tests count allocations in between).
+  void (*loop_started)(void* context) = nullptr;
+  void (*loop_ended)(void* context) = nullptr;
+  void* context = nullptr;
+};
+
+struct FaultScenarioResult {
+  bool ran = false;
+  char error[256] = "";
+  std::uint64_t frames = 0;
+  // The base: moving just before the onset, and how long after it the wheels were at rest
+  // (-1: not within the fault), and whether they stayed at rest until it ended.
+  bool moving_before = false;
+  double stop_latency_ms = -1.0;
+  bool stayed_stopped = false;
+  bool moving_after = false;  // turning again by the end of the run
+  // The console: the LOG lines of the run (truncated to the buffer), health afterwards.
+  std::array<char, 16384> console{};
+  bool says_expected = false;  // console_says appeared
+  bool unhealthy_during = false;
+  bool healthy_after = false;
+  // The rest of the firmware's state at the end.
+  std::uint64_t camera_frames_during = 0;  // frames the stand-in took while the fault lasted
+  std::uint64_t camera_frames_after = 0;
+  double worst_frame_lag_ms = 0.0;  // frame age when taken
+  std::uint64_t ptu_moves_after = 0;
+  std::uint64_t frame_overruns = 0;
+  std::uint64_t missed_frames = 0;
+  std::uint32_t watchdog_expirations = 0;
+  std::uint32_t collisions = 0;  // the simulator's own, from the world
+  std::uint64_t saves = 0;
+  std::uint64_t save_failures = 0;
+  bool state_loadable = true;  // the state file loads at the end (when there is one)
+  // Met the expectation in every respect it names.
+  bool passed = false;
+};
+
+// A long run under a plan of many faults (generate_fault_plan): the same rig, judged after
+// each fault has ended and nothing else is active for 1.5 s.
+struct FaultSoakResult {
+  bool ran = false;
+  char error[256] = "";
+  double sim_s = 0.0;
+  std::uint64_t frames = 0;
+  std::uint32_t faults_started = 0;
+  std::uint32_t faults_ended = 0;
+  std::uint32_t quiet_checks = 0;     // moments with no fault active, 1.5 s after one ended
+  std::uint32_t ended_safe = 0;       // ... where everything was healthy and moving again
+  std::uint32_t ended_unsafe = 0;     // ... where something was not
+  char first_unsafe[200] = "";        // what, the first time
+  std::uint64_t stop_violations = 0;  // frames moving while the e-stop or bumper line was active
+  std::uint32_t collisions = 0;
+  std::uint64_t saves = 0;
+  std::uint64_t save_failures = 0;
+  std::uint32_t state_loads_failed = 0;  // the state file did not load at a quiet check
+  std::uint64_t frame_overruns = 0;
+  std::uint64_t missed_frames = 0;
+  std::uint32_t worst_jitter_us = 0;
+  std::uint32_t worst_task_us = 0;
+  std::uint64_t console_dropped_bytes = 0;
+  std::uint32_t watchdog_expirations = 0;
+};
+bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run_s,
+                    const FaultScenarioConfig& config, FaultSoakResult& out);
+
+// Runs one pair on `board` (init()ed here with the config's world and seed). Allocates only
+// before loop_started.
+bool run_fault_scenario(SimBoard& board, hal::sim::FaultDevice device, hal::sim::FaultType type,
+                        const FaultScenarioConfig& config, FaultScenarioResult& out);
+
+}  // namespace boticelli::boards::sim

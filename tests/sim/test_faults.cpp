@@ -1,0 +1,189 @@
+// One test per (device, fault type) pair on the sim board: the fault injected at the HAL
+// boundary, the firmware's device tasks, e-stop latch, console and state saver around a
+// stand-in mission; each run is checked against its expectation (boards/sim/fault_scenario.h)
+// and for zero heap allocations from the first frame to the last.
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "fault_scenario.h"
+#include "firmware/text_buffer.h"
+#include "hal/sim/fault_plan.h"
+#include "sim_board.h"
+#include "sim_test_worlds.h"
+
+#include "alloc_guard.h"
+#include "CppUTest/TestHarness.h"
+
+using boticelli::boards::sim::FaultScenarioConfig;
+using boticelli::boards::sim::FaultScenarioResult;
+using boticelli::hal::sim::FaultDevice;
+using boticelli::hal::sim::FaultType;
+
+namespace {
+
+// The guard lives only between the scenario's first and last frame (set-up allocates).
+struct AllocationWindow {
+  std::optional<boticelli::test::AllocationGuard> guard;
+  std::size_t allocations = 0;
+};
+void start_counting(void* context) {
+  static_cast<AllocationWindow*>(context)->guard.emplace();
+}
+void stop_counting(void* context) {
+  auto* w = static_cast<AllocationWindow*>(context);
+  w->allocations = w->guard->allocations();
+  w->guard.reset();
+}
+
+FaultScenarioResult g_result;  // 16 kB of console text: static
+
+}  // namespace
+
+TEST_GROUP(Faults) {
+  std::unique_ptr<boticelli::boards::sim::SimBoard> board;
+  std::string world;
+  std::string dir;
+  void setup() override {
+    board = std::make_unique<boticelli::boards::sim::SimBoard>();
+    world = boticelli::hal::sim::test::world_path("thesis_room");
+    char templ[] = "/tmp/boticelli-faults-XXXXXX";
+    dir = mkdtemp(templ);
+  }
+  void teardown() override {
+    board.reset();
+    unlink((dir + "/mission.state").c_str());
+    unlink((dir + "/mission.state.tmp").c_str());
+    rmdir(dir.c_str());
+  }
+
+  // Runs the pair and checks it met its expectation without allocating.
+  void check_pair(FaultDevice device, FaultType type) {
+    AllocationWindow window;
+    FaultScenarioConfig config;
+    config.world_file = world.c_str();
+    config.state_dir = dir.c_str();
+    config.loop_started = start_counting;
+    config.loop_ended = stop_counting;
+    config.context = &window;
+    const bool ran =
+        boticelli::boards::sim::run_fault_scenario(*board, device, type, config, g_result);
+    CHECK_TEXT(ran, g_result.error);
+    char summary[512];
+    std::snprintf(
+        summary, sizeof summary,
+        "%s %s: moving_before=%d stop_latency_ms=%.1f stayed_stopped=%d "
+        "moving_after=%d says_expected=%d healthy_after=%d collisions=%u "
+        "state_loadable=%d\n--- console ---\n",
+        boticelli::hal::sim::fault_device_name(device), boticelli::hal::sim::fault_type_name(type),
+        g_result.moving_before ? 1 : 0, g_result.stop_latency_ms, g_result.stayed_stopped ? 1 : 0,
+        g_result.moving_after ? 1 : 0, g_result.says_expected ? 1 : 0,
+        g_result.healthy_after ? 1 : 0, g_result.collisions, g_result.state_loadable ? 1 : 0);
+    CHECK_TEXT(g_result.passed, (std::string(summary) + g_result.console.data()).c_str());
+    UNSIGNED_LONGS_EQUAL_TEXT(0U, window.allocations, "heap allocations during the fault run");
+  }
+};
+
+// The expectation for each pair is in boards/sim/fault_scenario.cpp (docs/reliability.md).
+// FAULT_PAIR runs in every build; FAULT_PAIR_MORE is ignored under the sanitizers
+// (BOTICELLI_FAULTS_QUICK), where a pair costs 15-40 s: one base and one storage pair there.
+#define FAULT_PAIR(name, device, type)                \
+  TEST(Faults, name) {                                \
+    check_pair(FaultDevice::device, FaultType::type); \
+  }
+#ifdef BOTICELLI_FAULTS_QUICK
+#define FAULT_PAIR_MORE(name, device, type)           \
+  IGNORE_TEST(Faults, name) {                         \
+    check_pair(FaultDevice::device, FaultType::type); \
+  }
+#else
+#define FAULT_PAIR_MORE(name, device, type) FAULT_PAIR(name, device, type)
+#endif
+
+FAULT_PAIR_MORE(ACameraThatIsGoneIsReportedAsGoneAndFramesComeBackAfterIt, kCamera, kOff)
+FAULT_PAIR_MORE(AFrozenCameraIsNotANewFrameAndIsReportedAsTheSameFrameAgain, kCamera, kStuck)
+FAULT_PAIR_MORE(ErrorFlaggedFramesAreDroppedAndAStallOfThemIsReported, kCamera, kGarbage)
+FAULT_PAIR_MORE(FramesOfTheWrongSizeAreNotUsedAndAreReportedAsSuch, kCamera, kWrong)
+FAULT_PAIR_MORE(ASlowCameraStillDeliversAndStaysHealthy, kCamera, kSlow)
+FAULT_PAIR_MORE(LateFramesArriveWithTheirCaptureTimeAndTheCameraStaysHealthy, kCamera, kDelayed)
+FAULT_PAIR_MORE(ACameraThatComesAndGoesKeepsDelivering, kCamera, kIntermittent)
+FAULT_PAIR_MORE(APtuThatStopsAnsweringIsAFaultHalfASecondLater, kPtu, kOff)
+FAULT_PAIR_MORE(APtuMoveThatNeverCompletesIsReportedAsNotProgressing, kPtu, kStuck)
+FAULT_PAIR_MORE(GarbledPtuRepliesAreAFaultAtOnce, kPtu, kGarbage)
+FAULT_PAIR_MORE(APtuAnsweringErrorsRefusesMovesButStaysHealthy, kPtu, kWrong)
+FAULT_PAIR_MORE(ASlowPtuKeepsMoving, kPtu, kSlow)
+FAULT_PAIR_MORE(ADelayedPtuKeepsMoving, kPtu, kDelayed)
+FAULT_PAIR_MORE(APtuWithIntermittentlyGarbledRepliesIsReported, kPtu, kIntermittent)
+FAULT_PAIR(TheLeftAxisLosingItsHeartbeatStopsTheBaseWithinAFrame, kAxisLeft, kOff)
+FAULT_PAIR_MORE(AnErrorOfTheLeftAxisStopsTheBaseWithinAFrame, kAxisLeft, kWrong)
+FAULT_PAIR_MORE(TheLeftAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kAxisLeft,
+                kIntermittent)
+FAULT_PAIR_MORE(TheRightAxisLosingItsHeartbeatStopsTheBaseWithinAFrame, kAxisRight, kOff)
+FAULT_PAIR_MORE(AnErrorOfTheRightAxisStopsTheBaseWithinAFrame, kAxisRight, kWrong)
+FAULT_PAIR_MORE(TheRightAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kAxisRight,
+                kIntermittent)
+FAULT_PAIR_MORE(ACanBusOffStopsTheBaseWithinAFrame, kCan, kOff)
+FAULT_PAIR_MORE(ACanBusGoingOffNowAndThenStopsTheBaseAtTheFirstTime, kCan, kIntermittent)
+FAULT_PAIR_MORE(ABrokenEstopLineStopsTheBaseAndTheRobotCarriesOnWhenItIsBack, kEstop, kOff)
+FAULT_PAIR_MORE(AStuckEstopStopsTheBaseAndTheRobotCarriesOnAfterTheRelease, kEstop, kStuck)
+FAULT_PAIR_MORE(AChatteringEstopKeepsTheBaseStoppedUntilItIsQuiet, kEstop, kIntermittent)
+FAULT_PAIR_MORE(ABrokenBumperLineStopsTheBaseForGood, kBumper, kOff)
+FAULT_PAIR_MORE(AStuckBumperStopsTheBaseForGood, kBumper, kStuck)
+FAULT_PAIR_MORE(AChatteringBumperStopsTheBaseForGood, kBumper, kIntermittent)
+FAULT_PAIR_MORE(AnUnwritableStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kOff)
+FAULT_PAIR(AFullStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kWrong)
+FAULT_PAIR_MORE(StateSavesFailingNowAndThenAreReportedAndTheLastGoodFileStays, kStorage,
+                kIntermittent)
+FAULT_PAIR_MORE(AStalledMainLoopIsCaughtByTheOdrivesWatchdogWithinItsTimeout, kMainLoop, kStuck)
+FAULT_PAIR_MORE(ASlowMainLoopOverrunsItsFramesAndKeepsTheBaseUnderControl, kMainLoop, kSlow)
+
+TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
+  int pairs = 0;
+  for (std::size_t d = 0; d < boticelli::hal::sim::kFaultDeviceCount; ++d) {
+    for (std::size_t t = 0; t < boticelli::hal::sim::kFaultTypeCount; ++t) {
+      const auto device = static_cast<FaultDevice>(d);
+      const auto type = static_cast<FaultType>(t);
+      if (!boticelli::hal::sim::fault_applies(device, type)) continue;
+      ++pairs;
+      CHECK_TEXT(boticelli::boards::sim::expectation(device, type).console_says[0] != '\0',
+                 boticelli::hal::sim::fault_device_name(device));
+    }
+  }
+  CHECK_EQUAL(33, pairs);  // the FAULT_PAIR tests above
+}
+
+TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {
+  boticelli::firmware::Options options;
+  options.world_file = world.c_str();
+  board->settings().camera_fps = 5.0F;
+  CHECK_TEXT(board->init(options, g_result.error, sizeof g_result.error), g_result.error);
+  boticelli::hal::Hal& hal = board->hal();
+  CHECK(hal.camera.init());
+  boticelli::firmware::TextBuffer<200> reply;
+  CHECK_FALSE(board->inject("toaster", "off", 1.0, reply));
+  STRCMP_CONTAINS("unknown device", reply.c_str());
+  reply.clear();
+  CHECK_FALSE(board->inject("estop", "garbage", 1.0, reply));
+  STRCMP_EQUAL("estop cannot be garbage", reply.c_str());
+  reply.clear();
+  CHECK_FALSE(board->inject("main-loop", "stuck", 0.0, reply));
+  STRCMP_CONTAINS("needs SECONDS", reply.c_str());
+  reply.clear();
+  hal.clock.sleep_until_us(500000);
+  CHECK(board->inject("camera", "off", 2.0, reply));
+  STRCMP_EQUAL("fault camera off seconds=2.0 from_t_s=0.50", reply.c_str());
+  boticelli::hal::Frame frame;
+  CHECK(hal.camera.poll(frame) == boticelli::hal::CameraPoll::kFault);
+  STRCMP_CONTAINS("device gone", hal.camera.error());
+  reply.clear();
+  board->describe_active(reply);
+  STRCMP_EQUAL("fault camera off since_t_s=0.50 until_t_s=2.50\r\n", reply.c_str());
+  hal.clock.sleep_until_us(2600000);
+  CHECK(hal.camera.poll(frame) == boticelli::hal::CameraPoll::kFrame);
+  reply.clear();
+  board->describe_active(reply);
+  STRCMP_EQUAL("", reply.c_str());
+}
