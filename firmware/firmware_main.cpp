@@ -348,6 +348,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
   console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
               mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
+  if (mission.guard_truncated_looks() > 0) {
+    console.log(LogLevel::kWarn, "mission guard_truncated_looks=%u (a full list dropped readings)",
+                static_cast<unsigned>(mission.guard_truncated_looks()));
+  }
   {
     // The longest unit of each kind [ms of host thread CPU]: what a slice or the mission
     // task's budget must hold on the robot.

@@ -730,6 +730,9 @@ void Mission::begin_think() {
 void Mission::after_think() {
   const mapping::LocalMap& local = builder_.map();
   last_pieces_ = static_cast<std::uint32_t>(builder_.stats().pieces);
+  if (builder_.stats().guard_dropped > 0 || builder_.stats().guard_points_full) {
+    ++guard_truncated_looks_;
+  }
   // Map points (§5.4.4): obstacles where evidence backs the polygon's boundary; exploration
   // points on the bounding circle and where only the lack of seen floor cuts it.
   cycle_obstacles_.clear();

@@ -66,7 +66,8 @@ MissionParams make_mission_params(const BoardConfig& c) {
   // step after 20 cycles (found in 18 without), so it waits for the Think-stage fixes.
   p.stereo.target_range_from_edges = false;
 
-  // Look.
+  // Look: features down to the image's bottom border (see FeatureParams).
+  p.stereo.features.band_half_height_below_at_f150_px = 60.0F;
   p.pan_positions = std::max<std::uint32_t>(c.look_pan_positions, 1);
   p.row_count = std::min<std::size_t>(c.look_tilt_rows, BoardConfig::kMaxTiltRows);
   for (std::size_t i = 0; i < p.row_count; ++i) {

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "algo/core/fixed_vector.h"
@@ -192,4 +193,63 @@ TEST(Image, AMatchThatLeftTheImageIsNotReportedAtTheBorder) {
   const Track t = track_feature(a, 60, 40, b, inside, params);
   CHECK(t.found);
   DOUBLES_EQUAL(32.0, t.v_px, 0.05);
+}
+
+TEST(Image, TheBandReachesTheImageBottomWhenItsLowerHalfIsSetApart) {
+  LowResFrame& f = frame_a();
+  fill_pattern(f, 0.0F);
+  static core::FixedVector<Feature, 1024> features;
+  const BandGeometry band{79.5F, 59.5F, 150.0F};
+  const auto lowest = [&](const FeatureParams& params) {
+    FeatureSelector selector(params);
+    selector.select(f, band, features);
+    std::uint32_t v_max = 0;
+    std::uint32_t v_min = f.height;
+    for (const Feature& a : features) {
+      v_max = std::max<std::uint32_t>(v_max, a.v_px);
+      v_min = std::min<std::uint32_t>(v_min, a.v_px);
+    }
+    return std::pair{v_min, v_max};
+  };
+  FeatureParams thesis;
+  thesis.max_features = 1000;
+  const auto [top, bottom] = lowest(thesis);
+  CHECK(bottom <= 99U);  // 59.5 + 40
+  FeatureParams low = thesis;
+  low.band_half_height_below_at_f150_px = 60.0F;
+  const auto [top_low, bottom_low] = lowest(low);
+  LONGS_EQUAL(top, top_low);  // the upper half is the thesis's
+  CHECK(bottom_low > 110U);   // down to the 5x5 window's and the 3x3 test's border
+  CHECK(bottom_low <= f.height - 4U);
+}
+
+// An occlusion edge: a near surface (dark, rows above the edge) over a far one (bright, with
+// a dark line two rows below the edge). Between the frames the near surface moves up 10 rows
+// and the far one 8, so the centred 5x5 window, which holds both, matches neither.
+TEST(Image, AShiftedWindowMatchesTheNearSideOfAnOcclusionEdge) {
+  LowResFrame& a = frame_a();
+  LowResFrame& b = frame_b();
+  const auto scene = [](LowResFrame& f, int edge_row, int line_row) {
+    f.width = 160;
+    f.height = 120;
+    for (std::uint32_t v = 0; v < f.height; ++v) {
+      for (std::uint32_t u = 0; u < f.width; ++u) {
+        const int row = static_cast<int>(v);
+        f.luma[f.index(u, v)] = row < edge_row ? 60.0F : (row == line_row ? 110.0F : 170.0F);
+      }
+    }
+  };
+  scene(a, 60, 62);
+  scene(b, 50, 54);
+  const EpipolarSegment segment{80.0F, 56.0F, 80.0F, 40.0F};  // infinity at 56, near at 40
+  TrackParams params;
+  const Track centred = track_feature(a, 80, 60, b, segment, params);
+  CHECK_FALSE(centred.found);
+  CHECK(centred.match_error > params.match_error_thresh);
+  params.window_shift_px = 2;
+  Track t;
+  CHECK_NO_ALLOCATION(t = track_feature(a, 80, 60, b, segment, params));
+  CHECK(t.found);
+  DOUBLES_EQUAL(50.0, t.v_px, 0.1);  // the edge's own motion, not the far surface's
+  DOUBLES_EQUAL(80.0, t.u_px, 1e-3);
 }

@@ -1,5 +1,6 @@
 // Tests of the feature guard: unexplained features, their corroboration, and the polygon kept
 // clear of them.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -47,7 +48,8 @@ Reading at(float alpha, float rho, float h, float m = 0.9F) {
   return {alpha, h, std::sqrt(rho * rho + h * h), m};
 }
 
-// n features on the front face of a small box 1 m ahead: pan ±0.1 rad, heights -0.54..-0.24.
+// n features on the front face of a small box 1 m ahead: pan ±0.1 rad, heights -0.48..-0.24
+// (0.12 m and more above the floor: lower ones are the floor's line of sight within 2 δr).
 template <std::size_t N>
 void box_face(FixedVector<Reading, N>& out, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
@@ -55,7 +57,7 @@ void box_face(FixedVector<Reading, N>& out, std::size_t n) {
     const float v = static_cast<float>(i / 7 % 5) / 4.0F;
     const float alpha = -0.1F + 0.2F * u;
     (void)out.push_back(
-        at(alpha < 0.0F ? alpha + 6.2831853F : alpha, 1.0F / std::cos(alpha), -0.54F + 0.3F * v));
+        at(alpha < 0.0F ? alpha + 6.2831853F : alpha, 1.0F / std::cos(alpha), -0.48F + 0.24F * v));
   }
 }
 
@@ -75,7 +77,7 @@ float far_wall(float /*alpha*/, float h, float r) {
 }
 
 // n readings of the front face of a 0.5 m box 2.5 m ahead (pan ±0.1 rad, heights
-// -0.54..-0.24 m), each with a range error uniform in ±error_m (median |error| error_m / 2).
+// -0.48..-0.24 m), each with a range error uniform in ±error_m (median |error| error_m / 2).
 template <std::size_t N>
 void noisy_box(FixedVector<Reading, N>& out, std::size_t n, float error_m, Uniform& noise) {
   for (std::size_t i = 0; i < n; ++i) {
@@ -83,7 +85,7 @@ void noisy_box(FixedVector<Reading, N>& out, std::size_t n, float error_m, Unifo
     const float v = static_cast<float>(i / 6 % 4) / 3.0F;
     const float alpha = -0.1F + 0.2F * u;
     Reading rd =
-        at(alpha < 0.0F ? alpha + 6.2831853F : alpha, 2.5F / std::cos(alpha), -0.54F + 0.3F * v);
+        at(alpha < 0.0F ? alpha + 6.2831853F : alpha, 2.5F / std::cos(alpha), -0.48F + 0.24F * v);
     rd.r_m += error_m * noise.next();
     (void)out.push_back(rd);
   }
@@ -128,6 +130,39 @@ TEST(FeatureGuard, OnlySurfacesTheModelCallsFreeInTheRobotsHeightBandAreCandidat
   (void)mapping::collect_unexplained_features(readings, wall_only, robot(), strong_only,
                                               candidates);
   LONGS_EQUAL(2, candidates.size());
+}
+
+TEST(FeatureGuard, FloorMismatchesAreNotCandidatesButTheFloorCuesBasesAndLowSurfacesAre) {
+  // Floor points 0.6-1.0 m ahead (PTU 0.6 m up) read 11-15% short along their rays: they lie
+  // 0.07-0.09 m above the floor, inside the robot's band, and within 2 δr of the floor.
+  FixedVector<Reading, 64> readings;
+  for (int i = 0; i < 20; ++i) {
+    const float rho = 0.6F + 0.02F * static_cast<float>(i);
+    const float shrink = 0.85F + 0.002F * static_cast<float>(i);
+    const Reading floor = at(0.05F * static_cast<float>(i % 5), rho, -0.6F);
+    (void)readings.push_back({floor.alpha_rad, floor.h_m * shrink, floor.r_m * shrink, 0.9F});
+  }
+  FixedVector<mapping::GuardPoint, 64> candidates;
+  (void)mapping::collect_unexplained_features(readings, wall_only, robot(),
+                                              mapping::FeatureGuardParams{}, candidates);
+  LONGS_EQUAL(0, candidates.size());
+  // The same points as the floor cue's obstacle bases: all candidates.
+  (void)mapping::collect_unexplained_features(readings, wall_only, robot(),
+                                              mapping::FeatureGuardParams{}, candidates, true);
+  LONGS_EQUAL(20, candidates.size());
+  // With the rule off, stereo features there are candidates too.
+  candidates.clear();
+  mapping::FeatureGuardParams off;
+  off.floor_delta_r_factor = 0.0F;
+  (void)mapping::collect_unexplained_features(readings, wall_only, robot(), off, candidates);
+  LONGS_EQUAL(20, candidates.size());
+  // A surface 0.15 m above the floor at 0.8 m is more than 2 δr short of the floor: kept.
+  readings.clear();
+  candidates.clear();
+  (void)readings.push_back(at(0.2F, 0.8F, -0.45F));
+  (void)mapping::collect_unexplained_features(readings, wall_only, robot(),
+                                              mapping::FeatureGuardParams{}, candidates);
+  LONGS_EQUAL(1, candidates.size());
 }
 
 TEST(FeatureGuard, AFullCandidateListCountsWhatItCouldNotKeep) {
@@ -178,7 +213,8 @@ TEST(FeatureGuard, NoisyReadingsOfABoxAreKeptWhereAFixedRadiusKeepsFew) {
     CHECK_TRUE(q.x_m > 2.05F && q.x_m < 2.95F && std::fabs(q.y_m) < 0.35F);
   }
   mapping::FeatureGuardParams fixed;
-  fixed.neighbour_delta_r_factor = 0.0F;  // the old rule: 0.1 m whatever the range
+  fixed.neighbour_delta_r_factor = 0.0F;  // the old rule: a 0.1 m ball whatever the range
+  fixed.lateral_radius_m = 0.0F;
   CHECK_TRUE(kept_by(candidates, fixed, kept) <= 5);
 }
 
@@ -202,8 +238,22 @@ TEST(FeatureGuard, IsolatedOutliersAreNotKeptThoughTheRadiusGrowsWithRange) {
   }
 }
 
+TEST(FeatureGuard, NeighboursAreFoundAlongTheLineOfSightWithinTheSummedRangeError) {
+  const mapping::FeatureGuardParams g;  // δr = 0.1 r, 0.25 m across the line of sight
+  // Along the line of sight (x axis) at 2 m and 2.4 m: 0.4 ≤ 0.2 + 0.24 m.
+  const mapping::GuardPoint a{2.0F, 0.0F, 0.0F, 2.0F};
+  CHECK_TRUE(mapping::are_neighbours(a, {2.4F, 0.0F, 0.0F, 2.4F}, g));
+  CHECK_FALSE(mapping::are_neighbours(a, {2.6F, 0.0F, 0.0F, 2.6F}, g));  // 0.6 > 0.46 m
+  // Across it the range error does not count: 0.24 m is near, 0.3 m is not, though both are
+  // well within 0.5 m.
+  CHECK_TRUE(mapping::are_neighbours(a, {2.0F, 0.24F, 0.0F, 2.01F}, g));
+  CHECK_FALSE(mapping::are_neighbours(a, {2.0F, 0.3F, 0.0F, 2.02F}, g));
+  CHECK_FALSE(mapping::are_neighbours(a, {2.0F, 0.0F, 0.3F, 2.02F}, g));  // above, too
+}
+
 TEST(FeatureGuard, NeighboursAreFoundWithinTheSummedRangeErrorOfThePair) {
   mapping::FeatureGuardParams g;  // δr = 0.1 r
+  g.lateral_radius_m = 0.0F;      // a ball of that radius
   // Two readings at 2 m and 3 m: 0.2 + 0.3 = 0.5 m.
   const mapping::GuardPoint a{2.0F, 0.0F, 0.0F, 2.0F};
   CHECK_TRUE(mapping::are_neighbours(a, {2.0F, 0.49F, 0.0F, 3.0F}, g));
@@ -293,4 +343,53 @@ TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
     mapping::extract_local_map(free_range, p, map, scratch, guard);
   });
   LONGS_EQUAL(35, guard.size());
+}
+
+// More candidates than the first wave's list held (2,048; looks on rendered frames have up to
+// 6,700): clusters and strays over a 5 m square, ranges 0.5–5 m. Sorted by x, the windowed
+// search must keep exactly the points the all-pairs search keeps.
+TEST(FeatureGuard, SortedCandidatesKeepTheSamePointsAsTheAllPairsSearch) {
+  static GuardCandidatesFor<mapping::kMaxGuardCandidates> candidates;
+  candidates.clear();
+  std::uint32_t state = 12345U;
+  const auto next = [&state]() {  // uniform in [0, 1)
+    state = state * 1664525U + 1013904223U;
+    return static_cast<float>(state >> 8) / 16777216.0F;
+  };
+  for (int c = 0; c < 700; ++c) {
+    const float cx = -2.5F + 5.0F * next();
+    const float cy = -2.5F + 5.0F * next();
+    const int members = c % 3 == 0 ? 1 : 2 + c % 9;  // a third are strays
+    for (int k = 0; k < members; ++k) {
+      const float x = cx + 0.15F * (next() - 0.5F);
+      const float y = cy + 0.15F * (next() - 0.5F);
+      const float h = -0.5F + 0.6F * next();
+      (void)candidates.push_back({x, y, h, std::hypot(x, y), next() < 0.3F ? 0.5F : 0.9F});
+    }
+  }
+  CHECK(candidates.size() > 2048U);
+  static FixedVector<Point2, mapping::kMaxGuardPoints> all_pairs;
+  static FixedVector<Point2, mapping::kMaxGuardPoints> windowed;
+  all_pairs.clear();
+  windowed.clear();
+  CHECK_TRUE(
+      mapping::corroborated_points(candidates.span(), mapping::FeatureGuardParams{}, all_pairs));
+  CHECK_NO_ALLOCATION(mapping::sort_guard_candidates(candidates.span()));
+  // In bounded slices, as the local model builder runs it.
+  for (std::size_t first = 0; first < candidates.size(); first += 256) {
+    CHECK_TRUE(mapping::corroborated_points(candidates.span(), first, first + 256,
+                                            mapping::FeatureGuardParams{}, windowed));
+  }
+  CHECK(all_pairs.size() > 1000U);
+  CHECK(all_pairs.size() < candidates.size());  // the strays are not kept
+  LONGS_EQUAL(all_pairs.size(), windowed.size());
+  const auto by_xy = [](const Point2& a, const Point2& b) {
+    return a.x_m < b.x_m || (a.x_m == b.x_m && a.y_m < b.y_m);
+  };
+  std::sort(all_pairs.begin(), all_pairs.end(), by_xy);
+  std::sort(windowed.begin(), windowed.end(), by_xy);
+  for (std::size_t i = 0; i < all_pairs.size(); ++i) {
+    CHECK_EQUAL(all_pairs[i].x_m, windowed[i].x_m);
+    CHECK_EQUAL(all_pairs[i].y_m, windowed[i].y_m);
+  }
 }

@@ -375,3 +375,21 @@ TEST(LocalModelBuilder, StartingAndSteppingDoNotAllocate) {
   CHECK(g_other.done());
   CHECK(g_other.map().can_move);
 }
+
+TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
+  // Only the floor cue's reports, 0.05 m above the floor (on the floor's line of sight within
+  // 2 δr, where stereo features are not candidates) and weak (m = 0.5: their ray samples
+  // plateau below m_safe, so the fit never holds them): every one is a guard candidate.
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    (void)look.obstacles.push_back(at(alpha, 2.0F, 0.05F, 0.5F));
+    (void)look.free.push_back(at(alpha, 1.97F, 0.0F, 0.0F));
+  }
+  g_other.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+  UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_candidates);
+}

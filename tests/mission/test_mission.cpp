@@ -161,7 +161,9 @@ TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose
                                 {static_cast<float>(odo[0]), static_cast<float>(odo[1])});
   const double drift = std::hypot(static_cast<double>(odo_world.x_m) - last.x_m,
                                   static_cast<double>(odo_world.y_m) - last.y_m);
-  CHECK_TEXT(drift > 0.02, "2% odometry noise should carry odometry away from the true pose");
+  // Without noise this run's odometry ends 0.014 mm from the truth; with it, 17 mm.
+  const std::string drift_text = "odometry " + std::to_string(drift) + " m from the true pose";
+  CHECK_TEXT(drift > 0.005, drift_text.c_str());
   std::remove(r.trace_path.c_str());
 }
 

@@ -323,7 +323,8 @@ bool target_in_image(const hal::sim::RigidTransform& first, const hal::sim::Rigi
 struct WorldStats {
   std::vector<double> readings, floor_obstacles, floor_free, weak_share;
   std::vector<double> range_error_m, range_error_rel;  // |r − r_true| [m] and / δr (Eq 3.7)
-  std::vector<double> safety, coverage, nav_safety, free_area, nav_area, pieces;
+  std::vector<double> safety, coverage, nav_safety, free_area, nav_area, pieces, guard_points;
+  std::size_t guard_truncated = 0;
   std::vector<double> render_ms, stereo_ms, target_ms, floor_ms, think_ms;
   std::size_t target_views = 0, target_found = 0, target_far = 0, target_false = 0;
   std::vector<double> target_error_m, target_far_error_m;
@@ -481,6 +482,9 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     g_builder.run();
     st.think_ms.push_back(static_cast<double>(cpu_ns() - t0) * 1e-6);
     st.pieces.push_back(static_cast<double>(g_builder.stats().pieces));
+    st.guard_points.push_back(static_cast<double>(g_builder.stats().guard_points));
+    st.guard_truncated +=
+        g_builder.stats().guard_dropped > 0 || g_builder.stats().guard_points_full ? 1U : 0U;
     st.render_ms.push_back(render_ns * 1e-6);
     st.stereo_ms.push_back(stereo_ns * 1e-6);
     st.target_ms.push_back(target_ns * 1e-6);
@@ -527,6 +531,8 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .num("range_err_p90_dr", percentile(st.range_error_rel, 0.9))
       .num("range_err_p99_dr", percentile(st.range_error_rel, 0.99))
       .num("pieces", mean(st.pieces))
+      .num("guard_points", mean(st.guard_points))
+      .integer("looks_guard_truncated", static_cast<std::int64_t>(st.guard_truncated))
       .num("safety", mean(st.safety))
       .num("safety_min", min_safety)
       .num("coverage", mean(st.coverage))

@@ -177,7 +177,10 @@ float match_error(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
   return error_against(feature, second, static_cast<int>(u2), static_cast<int>(v2));
 }
 
-Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
+namespace {
+
+// track_feature with the centred window only.
+Track track_centred(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
                     const LowResFrame& second, const EpipolarSegment& segment,
                     const TrackParams& params) {
   Track track;
@@ -269,6 +272,47 @@ Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1
   track.u_px = segment.far_u_px + slope * (v_sub - segment.far_v_px);
   track.v_px = v_sub;
   return track;
+}
+
+}  // namespace
+
+Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
+                    const LowResFrame& second, const EpipolarSegment& segment,
+                    const TrackParams& params) {
+  const Track centred = track_centred(first, u1, v1, second, segment, params);
+  // Only a match that was distinctive but too poor: one that was not distinctive is
+  // repeated texture, which another window does not make unique.
+  const bool distinctive = params.distinctiveness >= 1.0F ||
+                           !(centred.runner_up_error < std::numeric_limits<float>::max()) ||
+                           centred.match_error < params.distinctiveness * centred.runner_up_error;
+  if (centred.found || params.window_shift_px == 0 || centred.match_error <= 0.0F || !distinctive) {
+    return centred;
+  }
+  // Shifted windows: the window of pixel (u1, v1 + s) moved along the same line, s = −shift
+  // then +shift (the motion is nearly vertical, so the shifted pixel's line is the same
+  // line shifted by s rows). The match of (u1, v1) is that window's match minus s.
+  Track best = centred;
+  const auto shift = static_cast<float>(params.window_shift_px);
+  for (const float s : {-shift, shift}) {
+    const float v_shifted = static_cast<float>(v1) + s;
+    if (v_shifted < 0.0F) {
+      continue;
+    }
+    EpipolarSegment moved = segment;
+    moved.far_v_px += s;
+    moved.near_v_px += s;
+    Track t =
+        track_centred(first, u1, static_cast<std::uint32_t>(v_shifted), second, moved, params);
+    if (t.found && (!best.found || t.match_error < best.match_error)) {
+      t.v_px -= s;
+      const float dv_total = segment.near_v_px - segment.far_v_px;
+      const float slope =
+          std::fabs(dv_total) > 1e-3F ? (segment.near_u_px - segment.far_u_px) / dv_total : 0.0F;
+      t.u_px = segment.far_u_px + slope * (t.v_px - segment.far_v_px);
+      best = t;
+    }
+  }
+  return best;
 }
 
 }  // namespace boticelli::image

@@ -18,11 +18,15 @@ std::size_t FeatureSelector::select(const LowResFrame& frame, const BandGeometry
   const float scale = band.focal_px / 150.0F;
   const float half_w = params_.band_half_width_at_f150_px * scale;
   const float half_h = params_.band_half_height_at_f150_px * scale;
+  const float half_h_below =
+      (params_.band_half_height_below_at_f150_px > 0.0F ? params_.band_half_height_below_at_f150_px
+                                                        : params_.band_half_height_at_f150_px) *
+      scale;
   // Band limits, kept 2 px from the border for the 5x5 window and 1 more for the 3x3 test.
   const int u0 = std::max(3, static_cast<int>(std::ceil(band.principal_x_px - half_w)));
   const int u1 = std::min(w - 4, static_cast<int>(std::floor(band.principal_x_px + half_w)));
   const int v0 = std::max(3, static_cast<int>(std::ceil(band.principal_y_px - half_h)));
-  const int v1 = std::min(h - 4, static_cast<int>(std::floor(band.principal_y_px + half_h)));
+  const int v1 = std::min(h - 4, static_cast<int>(std::floor(band.principal_y_px + half_h_below)));
   if (u0 > u1 || v0 > v1) {
     return 0;
   }

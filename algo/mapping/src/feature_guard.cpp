@@ -11,10 +11,24 @@ bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuard
   // δr_a + δr_b (§3.7.3): see FeatureGuardParams for why the sum.
   const float delta_r = g.delta_r_fraction * (std::fabs(a.r_m) + std::fabs(b.r_m));
   const float radius = std::fmax(g.neighbour_radius_m, g.neighbour_delta_r_factor * delta_r);
-  const float dx = a.x_m - b.x_m;
-  const float dy = a.y_m - b.y_m;
-  const float dh = a.h_m - b.h_m;
-  return dx * dx + dy * dy + dh * dh <= radius * radius;
+  const float dx = b.x_m - a.x_m;
+  const float dy = b.y_m - a.y_m;
+  const float dh = b.h_m - a.h_m;
+  const float d2 = dx * dx + dy * dy + dh * dh;
+  if (!(g.lateral_radius_m > 0.0F)) {
+    return d2 <= radius * radius;
+  }
+  // Along and across the mean line of sight from the PTU centre: the range error lies along
+  // it; across it a reading is off by a pixel or two.
+  const float sx = a.x_m + b.x_m;
+  const float sy = a.y_m + b.y_m;
+  const float sh = a.h_m + b.h_m;
+  const float s2 = sx * sx + sy * sy + sh * sh;
+  const float along = s2 > 1e-12F ? (dx * sx + dy * sy + dh * sh) / std::sqrt(s2) : 0.0F;
+  const float across2 = std::fmax(d2 - along * along, 0.0F);
+  // Never wider across than the ball the range error alone would allow.
+  const float lateral = std::fmin(g.lateral_radius_m, radius);
+  return std::fabs(along) <= radius && across2 <= lateral * lateral;
 }
 
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
@@ -22,16 +36,47 @@ bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGu
   return corroborated_points(candidates, 0, candidates.size(), g, out);
 }
 
+void sort_guard_candidates(std::span<GuardPoint> candidates) {
+  std::sort(candidates.begin(), candidates.end(),
+            [](const GuardPoint& a, const GuardPoint& b) { return a.x_m < b.x_m; });
+}
+
 bool corroborated_points(std::span<const GuardPoint> candidates, std::size_t first,
                          std::size_t last, const FeatureGuardParams& g, GuardPoints& out) {
+  // Sorted by x (sort_guard_candidates): only candidates within the largest radius a pair
+  // with this one can have, along x, can be neighbours; else every pair is tried.
+  const bool sorted =
+      std::is_sorted(candidates.begin(), candidates.end(),
+                     [](const GuardPoint& a, const GuardPoint& b) { return a.x_m < b.x_m; });
+  float r_max = 0.0F;
+  for (const GuardPoint& c : candidates) {
+    r_max = std::fmax(r_max, std::fabs(c.r_m));
+  }
   bool ok = true;
-  for (std::size_t i = first; i < std::min(last, candidates.size()); ++i) {
+  const std::size_t n = candidates.size();
+  for (std::size_t i = first; i < std::min(last, n); ++i) {
     const GuardPoint& a = candidates[i];
     const std::size_t required = a.m < g.min_evidence ? g.min_weak_neighbours : g.min_neighbours;
     std::size_t neighbours = 0;
-    for (std::size_t j = 0; j < candidates.size() && neighbours < required; ++j) {
-      if (j != i && are_neighbours(a, candidates[j], g)) {
-        ++neighbours;
+    if (sorted) {
+      // |Δx| ≤ |b − a| ≤ along + across bound.
+      const float reach =
+          std::fmax(g.neighbour_radius_m,
+                    g.neighbour_delta_r_factor * g.delta_r_fraction * (std::fabs(a.r_m) + r_max)) +
+          std::fmax(g.lateral_radius_m, 0.0F);
+      for (std::size_t j = i + 1; j < n && neighbours < required; ++j) {
+        if (candidates[j].x_m - a.x_m > reach) break;
+        neighbours += are_neighbours(a, candidates[j], g) ? 1U : 0U;
+      }
+      for (std::size_t j = i; j-- > 0 && neighbours < required;) {
+        if (a.x_m - candidates[j].x_m > reach) break;
+        neighbours += are_neighbours(a, candidates[j], g) ? 1U : 0U;
+      }
+    } else {
+      for (std::size_t j = 0; j < n && neighbours < required; ++j) {
+        if (j != i && are_neighbours(a, candidates[j], g)) {
+          ++neighbours;
+        }
       }
     }
     if (neighbours >= required && !out.push_back({a.x_m, a.y_m})) {

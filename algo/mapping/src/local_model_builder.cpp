@@ -23,6 +23,12 @@ std::size_t vertex_of(const StarPolygon& p, float alpha_rad) {
   return k % n;
 }
 
+// The robot's disc and its clearance margin, a little more so the shrunk polygon keeps a point:
+// free at every look (the robot stands there).
+float own_disc_m(const ExtractionParams& p) {
+  return p.robot_radius_m + p.clearance_margin_m + 0.02F;
+}
+
 }  // namespace
 
 void LocalModelBuilder::start(const LocalModelParams& params,
@@ -124,17 +130,24 @@ bool LocalModelBuilder::step() {
     case Phase::kGuardObstacles: {
       const auto occupancy = [this](float a, float h, float r) { return this->occupancy(a, h, r); };
       const bool features = phase_ == Phase::kGuardFeatures;
-      (void)collect_unexplained_features(features ? features_ : obstacles_, occupancy,
-                                         params_.extraction, params_.guard, candidates_);
+      const std::size_t lost =
+          collect_unexplained_features(features ? features_ : obstacles_, occupancy,
+                                       params_.extraction, params_.guard, candidates_, !features);
+      stats_.guard_dropped += lost;
+      if (!features) {
+        sort_guard_candidates(candidates_.span());
+      }
       phase_ = features ? Phase::kGuardObstacles : Phase::kGuardPoints;
       guard_cursor_ = 0;
       return false;
     }
     case Phase::kGuardPoints: {
-      // O(n²) over the candidates: a bounded slice of them per unit.
+      // A bounded slice of the candidates (sorted by x) per unit, each against its reach.
       const std::size_t end =
           std::min(candidates_.size(), guard_cursor_ + params_.guard_candidates_per_unit);
-      (void)corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_);
+      if (!corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_)) {
+        stats_.guard_points_full = true;
+      }
       guard_cursor_ = end;
       if (guard_cursor_ == candidates_.size()) {
         stats_.guard_candidates = candidates_.size();
@@ -194,7 +207,7 @@ void LocalModelBuilder::build_seen_free() {
   // The robot stands on its own disc: that much is free whatever was seen (an unseen sector
   // must not pin the robot where it is; the shrink still keeps it off the unknown). After the
   // gap fill, which looks for unseen (0) vertices.
-  const float own = p.robot_radius_m + p.clearance_margin_m + 0.02F;
+  const float own = own_disc_m(p);
   for (std::size_t k = 0; k < seen_free_.vertex_count(); ++k) {
     seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), own));
   }
@@ -208,6 +221,15 @@ void LocalModelBuilder::extract() {
     for (std::size_t i = 1; i < heights; ++i) {
       extract_slice(free_range_, slice_height_m(p, i), p, scratch_);
       (void)intersect_into(obstacle_polygon_, scratch_);
+    }
+    // The robot stands on its own disc, and the step that brought it here kept the disc and
+    // its margin inside the last look's navigable polygon: a crossing of the fit nearer than
+    // that is the fit's extrapolation into space no line of sight crosses (near a wall the
+    // body's top slice, 0.2 m over the PTU, is in view only from 0.62 m on), not evidence.
+    // Evidence still cuts nearer: guard points and floor-cue bases, below.
+    const float own = own_disc_m(p);
+    for (std::size_t k = 0; k < obstacle_polygon_.vertex_count(); ++k) {
+      obstacle_polygon_.set_rho_m(k, std::max(obstacle_polygon_.rho_m(k), own));
     }
   } else {
     obstacle_polygon_.set_vertex_count(p.vertex_count);  // nothing known: nothing free

@@ -135,6 +135,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] double look_cpu_s() const { return cpu_s_[0]; }
   [[nodiscard]] double think_cpu_s() const { return cpu_s_[1]; }
   [[nodiscard]] double plan_cpu_s() const { return cpu_s_[2]; }
+  // Looks whose feature guard dropped readings because a fixed list was full (0 expected).
+  [[nodiscard]] std::uint32_t guard_truncated_looks() const { return guard_truncated_looks_; }
   // The longest single unit of each kind so far [s of host thread CPU].
   [[nodiscard]] double longest_unit_s(Unit unit) const {
     return longest_s_[static_cast<std::size_t>(unit)];
@@ -243,6 +245,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   TargetTracker tracker_;
   std::uint32_t last_features_ = 0;
   std::uint32_t last_pieces_ = 0;
+  std::uint32_t guard_truncated_looks_ = 0;
 
   // Think and plan.
   mapping::LocalModelBuilder builder_;

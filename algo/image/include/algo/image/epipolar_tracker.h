@@ -31,6 +31,12 @@ struct TrackParams {
   // After the parabola, a few Gauss-Newton steps along the line on bilinearly sampled
   // luma (a one-dimensional Lucas-Kanade): beats the parabola's bias towards whole pixels.
   bool refine_along_line = true;
+  // Multiple windows (Fusiello, Roberto & Trucco 1997): when the centred 5x5 window finds
+  // no match, the windows shifted this many rows up and down are tried, and the better match
+  // kept. At an occlusion edge (the rim of an overhang against the floor behind it) the
+  // centred window holds both surfaces, which move differently between the frames, so it
+  // matches neither; a shifted window lies on one side. 0: the thesis's single window.
+  std::uint32_t window_shift_px = 0;
 };
 
 struct Track {

@@ -21,7 +21,12 @@ struct FeatureParams {
   std::size_t max_features = 500;  // cap on the features per frame (§3.4.1: about 500)
   // Central band |i| ≤ 53, |j| ≤ 40 at F = 150 px (§3.4.1); scaled by the actual F.
   float band_half_width_at_f150_px = 53.0F;
-  float band_half_height_at_f150_px = 40.0F;
+  float band_half_height_at_f150_px = 40.0F;  // above the principal point (and below, unless set)
+  // Below the principal point, if > 0: a point low in the first frame is higher in the second,
+  // tilted down by Φ, so the band may reach the image's bottom; the thesis's band stops at 40
+  // rows, leaving a gap between two tilt rows 0.5 rad apart in which an overhang 0.3 m up at
+  // 1 m falls (its rim is below the upper row's band and above the lower row's).
+  float band_half_height_below_at_f150_px = 0.0F;
   float min_strength = 2.0F;  // weaker derivatives are not features [grey levels per px]
 };
 

@@ -42,6 +42,11 @@ struct FeatureGuardParams {
   float delta_r_fraction = evidence::RaySampleParams{}.delta_r_fraction;
   // Neighbour radius in units of the pair's summed range error δr_a + δr_b (0: fixed radius).
   float neighbour_delta_r_factor = 1.0F;
+  // If > 0, that radius holds only along the pair's mean line of sight (where the range error
+  // lies) and across it they must be within lateral_radius_m [m]. With a ball of the range
+  // error's radius (0.6 m at 3 m), thousands of unexplained readings of a coarse fit find
+  // four stray mismatches anywhere in free space to corroborate them.
+  float lateral_radius_m = 0.25F;
   // Weak features, min_weak_evidence ≤ m < min_evidence: their ray samples (§4.5) plateau at
   // m, so the fit cannot raise F to m_safe (0.6) on them however many there are, and only
   // the guard can keep such a surface. Being more likely mismatches (Eq 3.8: m = 0.4 is a
@@ -49,6 +54,15 @@ struct FeatureGuardParams {
   // min_weak_evidence ≥ min_evidence turns this off.
   float min_weak_evidence = 0.4F;
   std::size_t min_weak_neighbours = 8;
+  // A stereo feature whose line of sight meets the floor within floor_delta_r_factor · δr
+  // beyond it is not a candidate: a floor texture mismatch puts readings there, along the
+  // ray (Eq 3.7), and near the robot, where the rays are steep, a few percent of the floor's
+  // readings end up above the lowest slice; corroborating each other, they ring the robot
+  // with obstacles that are not there. With δr = 0.1 r and 2 δr this is the lowest
+  // 0.35 · (1 − 1/1.2) = 0.06 m above the floor at any range (PTU 0.35 m up). Obstacles
+  // there are the floor cue's to report (its bases are exempt), and the fit keeps every
+  // reading. 0 turns this off.
+  float floor_delta_r_factor = 2.0F;
 };
 
 // A feature in the robot frame: x, y [m] on the floor plane, h [m] relative to the PTU centre,
@@ -62,8 +76,11 @@ struct GuardPoint {
   float m = 1.0F;
 };
 
-inline constexpr std::size_t kMaxGuardCandidates = 2048;
-inline constexpr std::size_t kMaxGuardPoints = 1024;
+// A look's stereo features and floor-cue bases in the robot's height band: thousands of them
+// are unexplained when the fit is coarse (1,000–6,700 a look on rendered frames), and every
+// one dropped is a surface left unguarded.
+inline constexpr std::size_t kMaxGuardCandidates = 16384;
+inline constexpr std::size_t kMaxGuardPoints = 16384;
 
 using GuardCandidates = core::FixedVectorBase<GuardPoint>;
 using GuardPoints = core::FixedVectorBase<core::Point2>;
@@ -72,7 +89,10 @@ using GuardPoints = core::FixedVectorBase<core::Point2>;
 // height lies in the robot's band (slice_height_m(p, 0) .. slice_height_m(p, n − 1)) and where
 // the model says free: occupancy(α, h, r) < p.safe_occupancy. `occupancy` is any callable
 // (α [rad], h [m], r [m]) → m, e.g. the fitted ALN. Returns the number of readings that did
-// not fit (the list was full). Those are dropped, not kept: the list holds the first ones in
+// not fit (the list was full). Stereo features on the floor's line of sight within
+// floor_delta_r_factor · δr are left out (FeatureGuardParams); `floor_cue_bases` says the
+// readings are the floor cue's obstacle bases, which never are. Those not fitting are
+// dropped, not kept: the list holds the first ones in
 // reading order, so with a full list a surface seen late in the readings may go unguarded.
 // kMaxGuardCandidates is sized so that this does not happen in a room the model explains
 // (only unexplained features get here); a caller that gets a non-zero count should report it
@@ -80,14 +100,22 @@ using GuardPoints = core::FixedVectorBase<core::Point2>;
 template <typename Occupancy>
 std::size_t collect_unexplained_features(std::span<const evidence::Reading> readings,
                                          const Occupancy& occupancy, const ExtractionParams& p,
-                                         const FeatureGuardParams& g, GuardCandidates& candidates) {
+                                         const FeatureGuardParams& g, GuardCandidates& candidates,
+                                         bool floor_cue_bases = false) {
   const float h_lo = slice_height_m(p, 0);
+  const float h_floor = -p.ptu_height_m;
+  const float floor_reach = g.floor_delta_r_factor * g.delta_r_fraction;
   const float h_hi = slice_height_m(p, p.height_count == 0 ? 0 : p.height_count - 1);
   std::size_t lost = 0;
   for (const evidence::Reading& rd : readings) {
     if (!(rd.m >= std::fmin(g.min_evidence, g.min_weak_evidence)) ||
         !(rd.h_m >= h_lo && rd.h_m <= h_hi) || !(rd.r_m > std::fabs(rd.h_m))) {
       continue;
+    }
+    // The ray meets the floor at r · h_floor / h (h < 0): within floor_reach · r beyond r?
+    if (!floor_cue_bases && floor_reach > 0.0F && rd.h_m < 0.0F &&
+        rd.r_m * h_floor / rd.h_m - rd.r_m <= floor_reach * rd.r_m) {
+      continue;  // indistinguishable from a mismatched floor texture
     }
     if (!(occupancy(rd.alpha_rad, rd.h_m, rd.r_m) < p.safe_occupancy)) {
       continue;  // the model already holds this surface
@@ -101,11 +129,15 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
   return lost;
 }
 
+// Orders candidates by x, so corroborated_points looks only at those within reach along x.
+void sort_guard_candidates(std::span<GuardPoint> candidates);
+
 // Appends the candidates (robot frame, as x, y) with at least min_neighbours other
 // candidates (min_weak_neighbours for a weak one, m < min_evidence) within the pair's
-// neighbour radius (FeatureGuardParams). Neighbours of either kind count. O(n²) over the
-// candidates, which are few: the features the model explains never get here. Returns false
-// if `out` was full.
+// neighbour radius (FeatureGuardParams). Neighbours of either kind count. Sorted by x
+// (sort_guard_candidates), each candidate is compared only with those whose x is within the
+// largest radius it can have with any of them; unsorted, with all (O(n²)); the points are the
+// same either way. Returns false if `out` was full.
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
                          GuardPoints& out);
 // The same for candidates [first, last) only (each still against all of them), so the

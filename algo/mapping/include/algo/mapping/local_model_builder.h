@@ -59,6 +59,8 @@ struct LocalModelStats {
   double rms = 0.0;
   std::size_t guard_candidates = 0;
   std::size_t guard_points = 0;
+  std::size_t guard_dropped = 0;   // unexplained readings that found the candidate list full
+  bool guard_points_full = false;  // corroborated points were dropped (the list was full)
   std::size_t units = 0;
   bool model_valid = false;  // the fit was invertible (monotone in r)
 };
