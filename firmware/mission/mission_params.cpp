@@ -61,10 +61,9 @@ MissionParams make_mission_params(const BoardConfig& c) {
   // within 1 m, weighted by 1/range², which sits near the truth.
   p.target.agree_radius_m = 0.5F;
   p.target.refine_radius_m = 1.0F;
-  // The target's range from its tracked edges (StereoParams) stays off: with it the goal sits
-  // nearer the truth, but in the l_corridor test world the mission then ended with no safe
-  // step after 20 cycles (found in 18 without), so it waits for the Think-stage fixes.
-  p.stereo.target_range_from_edges = false;
+  // The target's range from its tracked edges (StereoParams): the look bench's fixes come
+  // nearer the truth, and every shipped and test world ends found nearer the target.
+  p.stereo.target_range_from_edges = true;
 
   // Look: features down to the image's bottom border (see FeatureParams).
   p.stereo.features.band_half_height_below_at_f150_px = 60.0F;

@@ -393,3 +393,40 @@ TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
   g_other.run();
   UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_candidates);
 }
+
+// A wall whose stereo readings in one sector all have m = 0.5 (below m_safe: their ray samples
+// plateau at 0.5, so the fit alone never reaches 0.6 there) and whose base the floor cue
+// missed, though it saw the floor free up to it: the robot must still not be let through.
+TEST(LocalModelBuilder, AWallSeenOnlyWithLowEvidenceIsNotDrivenThrough) {
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  constexpr float kWeakFirst_deg = 120.0F;
+  constexpr float kWeakLast_deg = 180.0F;
+  constexpr float kHeights_m[] = {0.1F, 0.3F, 0.6F, 0.9F, 1.2F, 1.6F};
+  for (int d = 0; d < 360; ++d) {
+    const auto alpha_deg = static_cast<float>(d);
+    const float alpha = deg(alpha_deg);
+    const bool weak = alpha_deg >= kWeakFirst_deg && alpha_deg <= kWeakLast_deg;
+    for (const float z : kHeights_m) {
+      (void)look.features.push_back(at(alpha, kWall_m, z, weak ? 0.5F : 0.9F));
+    }
+    if (!weak) {
+      for (const float z : {0.05F, 0.2F, 0.4F})
+        (void)look.obstacles.push_back(at(alpha, kWall_m, z, 0.9F));
+    }
+    (void)look.free.push_back(at(alpha, kWall_m - 0.03F, 0.0F, 0.0F));
+  }
+  g_other.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+  CHECK(g_other.map().can_move);
+  const mapping::StarPolygon& nav = g_other.map().navigable;
+  float worst_m = 1e9F;
+  for (float a = kWeakFirst_deg; a <= kWeakLast_deg; a += 0.25F) {
+    worst_m = std::min(worst_m, kWall_m - nav.radius_at_m(deg(a)));
+  }
+  // The robot's disc stays off the weak wall.
+  CHECK_TEXT(worst_m >= kRobotRadius_m,
+             "a navigable point puts the robot's disc into the weak wall");
+}
