@@ -101,6 +101,68 @@ bool same_model(const Model3& a, const Model3& b) {
   return true;
 }
 
+// A wall step seen along a corridor: the distance to the wall is 1 m up to x = 0.5 and 2 m
+// beyond (a recess), rising 0.3 m across y, with +-1 cm noise; `outlier_fraction` of the
+// samples get a uniformly random distance in [0, 3] m instead.
+std::size_t fill_wall_step(std::size_t n, double outlier_fraction, std::uint64_t seed) {
+  aln_test::Rng rng(seed);
+  for (std::size_t k = 0; k < n; ++k) {
+    auto& s = g_samples2[k];
+    s.x = Eigen::Vector2d(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    s.y = (s.x(0) < 0.5 ? 1.0 : 2.0) + 0.3 * s.x(1) + 0.01 * rng.uniform(-1.0, 1.0);
+    if (rng.uniform(0.0, 1.0) < outlier_fraction) s.y = rng.uniform(0.0, 3.0);
+    s.weight = 1.0;
+  }
+  return n;
+}
+
+void set_unit_ranges(Model2& m) {
+  m.set_input_range(0, 0.0, 1.0);
+  m.set_input_range(1, 0.0, 1.0);
+}
+
+// The M-estimator's loss rho(r / s) s^2 (Huber: r^2 / 2 inside 1.345 s, then linear; Tukey:
+// constant c^2 s^2 / 6 beyond c = 4.685 s), r^2 without robust weights.
+double robust_loss(aln::RobustWeighting kind, double r, double s) {
+  const double u = std::fabs(r) / s;
+  if (kind == aln::RobustWeighting::kHuber) {
+    constexpr double k = 1.345;
+    return u <= k ? 0.5 * r * r : s * s * (k * u - 0.5 * k * k);
+  }
+  if (kind == aln::RobustWeighting::kTukey) {
+    constexpr double c = 4.685;
+    const double t = u < c ? 1.0 - (u / c) * (u / c) : 0.0;
+    return c * c / 6.0 * (1.0 - t * t * t) * s * s;
+  }
+  return r * r;
+}
+
+// Sum of w rho(r / s) s^2 of a model over the first n samples, evaluated here, not by the
+// trainer.
+template <typename Model, typename Sample>
+double loss_over(const Model& m, const Sample* samples, std::size_t n, aln::RobustWeighting kind,
+                 double s) {
+  double loss = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r =
+        static_cast<double>(samples[k].y) - static_cast<double>(m.evaluate(samples[k].x).value);
+    loss += static_cast<double>(samples[k].weight) * robust_loss(kind, r, s);
+  }
+  return loss;
+}
+
+// Share of the first n samples a model fits to within tol.
+template <typename Model, typename Sample>
+double share_within(const Model& m, const Sample* samples, std::size_t n, double tol) {
+  std::size_t fitted = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r =
+        static_cast<double>(samples[k].y) - static_cast<double>(m.evaluate(samples[k].x).value);
+    if (std::fabs(r) <= tol) ++fitted;
+  }
+  return static_cast<double>(fitted) / static_cast<double>(n);
+}
+
 }  // namespace
 
 TEST_GROUP(AlnTrain){};
@@ -344,6 +406,18 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
     while (!done) done = g_trainer3.step(500);
   });
   CHECK(g_model3.piece_count() > 1);
+  // A wall step whose Tukey training ends on a pruned model that fits worse than before
+  // its pruning: the trainer evaluates it once more and returns the model before.
+  const std::size_t m = fill_wall_step(2500, 0.05, 1);
+  set_unit_ranges(g_model2);
+  cfg.epsilon = 0.1;
+  g_trainer2.configure(cfg);
+  done = false;
+  CHECK_NO_ALLOCATION({
+    CHECK(g_trainer2.start(aln::SampleSet<double, 2>(g_samples2, m), g_model2));
+    while (!done) done = g_trainer2.step(500);
+  });
+  CHECK(g_model2.piece_count() > 1);
 }
 
 TEST(AlnTrain, AnEmptySampleSetIsRefused) {
@@ -465,4 +539,86 @@ TEST(AlnTrain, HuberWeightsKeepTheFitCloseToTheCleanFunctionDespiteOutliers) {
     sse += e * e;
   }
   CHECK(std::sqrt(sse / 1000.0) < 0.1);
+}
+
+TEST(AlnTrain, TukeyTrainingOfAWallStepWithOutliersEndsOnAModelThatFitsTheWall) {
+  // 5% outliers: a Tukey piece can lower its robust-weighted squared error by pushing its
+  // samples out of the weights' window, so judged by that error, training could end on a
+  // model that fits only one side of the step. Judged by the robust loss it cannot.
+  for (const std::uint64_t seed : {1U, 3U, 5U}) {
+    const std::size_t n = fill_wall_step(2500, 0.05, seed);
+    set_unit_ranges(g_model2);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = 0.1;
+    cfg.robust = aln::RobustWeighting::kTukey;
+    cfg.max_iterations = 0;  // the one-piece start
+    g_trainer2.configure(cfg);
+    CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2));
+    const double start = loss_over(g_model2, g_samples2, n, cfg.robust, cfg.epsilon);
+    cfg.max_iterations = 10;
+    g_trainer2.configure(cfg);
+    CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2));
+    const std::string text = "seed " + std::to_string(seed);
+    CHECK_TEXT(share_within(g_model2, g_samples2, n, cfg.epsilon) >= 0.9, text.c_str());
+    CHECK_TEXT(loss_over(g_model2, g_samples2, n, cfg.robust, cfg.epsilon) < 0.2 * start,
+               text.c_str());
+  }
+}
+
+TEST(AlnTrain, TheRobustLossOfTheModelTrainingEndsWithNeverRisesWithMoreRounds) {
+  // The model after k rounds is the one training with max_iterations = k returns: the loss
+  // of the final model is never above the one-piece start's nor above any round's model.
+  struct Run {
+    aln::RobustWeighting kind;
+    std::uint64_t seed;
+    double epsilon;
+  };
+  for (const Run run :
+       {Run{aln::RobustWeighting::kTukey, 1, 0.1}, Run{aln::RobustWeighting::kTukey, 5, 0.1},
+        Run{aln::RobustWeighting::kTukey, 8, 0.05}, Run{aln::RobustWeighting::kHuber, 1, 0.1},
+        Run{aln::RobustWeighting::kHuber, 8, 0.05}}) {
+    const std::size_t n = fill_wall_step(2500, 0.05, run.seed);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = run.epsilon;
+    cfg.robust = run.kind;
+    double start = 0.0;
+    double previous = 0.0;
+    for (std::size_t rounds = 0; rounds <= 12; ++rounds) {
+      set_unit_ranges(g_model2);
+      cfg.max_iterations = rounds;
+      g_trainer2.configure(cfg);
+      CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2));
+      const double loss = loss_over(g_model2, g_samples2, n, run.kind, run.epsilon);
+      if (rounds == 0) start = loss;
+      const std::string text = "seed " + std::to_string(run.seed) + ", " + std::to_string(rounds) +
+                               " rounds: " + std::to_string(loss);
+      CHECK_TEXT(loss <= start * (1.0 + 1e-6), text.c_str());
+      if (rounds > 0) CHECK_TEXT(loss <= previous * (1.0 + 1e-6), text.c_str());
+      previous = loss;
+    }
+  }
+}
+
+TEST(AlnTrain, TheStatsReportTheRobustLossOfTheModelReturned) {
+  const std::size_t n = fill_wall_step(2500, 0.05, 1);
+  for (const auto kind : {aln::RobustWeighting::kHuber, aln::RobustWeighting::kTukey}) {
+    set_unit_ranges(g_model2);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = 0.1;
+    cfg.robust = kind;
+    g_trainer2.configure(cfg);
+    CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2));
+    const double loss = loss_over(g_model2, g_samples2, n, kind, cfg.epsilon);
+    DOUBLES_EQUAL(loss, g_trainer2.stats().robust_loss, 1e-9 * loss);
+    LONGS_EQUAL(g_model2.piece_count(), g_trainer2.stats().pieces);
+  }
+  // Without robust weights the loss is the sum of squared residuals.
+  set_unit_ranges(g_model2);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.1;
+  g_trainer2.configure(cfg);
+  CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2));
+  const double rms = g_trainer2.stats().rms;
+  DOUBLES_EQUAL(rms * rms * static_cast<double>(n), g_trainer2.stats().robust_loss,
+                1e-9 * g_trainer2.stats().robust_loss);
 }

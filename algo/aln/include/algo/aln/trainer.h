@@ -52,6 +52,10 @@ struct TrainerStats {
   std::uint64_t sample_visits = 0;
   double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
   double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
+  // What training minimises and judges every model by: sum w rho(r / s) s^2 at the fixed
+  // scale s = robust_scale (or epsilon), rho the Huber or Tukey loss; sum w r^2 without
+  // robust weights. The model returned is the one with the least loss training evaluated.
+  double robust_loss = 0.0;
   bool done = false;
 };
 
@@ -63,10 +67,14 @@ struct TrainerStats {
 // copies (MAX if the data rise above the piece at the rim of its region, i.e. convex, else
 // MIN), pieces no sample uses are pruned, and the next round starts. Stops at epsilon, at the
 // piece cap or at the iteration cap; the model is always one that was evaluated, with every
-// piece inside its bounds.
+// piece inside its bounds. Models are compared by the robust loss at a fixed scale
+// (TrainerStats::robust_loss), not by the robust-weighted squared error, which a Tukey fit
+// could lower by pushing its samples out of the weights' window: a refit is kept only if it
+// lowers that loss, a round's splits are undone unless they lower it, so the model returned
+// has the least loss of all models training evaluated.
 // Resumable: step(budget) visits at most about `budget` samples and returns; the sequence of
 // operations does not depend on the budgets, so sliced training equals one-shot training.
-// All working memory is inside the object (about 1.2 KB per piece for N = 3, 298 KB for
+// All working memory is inside the object (about 1.2 KB per piece for N = 3, 318 KB for
 // 256 pieces; no per-sample memory, so the sample count is unbounded): make it static.
 template <typename Scalar, int N, std::size_t MaxPieces>
 class Trainer {
@@ -114,6 +122,8 @@ class Trainer {
     split_limit_ = 0;
     last_made_ = 0;
     failed_rounds_ = 0;
+    unevaluated_ = false;
+    checking_ = false;
     tried_.fill(0);
     begin_pass();
     stats_.pieces = 1;
@@ -157,6 +167,7 @@ class Trainer {
     MatD sxx = MatD::Zero();
     VecD sxy = VecD::Zero();
     double sse = 0.0;        // robust-weighted squared residuals
+    double loss = 0.0;       // robust loss at the fixed scale (sse without robust weights)
     double sse_plain = 0.0;  // sample-weighted squared residuals
     double sw_plain = 0.0;
     // For the split: |d_j| = |x_j - centroid_j| / width_j (the V a split would add).
@@ -182,17 +193,38 @@ class Trainer {
     return rng_;
   }
 
+  static constexpr double kHuber = 1.345;
+  static constexpr double kTukey = 4.685;
+
+  // The fixed residual scale models are compared at (the pieces' own scales only weight
+  // their refits).
+  double base_scale() const {
+    return config_.robust_scale > 0.0 ? config_.robust_scale : config_.epsilon;
+  }
+
   double robust_weight(double r, double s) const {
     if (config_.robust == RobustWeighting::kNone || !std::isfinite(s)) return 1.0;
     const double u = std::fabs(r) / s;
-    if (config_.robust == RobustWeighting::kHuber) {
-      constexpr double kHuber = 1.345;
-      return u <= kHuber ? 1.0 : kHuber / u;
-    }
-    constexpr double kTukey = 4.685;
+    if (config_.robust == RobustWeighting::kHuber) return u <= kHuber ? 1.0 : kHuber / u;
     if (u >= kTukey) return 0.0;
     const double t = 1.0 - (u / kTukey) * (u / kTukey);
     return t * t;
+  }
+
+  // rho(r / s) s^2 of the M-estimator whose weights robust_weight() gives, at s = base_scale():
+  // Huber r^2 / 2 inside k s, then linear; Tukey rising to c^2 s^2 / 6 at c s, then constant,
+  // so a residual pushed out of the window costs the most, not nothing.
+  double robust_loss(double r) const {
+    const double s = base_scale();
+    if (!(s > 0.0)) return r * r;
+    const double u = std::fabs(r) / s;
+    if (config_.robust == RobustWeighting::kHuber) {
+      return u <= kHuber ? 0.5 * r * r : s * s * kHuber * (u - 0.5 * kHuber);
+    }
+    constexpr double kTukeyMax = kTukey * kTukey / 6.0;
+    if (u >= kTukey) return kTukeyMax * s * s;
+    const double t = 1.0 - (u / kTukey) * (u / kTukey);
+    return kTukeyMax * (1.0 - t * t * t) * s * s;
   }
 
   void begin_pass() {
@@ -218,6 +250,7 @@ class Trainer {
     a.sxx.noalias() += (w * x) * x.transpose();
     a.sxy += (w * y) * x;
     a.sse += w * r * r;
+    a.loss += config_.robust == RobustWeighting::kNone ? w * r * r : w_plain * robust_loss(r);
     a.sr += w * r;
     for (int j = 0; j < N; ++j) {
       const double d = std::fabs(x(j)) / width(j);
@@ -253,13 +286,28 @@ class Trainer {
     piece.set(w.template cast<Scalar>(), centroid, cy);
   }
 
-  // After a pass over the samples: keep the best model of this round, then either refit
-  // (one Lloyd step) or, when the error has stopped falling, end the round.
+  double loss_of(const Accumulators& acc) const {
+    double loss = 0.0;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) loss += acc[p].loss;
+    return loss;
+  }
+
+  double sse_of(const Accumulators& acc) const {
+    double sse = 0.0;
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) sse += acc[p].sse;
+    return sse;
+  }
+
+  // After a pass over the samples: keep the best model of this round (by the robust loss),
+  // then either refit (one Lloyd step) or, when the loss has stopped falling, end the round.
   void finish_pass() {
     stats_.passes += 1;
+    if (checking_) {
+      finish_check();
+      return;
+    }
     const std::size_t pieces = model_->piece_count();
-    double objective = 0.0;
-    for (std::size_t p = 0; p < pieces; ++p) objective += (*current_)[p].sse;
+    const double objective = loss_of(*current_);
     const bool improved = pass_in_round_ == 0 || objective < best_objective_ * (1.0 - 1e-4);
     if (improved) {
       best_objective_ = objective;
@@ -294,7 +342,7 @@ class Trainer {
   }
 
   void update_scales(const Accumulators& acc) {
-    const double base = config_.robust_scale > 0.0 ? config_.robust_scale : config_.epsilon;
+    const double base = base_scale();
     for (std::size_t p = 0; p < model_->piece_count(); ++p) {
       const double rms = acc[p].sw > 0.0 ? std::sqrt(acc[p].sse / acc[p].sw) : 0.0;
       scale_[p] = std::max(base, rms);
@@ -302,11 +350,13 @@ class Trainer {
   }
 
   // The current model and the sums in *current_ belong together: prune, split or stop.
+  // Every round's model is judged against the one before it by the robust loss, so that
+  // loss never rises from one round to the next (see end_training() for pruning).
   void finish_round() {
-    double objective = 0.0;
-    for (std::size_t p = 0; p < model_->piece_count(); ++p) objective += (*current_)[p].sse;
+    double objective = loss_of(*current_);
+    double sse = sse_of(*current_);  // for the overall-RMS split rule
     if (split_limit_ > 0 && objective >= saved_objective_ * (1.0 - 1e-4)) {
-      // The last round's splits did not lower the error: undo them, so the error never rises
+      // The last round's splits did not lower the loss: undo them, so the loss never rises
       // from one round to the next, and split half as many of the worst pieces; once a single
       // split fails, that piece is left and the next worst tried. Training ends when every
       // candidate has been tried on this model or after max_failed_rounds such rounds.
@@ -314,6 +364,7 @@ class Trainer {
       *current_ = saved_acc_;
       scale_ = saved_scale_;
       objective = saved_objective_;
+      sse = saved_sse_;
       if (last_made_ > 1) {
         split_limit_ = last_made_ / 2;  // fewer of the worst pieces
       } else {
@@ -324,18 +375,22 @@ class Trainer {
       stats_.failed_rounds = ++failed_rounds_;
       if (failed_rounds_ > config_.max_failed_rounds) {
         finish_stats(*current_);
-        stats_.done = true;
+        end_training();
         return;
       }
     } else {
       split_limit_ = MaxPieces;
       tried_.fill(0);  // another model now: every piece is a candidate again
+      const std::size_t evaluated_pieces = model_->piece_count();
+      if (config_.robust != RobustWeighting::kNone) best_model_ = *model_;
       prune(*current_);
+      unevaluated_ = model_->piece_count() != evaluated_pieces;
+      best_loss_ = objective;
     }
     Accumulators& acc = *current_;
     finish_stats(acc);
     if (stats_.iterations >= config_.max_iterations || model_->piece_count() >= cap_) {
-      stats_.done = true;
+      end_training();
       return;
     }
     // Candidates for splitting.
@@ -354,7 +409,7 @@ class Trainer {
         }
       }
     } else if (stats_.robust_rms > config_.epsilon) {
-      const double mean_sse = objective / static_cast<double>(pieces);
+      const double mean_sse = sse / static_cast<double>(pieces);
       for (std::size_t p = 0; p < pieces; ++p) {
         if (tried_[p] == 0 && enough(acc[p]) && acc[p].sse >= mean_sse) {
           want[p] = 1;
@@ -363,7 +418,7 @@ class Trainer {
       }
     }
     if (wanted == 0) {
-      stats_.done = true;
+      end_training();
       return;
     }
     update_scales(acc);
@@ -371,6 +426,7 @@ class Trainer {
     saved_acc_ = acc;
     saved_scale_ = scale_;
     saved_objective_ = objective;
+    saved_sse_ = sse;
     // Split the worst first until the cap or the limit.
     std::size_t made = 0;
     last_split_count_ = 0;
@@ -386,7 +442,7 @@ class Trainer {
     }
     if (made == 0) {
       split_limit_ = 0;
-      stats_.done = true;
+      end_training();
       return;
     }
     last_made_ = made;
@@ -395,6 +451,34 @@ class Trainer {
     pass_in_round_ = 0;
     stall_ = 0;
     next_pass();
+  }
+
+  // Pruning a piece no sample uses can still change the model at samples: the piece may win
+  // an inner node there whose branch then loses higher up. Robust fits leave such pieces
+  // often (a Tukey piece can drift off all its samples), so when training would end on a
+  // pruned model no pass has evaluated, robust training evaluates it once more and returns
+  // the last evaluated model instead if pruning raised the loss. Without robust weights the
+  // pruned model is returned as it is.
+  void end_training() {
+    if (unevaluated_ && config_.robust != RobustWeighting::kNone) {
+      checking_ = true;
+      next_pass();
+      return;
+    }
+    stats_.done = true;
+  }
+
+  void finish_check() {
+    checking_ = false;
+    unevaluated_ = false;
+    if (loss_of(*current_) > best_loss_ * (1.0 + 1e-9)) {
+      // The stats, from the round's sums, are those of the model before its pruning.
+      *model_ = best_model_;
+      stats_.pieces = model_->piece_count();
+    } else {
+      finish_stats(*current_);
+    }
+    stats_.done = true;
   }
 
   void finish_stats(const Accumulators& acc) {
@@ -410,6 +494,7 @@ class Trainer {
     }
     stats_.rms = sw_plain > 0.0 ? std::sqrt(sse_plain / sw_plain) : 0.0;
     stats_.robust_rms = sw > 0.0 ? std::sqrt(sse / sw) : 0.0;
+    stats_.robust_loss = loss_of(acc);
     stats_.pieces = model_->piece_count();
   }
 
@@ -541,7 +626,14 @@ class Trainer {
   Model saved_model_{};
   Accumulators saved_acc_{};
   std::array<double, MaxPieces> saved_scale_{};
-  double saved_objective_ = 0.0;
+  double saved_objective_ = 0.0;  // its robust loss
+  double saved_sse_ = 0.0;        // its robust-weighted squared error
+  // The last round's model as evaluated, before pruning (robust training only), its loss,
+  // whether the current model was pruned since, and whether a pass is checking that.
+  Model best_model_{};
+  double best_loss_ = 0.0;
+  bool unevaluated_ = false;
+  bool checking_ = false;
   std::size_t split_limit_ = 0;  // 0: no split to judge yet
   std::size_t last_made_ = 0;
   // Pieces of the current model whose split did not lower the error (not tried again), the
