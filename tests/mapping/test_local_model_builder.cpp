@@ -394,27 +394,36 @@ TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
   UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_candidates);
 }
 
-// A wall whose stereo readings in one sector all have m = 0.5 (below m_safe: their ray samples
-// plateau at 0.5, so the fit alone never reaches 0.6 there) and whose base the floor cue
-// missed, though it saw the floor free up to it: the robot must still not be let through.
-TEST(LocalModelBuilder, AWallSeenOnlyWithLowEvidenceIsNotDrivenThrough) {
+// A shelf (its front edge 1.5 m away, 0.45-0.55 m above the floor, below the robot's top) seen
+// by the stereo only with m = 0.5 in one sector: below m_safe, so its ray samples plateau at
+// 0.5 and the fit alone never reaches 0.6 there. The floor cue sees the floor free beneath it
+// up to the wall behind. Only the guard's weak readings stand between the robot and the shelf:
+// the robot must still not be let under it.
+TEST(LocalModelBuilder, AShelfSeenOnlyWithLowEvidenceIsNotDrivenUnder) {
   static Look look;
   look.features.clear();
   look.obstacles.clear();
   look.free.clear();
   constexpr float kWeakFirst_deg = 120.0F;
   constexpr float kWeakLast_deg = 180.0F;
+  constexpr float kShelf_m = 1.5F;
   constexpr float kHeights_m[] = {0.1F, 0.3F, 0.6F, 0.9F, 1.2F, 1.6F};
   for (int d = 0; d < 360; ++d) {
     const auto alpha_deg = static_cast<float>(d);
     const float alpha = deg(alpha_deg);
-    const bool weak = alpha_deg >= kWeakFirst_deg && alpha_deg <= kWeakLast_deg;
+    const bool shelf = alpha_deg >= kWeakFirst_deg && alpha_deg <= kWeakLast_deg;
     for (const float z : kHeights_m) {
-      (void)look.features.push_back(at(alpha, kWall_m, z, weak ? 0.5F : 0.9F));
+      (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
     }
-    if (!weak) {
-      for (const float z : {0.05F, 0.2F, 0.4F})
-        (void)look.obstacles.push_back(at(alpha, kWall_m, z, 0.9F));
+    if (shelf) {
+      for (const float z : {0.45F, 0.5F, 0.55F}) {
+        for (const float da : {0.0F, 0.33F, 0.67F}) {
+          (void)look.features.push_back(at(deg(alpha_deg + da), kShelf_m, z, 0.5F));
+        }
+      }
+    }
+    for (const float z : {0.05F, 0.2F, 0.4F}) {
+      (void)look.obstacles.push_back(at(alpha, kWall_m, z, 0.9F));
     }
     (void)look.free.push_back(at(alpha, kWall_m - 0.03F, 0.0F, 0.0F));
   }
@@ -424,9 +433,8 @@ TEST(LocalModelBuilder, AWallSeenOnlyWithLowEvidenceIsNotDrivenThrough) {
   const mapping::StarPolygon& nav = g_other.map().navigable;
   float worst_m = 1e9F;
   for (float a = kWeakFirst_deg; a <= kWeakLast_deg; a += 0.25F) {
-    worst_m = std::min(worst_m, kWall_m - nav.radius_at_m(deg(a)));
+    worst_m = std::min(worst_m, kShelf_m - nav.radius_at_m(deg(a)));
   }
-  // The robot's disc stays off the weak wall.
-  CHECK_TEXT(worst_m >= kRobotRadius_m,
-             "a navigable point puts the robot's disc into the weak wall");
+  // The robot's disc stays off the shelf's edge.
+  CHECK_TEXT(worst_m >= kRobotRadius_m, "a navigable point puts the robot under the weak shelf");
 }
