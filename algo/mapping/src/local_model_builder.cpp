@@ -215,13 +215,8 @@ void LocalModelBuilder::build_seen_free() {
 
 void LocalModelBuilder::extract() {
   const ExtractionParams& p = params_.extraction;
-  const std::size_t heights = std::clamp<std::size_t>(p.height_count, 1, kMaxHeights);
   if (stats_.model_valid) {
-    extract_slice(free_range_, slice_height_m(p, 0), p, obstacle_polygon_);
-    for (std::size_t i = 1; i < heights; ++i) {
-      extract_slice(free_range_, slice_height_m(p, i), p, scratch_);
-      (void)intersect_into(obstacle_polygon_, scratch_);
-    }
+    extract_free_polygon(free_range_, p, obstacle_polygon_, scratch_);
     // The robot stands on its own disc, and the step that brought it here kept the disc and
     // its margin inside the last look's navigable polygon: a crossing of the fit nearer than
     // that is the fit's extrapolation into space no line of sight crosses (near a wall the

@@ -59,15 +59,32 @@ class AlnFreeRange {
   // rounding (the terms are summed in another order).
   void ranges_at_height(float h_m, float step_rad, std::size_t first_index, std::size_t count,
                         float offset_rad, float* out) const {
+    ranges_over_band(h_m, h_m, step_rad, first_index, count, offset_rad, out);
+  }
+
+  // A lower bound on min { r(α, h) : h ∈ [h_lo_m, h_hi_m] } at the same pan angles as
+  // ranges_at_height (equal to it when h_lo_m = h_hi_m): the nearest range at which the
+  // occupancy reaches m_safe anywhere in the height band, never overestimated. Interval
+  // arithmetic over the MIN/MAX tree of the inverse: each piece is linear in h, so its
+  // minimum over the band is at the end its h-slope points away from (exact); a MIN node's
+  // minimum is the smaller of its children's (exact), a MAX node's is at least the larger of
+  // its children's minima (a bound: the children may take their minima at different h). So
+  // no crossing between two slices is missed, whatever the slope bounds (issue of §5.4.2's
+  // finite set of heights); the bound is tight where one piece answers across the band.
+  void ranges_over_band(float h_lo_m, float h_hi_m, float step_rad, std::size_t first_index,
+                        std::size_t count, float offset_rad, float* out) const {
     if (!valid_) {
       std::fill(out, out + count, 0.0F);
       return;
     }
+    const auto lo = static_cast<Scalar>(std::min(h_lo_m, h_hi_m));
+    const auto hi = static_cast<Scalar>(std::max(h_lo_m, h_hi_m));
     const std::size_t pieces = inverse_.piece_count();
     for (std::size_t p = 0; p < pieces; ++p) {
       const auto& piece = inverse_.piece(p);
-      constant_[p] = piece.bias + piece.weight(1) * static_cast<Scalar>(h_m) +
-                     piece.weight(2) * safe_occupancy_;
+      const Scalar w_h = piece.weight(1);
+      constant_[p] =
+          piece.bias + w_h * (w_h > Scalar(0) ? lo : hi) + piece.weight(2) * safe_occupancy_;
       slope_[p] = piece.weight(0);
     }
     for (std::size_t k0 = 0; k0 < count; k0 += kBlock) {
