@@ -353,3 +353,28 @@ TEST(Shrink, OnStraightWallsEveryVertexLiesOnTheExactOffsetWithinAMicrometre) {
     }
   }
 }
+
+TEST_GROUP(OpenSpikes){};
+
+TEST(OpenSpikes, WedgesNarrowerThanTheWindowGoAndWiderOpeningsStay) {
+  StarPolygon p(360);
+  p.fill(2.0F);
+  p.set_rho_m(10, 3.0F);  // one ray through the wall
+  p.set_rho_m(50, 3.0F);  // two rays
+  p.set_rho_m(51, 2.8F);
+  p.set_rho_m(358, 3.0F);  // across the seam
+  p.set_rho_m(359, 3.0F);
+  for (std::size_t k = 100; k < 110; ++k) p.set_rho_m(k, 3.0F);  // a doorway, 10 rays wide
+  p.set_rho_m(200, 0.5F);  // a notch (a thin leg): opening never fills it
+  StarPolygon before = p;
+  boticelli::mapping::open_spikes(p, 2);  // window of 5 rays
+  for (std::size_t k = 0; k < 360; ++k) {
+    CHECK(p.rho_m(k) <= before.rho_m(k));
+    const bool doorway = k >= 100 && k < 110;
+    DOUBLES_EQUAL(doorway ? 3.0 : (k == 200 ? 0.5 : 2.0), p.rho_m(k), 1e-6);
+  }
+  // Half width 0 leaves the polygon as it was.
+  StarPolygon q = before;
+  boticelli::mapping::open_spikes(q, 0);
+  for (std::size_t k = 0; k < 360; ++k) DOUBLES_EQUAL(before.rho_m(k), q.rho_m(k), 0.0);
+}

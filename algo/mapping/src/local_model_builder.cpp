@@ -260,6 +260,7 @@ void LocalModelBuilder::extract() {
   if (params_.clamp_to_seen_free) {
     (void)intersect_into(map_.free, seen_free_);
   }
+  open_spikes(map_.free, params_.spike_half_width);
   map_.can_move =
       shrink_for_robot(map_.free, p.robot_radius_m, p.clearance_margin_m, map_.navigable);
 }

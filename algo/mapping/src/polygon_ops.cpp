@@ -619,4 +619,27 @@ void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
   }
 }
 
+void open_spikes(StarPolygon& free, std::size_t half_width) {
+  const std::size_t n = free.vertex_count();
+  if (half_width == 0 || n < 3) {
+    return;
+  }
+  const std::size_t h = std::min(half_width, (n - 1) / 2);
+  std::array<float, kMaxPolygonVertices> eroded{};
+  for (std::size_t k = 0; k < n; ++k) {
+    float m = free.rho_m(k);
+    for (std::size_t d = 1; d <= h; ++d) {
+      m = std::min({m, free.rho_m((k + d) % n), free.rho_m((k + n - d) % n)});
+    }
+    eroded[k] = m;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    float m = eroded[k];
+    for (std::size_t d = 1; d <= h; ++d) {
+      m = std::max({m, eroded[(k + d) % n], eroded[(k + n - d) % n]});
+    }
+    free.set_rho_m(k, m);
+  }
+}
+
 }  // namespace boticelli::mapping

@@ -46,6 +46,10 @@ struct LocalModelParams {
   // Only space something showed free counts as free (§4.9.1: unknown is not free): the free
   // polygon is cut to the farthest floor seen in each vertex direction.
   bool clamp_to_seen_free = true;
+  // Wedges of the free polygon narrower than 2·spike_half_width + 1 vertex rays are cut to
+  // their neighbours (open_spikes): a ray or two the fit leaves open through a wall, or that a
+  // stray far reading kept seen. 0 keeps them (the first wave's polygon).
+  std::size_t spike_half_width = 0;
   // A floor-cue obstacle base cuts the polygon's vertex ray this much in front of it [m].
   float base_margin_m = 0.05F;
   std::size_t readings_per_unit = 64;           // work per unit while building samples

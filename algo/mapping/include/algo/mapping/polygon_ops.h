@@ -39,4 +39,11 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
 // vertex ray cuts both sectors beside that ray. Points at the centre close the polygon.
 void exclude_points(std::span<const core::Point2> points, StarPolygon& free);
 
+// Morphological opening of the radial function over a circular window of 2·half_width + 1
+// vertices: every vertex takes the largest, over the windows holding it, of the window's
+// smallest ρ. A wedge narrower than the window (a ray or two the fit left open through a
+// wall, or that a stray far reading kept seen) is cut to its neighbours; anything wider stays
+// as it was. Never grows the polygon. half_width 0 leaves it unchanged.
+void open_spikes(StarPolygon& free, std::size_t half_width);
+
 }  // namespace boticelli::mapping
