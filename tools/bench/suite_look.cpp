@@ -546,10 +546,9 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .num("target_rate", st.target_views > 0 ? static_cast<double>(st.target_found) /
                                                     static_cast<double>(st.target_views)
                                               : std::numeric_limits<double>::quiet_NaN())
-      .integer("target_found_within_0_1m",
-               static_cast<std::int64_t>(std::count_if(st.target_error_m.begin(),
-                                                       st.target_error_m.end(),
-                                                       [](double e) { return e <= 0.1; })))
+      .integer("target_found_within_0_1m", static_cast<std::int64_t>(std::count_if(
+                                               st.target_error_m.begin(), st.target_error_m.end(),
+                                               [](double e) { return e <= 0.1; })))
       .num("target_err_median_m", percentile(st.target_error_m, 0.5))
       .num("target_err_max_m", percentile(st.target_error_m, 1.0))
       .integer("target_far", static_cast<std::int64_t>(st.target_far))
