@@ -438,3 +438,62 @@ TEST(LocalModelBuilder, AShelfSeenOnlyWithLowEvidenceIsNotDrivenUnder) {
   // The robot's disc stays off the shelf's edge.
   CHECK_TEXT(worst_m >= kRobotRadius_m, "a navigable point puts the robot under the weak shelf");
 }
+
+// A plain low box (0.3 m tall, front 1.0 m away, pan 60°–90°) that neither the stereo nor the
+// floor cue's appearance test sees: the low view's walks there end at its front (their
+// floor stops), and a high view's walks, whose bottom row already lies beyond the box, see
+// the floor behind it up to the wall. Only walks joined to the robot show floor free, so the
+// free polygon stops at the box; counting every walk's far end (no walk starts given) lets
+// it through. The wall's features in the sector lie above the robot's band (they show
+// nothing about the floor).
+TEST(LocalModelBuilder, AFloorWalkThatStartsBeyondAPlainBoxShowsNoFloorBeforeIt) {
+  static Look look;
+  static FixedVector<Reading, 1024> free;
+  static FixedVector<float, 1024> near_m;
+  look.features.clear();
+  look.obstacles.clear();
+  free.clear();
+  near_m.clear();
+  constexpr float kBox_m = 1.0F;
+  constexpr float kLowStart_m = 0.35F;
+  constexpr float kHighStart_m = 1.7F;
+  const auto boxed = [](int d) { return d >= 60 && d <= 90; };
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    for (const float z : {1.2F, 1.6F}) (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
+    if (!boxed(d)) {
+      for (const float z : {0.1F, 0.4F}) {
+        (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
+      }
+      for (const float z : {0.05F, 0.2F, 0.4F}) {
+        (void)look.obstacles.push_back(at(alpha, kWall_m, z, 0.9F));
+      }
+    }
+    // The low view's walk: to the wall, or to the box's front.
+    (void)free.push_back(at(alpha, (boxed(d) ? kBox_m : kWall_m) - 0.03F, 0.0F, 0.0F));
+    (void)near_m.push_back(kLowStart_m);
+    // The high view's walk, from beyond the box to the wall.
+    (void)free.push_back(at(alpha, kWall_m - 0.03F, 0.0F, 0.0F));
+    (void)near_m.push_back(kHighStart_m);
+  }
+  mapping::LocalModelParams params = make_params();
+  params.seen_floor_start_m = 0.7F;
+  const auto widest_over_box = [](const mapping::StarPolygon& polygon) {
+    float widest = 0.0F;
+    for (float a = 60.0F; a <= 90.0F; a += 0.25F) {
+      widest = std::max(widest, polygon.radius_at_m(deg(a)));
+    }
+    return widest;
+  };
+  g_other.start(params, look.features.span(), look.obstacles.span(), free.span(), near_m.span());
+  g_other.run();
+  CHECK(g_other.map().can_move);
+  CHECK_TEXT(widest_over_box(g_other.map().free) <= kBox_m,
+             "the free polygon passes the box's front");
+  // Away from the box the joined walks reach towards the wall (the fit's crossing, ~0.8 of it).
+  CHECK(g_other.map().free.radius_at_m(deg(200.0F)) > kBox_m + 0.5F);
+  // Without the walks' starts every far end counts: the polygon crosses the box.
+  g_other.start(params, look.features.span(), look.obstacles.span(), free.span());
+  g_other.run();
+  CHECK(widest_over_box(g_other.map().free) > kBox_m + 0.5F);
+}

@@ -29,6 +29,7 @@ using boticelli::evidence::Reading;
 using boticelli::image::LowResFrame;
 using boticelli::stereo::FloorColumn;
 using boticelli::stereo::FloorCue;
+using boticelli::stereo::FloorCueParams;
 using boticelli::stereo::FloorCueResult;
 using boticelli::stereo::FloorLearn;
 using boticelli::stereo::RigModel;
@@ -262,8 +263,16 @@ std::size_t check_detected(const FloorCue& cue, float pan, float tilt) {
 
 }  // namespace
 
+// The walks' tests trust the first region they learn from (the consensus of two directions
+// has its own tests below).
+FloorCueParams trusting() {
+  FloorCueParams p;
+  p.confirm_separation_rad = 0.0F;
+  return p;
+}
+
 TEST_GROUP(FloorCue) {
-  FloorCue cue{g_rig};
+  FloorCue cue{g_rig, trusting()};
   Outputs out;
 
   void teardown() override {
@@ -353,6 +362,133 @@ TEST(FloorCue, AnObstacleInTheReferenceRegionDoesNotPoisonTheFloorModel) {
   CHECK(check_against_truth(cue, out, 0.0F, kLookTilt) >= 5);
 }
 
+// A camouflage wall (the shipped rooms' dark cloth) 0.55 m in front fills the far part of the
+// reference region: two surfaces, one of them busy. Their mixture's spread is so wide that a
+// model of it (luma median 47 ± 77) calls wall and floor alike floor, so it passed its own
+// consistency test; no plain floor spreads so much, so the region is refused.
+TEST(FloorCue, ARegionHalfWallHalfFloorIsNotLearned) {
+  std::string wall = plain_box("wall", "0.6 0 0.75", "0.1 8 1.5", "0.36 0.4 0.26");
+  wall.insert(wall.find("</visual>"),
+              "<boticelli:pattern scale=\"0.08\" seed=\"1\">camouflage</boticelli:pattern>");
+  load(wall);
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kNotUniform == cue.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(cue.model().valid);
+}
+
+// Every free reading comes with where its walk began; the level view's walks begin beyond
+// the floor the low view sees first (its bottom row looks farther out).
+TEST(FloorCue, EachFreeReadingComesWithTheNearEndOfItsWalk) {
+  load("");
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  FixedVector<float, 256> near_m;
+  for (const float tilt : {kLookTilt, 0.0F}) {
+    render(0.7F, tilt, 2, g_frame);
+    out.obstacles.clear();
+    out.free.clear();
+    near_m.clear();
+    out.result = cue.process(g_frame, 0.7F, tilt, out.obstacles, out.free, &near_m);
+    CHECK(out.free.size() > 0);
+    CHECK_EQUAL(out.free.size(), near_m.size());
+    for (std::size_t i = 0; i < out.free.size(); ++i) {
+      CHECK(near_m[i] > 0.0F);
+      CHECK(near_m[i] < boticelli::evidence::horizontal_m(out.free[i]));
+      if (tilt < 0.0F) {
+        CHECK(near_m[i] < 0.8F);
+      } else {
+        CHECK(near_m[i] > 1.0F);
+      }
+    }
+  }
+}
+
+// Beside a plain box that fills the reference region of the view facing it, the box is
+// uniform and would be learned as the floor; then every region of the real floor is refused
+// as inconsistent and the box's colour is "floor" for the rest of the look. By default the
+// first model waits for a region from another direction (≥ 1 rad away) that agrees.
+TEST(FloorCue, APlainBoxFillingTheFirstRegionIsNotLearnedAsTheFloor) {
+  load(plain_box("crate", "0.75 0 0.3", "0.5 0.8 0.6", "0.5 0.4 0.3"));
+  static FloorCue fresh{g_rig};  // large (kept frames): not on the stack
+  fresh.reset();
+  // Trusting the first region learns the box (it is uniform): the case this guards.
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(cue.model().median[0] < 100.0F);  // the box's face, not the floor's ≈ 129
+  // The default cue waits; a region 0.4 rad on (still the box's side) does not confirm.
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(fresh.model().valid);
+  // The floor, away from the box, replaces the pending box (they disagree) and waits too.
+  render(1.6F, kLookTilt, 2, g_frame2);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame2, 1.6F, kLookTilt));
+  CHECK_FALSE(fresh.model().valid);
+  // Another direction of floor, far enough from the first floor view, confirms it.
+  render(-1.6F, kLookTilt, 3, g_frame2);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame2, -1.6F, kLookTilt));
+  CHECK(fresh.model().median[0] > 110.0F);
+  // With that model no walk in front goes past the box's front face (0.5 m); with the box's
+  // model they went on over it to the floor behind.
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK(out.result.model_valid);
+  for (const Reading& f : out.free) {
+    const Eigen::Vector3f p = floor_point_of(f);
+    if (std::fabs(p.y()) < 0.4F) CHECK(p.x() < 0.5F);
+  }
+  out.free.clear();
+  out.obstacles.clear();
+  (void)cue.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  bool past_box = false;
+  for (const Reading& f : out.free) {
+    const Eigen::Vector3f p = floor_point_of(f);
+    past_box = past_box || (std::fabs(p.y()) < 0.4F && p.x() > 1.0F);
+  }
+  CHECK_TEXT(past_box,
+             "the box's model no longer lets walks past the box (the guarded case changed)");
+}
+
+TEST(FloorCue, TwoAgreeingRegionsTooCloseInPanDoNotConfirmTheFloor) {
+  load("");
+  static FloorCue fresh{g_rig};
+  fresh.reset();
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  render(0.5F, kLookTilt, 2, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.5F, kLookTilt));
+  CHECK_FALSE(fresh.model().valid);
+  render(1.2F, kLookTilt, 3, g_frame);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 1.2F, kLookTilt));
+  CHECK(fresh.model().valid);
+}
+
+// While the first model waits, a view's frames are kept and walked once it comes: the views
+// before it lose nothing.
+TEST(FloorCue, FramesSeenBeforeTheModelIsConfirmedAreWalkedWhenItIs) {
+  load("");
+  static FloorCue fresh{g_rig};
+  fresh.reset();
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  FloorCueResult r = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK(r.deferred);
+  CHECK_FALSE(r.model_valid);
+  CHECK_EQUAL(0U, out.free.size());
+  render(1.2F, kLookTilt, 2, g_frame2);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame2, 1.2F, kLookTilt));
+  FixedVector<Reading, 512> free;
+  r = fresh.process(g_frame2, 1.2F, kLookTilt, out.obstacles, free);
+  CHECK_EQUAL(1U, r.deferred_walked);
+  CHECK_EQUAL(160U, free.size());  // 80 walks of each frame, all out to max range
+  std::size_t ahead = 0;  // walks of the kept frame (pan 0): within 0.5 rad of straight ahead
+  for (const Reading& f : free) {
+    ahead += std::fabs(std::remainder(f.alpha_rad, 6.2831853F)) < 0.5F ? 1U : 0U;
+  }
+  CHECK(ahead >= 70U);
+}
+
 TEST(FloorCue, LearningAtLevelTiltFindsNoReferenceRegion) {
   load("");
   render(0.0F, 0.0F, 1, g_frame);
@@ -370,6 +506,13 @@ TEST(FloorCue, ProcessingNeverWritesPastTheOutputsAndDoesNotAllocate) {
   FixedVector<Reading, 7> obstacles;
   FixedVector<Reading, 5> free;
   FloorCueResult r;
+  FixedVector<float, 3> near_m;
+  CHECK_NO_ALLOCATION(r = cue.process(g_frame, 0.0F, kLookTilt, obstacles, free, &near_m));
+  CHECK(r.truncated);
+  CHECK_EQUAL(3U, free.size());  // in step with the near ends, the shorter list
+  CHECK_EQUAL(3U, near_m.size());
+  obstacles.clear();
+  free.clear();
   CHECK_NO_ALLOCATION(r = cue.process(g_frame, 0.0F, kLookTilt, obstacles, free));
   CHECK(r.truncated);
   CHECK_EQUAL(7U, obstacles.size());

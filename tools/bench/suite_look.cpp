@@ -27,6 +27,7 @@
 #include "board_config.h"
 #include "firmware/mission/mission.h"
 #include "firmware/mission/mission_params.h"
+#include "firmware/mission/target_tracker.h"
 #include "firmware/snapshot.h"
 #include "hal/sim/renderer.h"
 #include "hal/sim/sim_world.h"
@@ -59,10 +60,12 @@ image::LowResFrame g_second;
 Readings g_features;
 FloorObstacles g_floor_obstacles;
 FloorFree g_floor_free;
+core::FixedVector<float, firmware::mission::kMaxLookFloorFree> g_floor_free_near;
 mapping::LocalModelBuilder g_builder;
 
 firmware::SnapshotWriter g_snapshots;
 const char* g_snapshot_dir = nullptr;
+bool g_snapshot_all = false;  // BOTICELLI_LOOK_SNAPSHOTS_ALL=1: every look, not only unsafe ones
 std::uint32_t g_look_number = 0;
 
 // BOTICELLI_LOOK_SNAPSHOTS=DIR: a picture of every look whose free polygon is not wholly free
@@ -328,6 +331,9 @@ struct WorldStats {
   std::vector<double> render_ms, stereo_ms, target_ms, floor_ms, think_ms;
   std::size_t target_views = 0, target_found = 0, target_far = 0, target_false = 0;
   std::vector<double> target_error_m, target_far_error_m;
+  // Per look, as the mission acts on it: the look's fixes in the mission's TargetTracker.
+  std::size_t pose_target_views = 0, pose_target_found = 0, pose_target_confirmed = 0;
+  std::vector<double> pose_target_error_m;
 };
 
 int run_world(const std::string& dir, const std::string& name, std::size_t poses,
@@ -383,7 +389,12 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     g_features.clear();
     g_floor_obstacles.clear();
     g_floor_free.clear();
+    g_floor_free_near.clear();
     floor_cue.reset();  // the mission's first look: nothing known about the floor yet
+    firmware::mission::TargetTracker tracker;
+    tracker.configure(params.target);
+    bool pose_in_view = false;
+    std::uint32_t view_number = 0;
     double render_ns = 0, stereo_ns = 0, target_ns = 0, floor_ns = 0;
     for (const firmware::mission::LookView& view : views) {
       stereo::PairPose pp;
@@ -438,10 +449,12 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
             static_cast<double>((g_world.target_point_m - first_pose.translation_m).norm()) <=
                 kTargetViewM;
         st.target_views += in_view ? 1U : 0U;
+        pose_in_view = pose_in_view || in_view;
         if (fix.found) {
           const core::Point2 w = core::to_world(pose, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
           const Eigen::Vector3f p(w.x_m, w.y_m, fix.point_ptu_m.z() + params.rig.ptu_height_m);
           const double e = (p - g_world.target_point_m).norm();
+          tracker.add(p, fix.confidence, view_number, fix.point_ptu_m.norm());
           if (in_view) {
             ++st.target_found;
             st.target_error_m.push_back(e);
@@ -453,18 +466,29 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
           }
         }
       }
+      ++view_number;
       // The floor cue as Mission::process_view: learn and walk the first frame, and a low
       // pair's second frame too (it sees nearer floor than the first).
       t0 = cpu_ns();
       (void)floor_cue.learn(g_first, pp.pan_rad, pp.first_tilt_rad);
       (void)floor_cue.process(g_first, pp.pan_rad, pp.first_tilt_rad, g_floor_obstacles,
-                              g_floor_free);
+                              g_floor_free, &g_floor_free_near);
       if (view.pair && pp.second_tilt_rad < -0.3F) {
         (void)floor_cue.learn(g_second, pp.pan_rad, pp.second_tilt_rad);
         (void)floor_cue.process(g_second, pp.pan_rad, pp.second_tilt_rad, g_floor_obstacles,
-                                g_floor_free);
+                                g_floor_free, &g_floor_free_near);
       }
       floor_ns += static_cast<double>(cpu_ns() - t0);
+    }
+    if (pose_in_view) {
+      ++st.pose_target_views;
+      if (tracker.sightings() > 0) {
+        ++st.pose_target_found;
+        st.pose_target_confirmed += tracker.confirmed() ? 1U : 0U;
+        const Eigen::Vector3f& est =
+            tracker.confirmed() ? tracker.estimate_m() : tracker.candidate_m();
+        st.pose_target_error_m.push_back((est - g_world.target_point_m).norm());
+      }
     }
     std::size_t weak = 0;
     for (const evidence::Reading& r : g_features) weak += r.m < 0.6F ? 1U : 0U;
@@ -478,7 +502,8 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     // Think, as Mission::begin_think: filter by the reading limits, then the local model.
     const std::int64_t t0 = cpu_ns();
     (void)evidence::filter_readings(g_features, params.limits);
-    g_builder.start(params.model, g_features.span(), g_floor_obstacles.span(), g_floor_free.span());
+    g_builder.start(params.model, g_features.span(), g_floor_obstacles.span(), g_floor_free.span(),
+                    g_floor_free_near.span());
     g_builder.run();
     st.think_ms.push_back(static_cast<double>(cpu_ns() - t0) * 1e-6);
     st.pieces.push_back(static_cast<double>(g_builder.stats().pieces));
@@ -493,7 +518,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     const Quality q =
         quality(pose, g_builder.map(),
                 static_cast<double>(params.model.extraction.bounding_radius_m), radius, height);
-    if (g_snapshot_dir != nullptr && (q.nav_safety < 1.0 || q.safety < 0.99)) {
+    if (g_snapshot_dir != nullptr && (g_snapshot_all || q.nav_safety < 1.0 || q.safety < 0.99)) {
       std::fprintf(stderr, "look: %s look %u at (%.2f, %.2f, %.2f): safety %.4f nav safety %.4f\n",
                    name.c_str(), g_look_number, static_cast<double>(pose.x_m),
                    static_cast<double>(pose.y_m), static_cast<double>(pose.yaw_rad), q.safety,
@@ -554,6 +579,15 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .integer("target_far", static_cast<std::int64_t>(st.target_far))
       .num("target_far_err_median_m", percentile(st.target_far_error_m, 0.5))
       .integer("target_false", static_cast<std::int64_t>(st.target_false))
+      .integer("looks_target_in_view", static_cast<std::int64_t>(st.pose_target_views))
+      .integer("looks_target_found", static_cast<std::int64_t>(st.pose_target_found))
+      .integer("looks_target_confirmed", static_cast<std::int64_t>(st.pose_target_confirmed))
+      .integer("looks_target_within_0_1m",
+               static_cast<std::int64_t>(std::count_if(st.pose_target_error_m.begin(),
+                                                       st.pose_target_error_m.end(),
+                                                       [](double e) { return e <= 0.1; })))
+      .num("looks_target_err_median_m", percentile(st.pose_target_error_m, 0.5))
+      .num("looks_target_err_max_m", percentile(st.pose_target_error_m, 1.0))
       .num("render_ms", mean(st.render_ms))
       .num("stereo_ms", mean(st.stereo_ms))
       .num("target_ms", mean(st.target_ms))
@@ -569,6 +603,7 @@ int run() {
   int status = 0;
   const std::string dir = worlds_dir("BOTICELLI_LOOK_WORLDS_DIR", BOTICELLI_WORLDS_DIR);
   g_snapshot_dir = std::getenv("BOTICELLI_LOOK_SNAPSHOTS");
+  g_snapshot_all = env_long("BOTICELLI_LOOK_SNAPSHOTS_ALL", 0) != 0;
   if (g_snapshot_dir != nullptr) {
     char error[200] = "";
     if (!g_snapshots.open(g_snapshot_dir, error, sizeof error)) {

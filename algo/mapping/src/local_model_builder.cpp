@@ -34,11 +34,15 @@ float own_disc_m(const ExtractionParams& p) {
 void LocalModelBuilder::start(const LocalModelParams& params,
                               std::span<const evidence::Reading> features,
                               std::span<const evidence::Reading> floor_obstacles,
-                              std::span<const evidence::Reading> floor_free) {
+                              std::span<const evidence::Reading> floor_free,
+                              std::span<const float> floor_free_near_m) {
   params_ = params;
   features_ = features;
   obstacles_ = floor_obstacles;
   free_ = floor_free;
+  // Out of step with the free readings: not used (every walk then counts as joined).
+  free_near_ =
+      floor_free_near_m.size() == floor_free.size() ? floor_free_near_m : std::span<const float>{};
   cursor_ = 0;
   ray_samples_.clear();
   samples_.clear();
@@ -179,11 +183,37 @@ void LocalModelBuilder::build_seen_free() {
     seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), std::min(rho, p.bounding_radius_m)));
   };
   const float dr = params_.rays.delta_r_fraction;
-  for (const evidence::Reading& r : free_) see(r.alpha_rad, horizontal_m(r));
-  for (const evidence::Reading& r : obstacles_) see(r.alpha_rad, horizontal_m(r) * (1.0F - dr));
+  if (free_near_.empty()) {
+    for (const evidence::Reading& r : free_) see(r.alpha_rad, horizontal_m(r));
+    for (const evidence::Reading& r : obstacles_) see(r.alpha_rad, horizontal_m(r) * (1.0F - dr));
+  } else {
+    // Walks joined to the robot, outwards: a pass joins every walk that starts within reach
+    // of its direction, until a pass joins none. Walks of one direction overlap (a low view
+    // sees from 0.3 m to the wall), so two or three passes do; the bound keeps a unit short,
+    // and a chain it cuts is left shorter (less free), never longer. A boundary walk's free
+    // reading is its last floor sample, just before the base.
+    constexpr std::size_t kMaxJoinPasses = 8;
+    bool joined = true;
+    for (std::size_t pass = 0; joined && pass < kMaxJoinPasses; ++pass) {
+      joined = false;
+      for (std::size_t i = 0; i < free_.size(); ++i) {
+        const evidence::Reading& r = free_[i];
+        const std::size_t k = vertex_of(seen_free_, r.alpha_rad);
+        const float reach = seen_free_.rho_m(k);
+        const float far = std::min(horizontal_m(r), p.bounding_radius_m);
+        const float start_limit =
+            std::max(params_.seen_floor_start_m, reach + params_.seen_floor_gap_m);
+        if (far > reach && free_near_[i] <= start_limit) {
+          seen_free_.set_rho_m(k, far);
+          joined = true;
+        }
+      }
+    }
+  }
   const float h_lo = slice_height_m(p, 0);
   const float h_hi = slice_height_m(p, p.height_count == 0 ? 0 : p.height_count - 1);
   for (const evidence::Reading& r : features_) {
+    if (!params_.features_show_free) break;
     if (r.h_m >= h_lo && r.h_m <= h_hi && r.m >= p.safe_occupancy) {
       see(r.alpha_rad, horizontal_m(r) * (1.0F - 2.0F * dr));
     }

@@ -164,23 +164,30 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   candidate.valid = true;
   const std::array<float, 3> min_tolerance{params_.min_tolerance_luma, params_.min_tolerance_chroma,
                                            params_.min_tolerance_chroma};
+  const std::array<float, 3> max_tolerance{params_.max_tolerance_luma, params_.max_tolerance_chroma,
+                                           params_.max_tolerance_chroma};
   for (std::size_t c = 0; c < 3; ++c) {
     float median = 0.0F;
     float sigma = 0.0F;
     robust_stats(histogram[c], count, median, sigma);
     candidate.median[c] = c == 0 ? median : median - 128.0F;
     candidate.tolerance[c] = std::max(params_.spread_factor * sigma, min_tolerance[c]);
+    if (candidate.tolerance[c] > max_tolerance[c]) {
+      return FloorLearn::kNotUniform;  // two surfaces (or one too busy to tell from others)
+    }
   }
   // Consistency: the region must look like floor to its own model (an obstacle covering
   // part of it fails here) and to the model already known (one covering all of it).
   std::size_t own = 0;
   std::size_t known = 0;
+  std::size_t pending = 0;
   for (std::size_t i = 0; i < count; ++i) {
     const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
                                       static_cast<float>(reference_[i][1]) - 128.0F,
                                       static_cast<float>(reference_[i][2]) - 128.0F};
     own += contrast_to(candidate, values) <= 1.0F ? 1U : 0U;
     known += model_.valid && contrast_to(model_, values) <= 1.0F ? 1U : 0U;
+    pending += pending_.valid && contrast_to(pending_, values) <= 1.0F ? 1U : 0U;
   }
   const auto needed =
       static_cast<std::size_t>(std::ceil(params_.consistency_min * static_cast<float>(count)));
@@ -191,8 +198,26 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
     return FloorLearn::kNotUniform;
   }
   if (!model_.valid) {
-    model_ = candidate;
-    return FloorLearn::kLearned;
+    if (params_.confirm_separation_rad <= 0.0F) {
+      model_ = candidate;
+      return FloorLearn::kLearned;
+    }
+    const float apart = std::fabs(std::remainder(pan_rad - pending_pan_rad_, core::kTwoPi<float>));
+    if (pending_.valid && pending >= needed && apart >= params_.confirm_separation_rad) {
+      // Two directions agree: the floor. The model starts between their two regions.
+      model_ = pending_;
+      for (std::size_t c = 0; c < 3; ++c) {
+        model_.median[c] = 0.5F * (pending_.median[c] + candidate.median[c]);
+        model_.tolerance[c] = 0.5F * (pending_.tolerance[c] + candidate.tolerance[c]);
+      }
+      pending_ = FloorModel{};
+      return FloorLearn::kLearned;
+    }
+    if (!(pending_.valid && pending >= needed)) {
+      pending_ = candidate;  // the first region, or one unlike it: the latest waits
+      pending_pan_rad_ = pan_rad;
+    }
+    return FloorLearn::kPending;
   }
   const float w = params_.learn_rate;
   for (std::size_t c = 0; c < 3; ++c) {
@@ -217,7 +242,59 @@ bool FloorCue::sight_floor_point(const CameraPose& pose, float azimuth_rad, floa
 
 FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                                  core::FixedVectorBase<evidence::Reading>& obstacles,
-                                 core::FixedVectorBase<evidence::Reading>& free) {
+                                 core::FixedVectorBase<evidence::Reading>& free,
+                                 core::FixedVectorBase<float>* free_near_m) {
+  const std::size_t pixels = std::size_t{frame.width} * frame.height;
+  if (!model_.valid) {
+    FloorCueResult result;
+    if (pixels == 0) return result;
+    if (deferred_count_ < kDeferredSlots && pixels <= kDeferredPixels) {
+      DeferredFrame& d = deferred_[deferred_count_++];
+      d.width = frame.width;
+      d.height = frame.height;
+      d.pan_rad = pan_rad;
+      d.tilt_rad = tilt_rad;
+      std::copy_n(frame.luma.begin(), pixels, d.luma.begin());
+      std::copy_n(frame.chroma_u.begin(), pixels, d.chroma_u.begin());
+      std::copy_n(frame.chroma_v.begin(), pixels, d.chroma_v.begin());
+      result.deferred = true;
+    } else {
+      result.deferred_dropped = true;
+    }
+    return result;
+  }
+  FloorCueResult total;
+  // One kept frame per call (oldest first), so that no call walks more than two frames.
+  if (deferred_next_ < deferred_count_) {
+    const DeferredFrame& d = deferred_[deferred_next_++];
+    const std::size_t n = std::size_t{d.width} * d.height;
+    scratch_.width = d.width;
+    scratch_.height = d.height;
+    std::copy_n(d.luma.begin(), n, scratch_.luma.begin());
+    std::copy_n(d.chroma_u.begin(), n, scratch_.chroma_u.begin());
+    std::copy_n(d.chroma_v.begin(), n, scratch_.chroma_v.begin());
+    const FloorCueResult r = walk(scratch_, d.pan_rad, d.tilt_rad, obstacles, free, free_near_m);
+    total.obstacle_readings += r.obstacle_readings;
+    total.free_readings += r.free_readings;
+    total.boundaries += r.boundaries;
+    total.truncated = total.truncated || r.truncated;
+    ++total.deferred_walked;
+    if (deferred_next_ == deferred_count_) deferred_next_ = deferred_count_ = 0;
+  }
+  const FloorCueResult r = walk(frame, pan_rad, tilt_rad, obstacles, free, free_near_m);
+  total.obstacle_readings += r.obstacle_readings;
+  total.free_readings += r.free_readings;
+  total.boundaries += r.boundaries;
+  total.columns = r.columns;
+  total.truncated = total.truncated || r.truncated;
+  total.model_valid = r.model_valid;
+  return total;
+}
+
+FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
+                              core::FixedVectorBase<evidence::Reading>& obstacles,
+                              core::FixedVectorBase<evidence::Reading>& free,
+                              core::FixedVectorBase<float>* free_near_m) {
   FloorCueResult result;
   column_count_ = 0;
   result.model_valid = model_.valid;
@@ -362,8 +439,16 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
     }
     if (have_floor) {
       col.free_rho_m = std::hypot(free_point.x(), free_point.y());
-      if (free.push_back(reading_from_point(free_point, 0.0F))) {
-        ++result.free_readings;
+      // With free_near_m, the walk's near end goes with it, or neither is kept.
+      if (free_near_m != nullptr && free_near_m->size() != free.size()) {
+        result.truncated = true;  // the caller's lists are out of step: add to neither
+      } else if (free.push_back(reading_from_point(free_point, 0.0F))) {
+        if (free_near_m == nullptr || free_near_m->push_back(col.near_rho_m)) {
+          ++result.free_readings;
+        } else {
+          free.pop_back();
+          result.truncated = true;
+        }
       } else {
         result.truncated = true;
       }

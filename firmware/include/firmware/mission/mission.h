@@ -242,6 +242,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   core::FixedVector<evidence::Reading, kMaxLookFeatures> features_;
   core::FixedVector<evidence::Reading, kMaxLookFloorObstacles> floor_obstacles_;
   core::FixedVector<evidence::Reading, kMaxLookFloorFree> floor_free_;
+  core::FixedVector<float, kMaxLookFloorFree> floor_free_near_;  // each walk's near end [m]
   TargetTracker tracker_;
   std::uint32_t last_features_ = 0;
   std::uint32_t last_pieces_ = 0;

@@ -46,6 +46,18 @@ struct LocalModelParams {
   // Only space something showed free counts as free (§4.9.1: unknown is not free): the free
   // polygon is cut to the farthest floor seen in each vertex direction.
   bool clamp_to_seen_free = true;
+  // With the floor cue's walk starts (start()'s floor_free_near), floor counts as seen only
+  // along walks joined to the robot: one that starts within seen_floor_start_m of the PTU
+  // axis (the floor nearer than the lowest view's bottom row is never in view, whatever the
+  // robot does) or at most seen_floor_gap_m beyond where a joined walk in the same vertex
+  // direction ends. A walk that starts beyond an obstacle (a high view over a low box)
+  // shows nothing about the floor before it.
+  float seen_floor_start_m = 0.7F;
+  float seen_floor_gap_m = 0.1F;
+  // A stereo feature in the robot's height band (m ≥ m_safe) counts the band as seen free up
+  // to 2 δr before it. Its line of sight is free, but not the floor under it: a box lower
+  // than the line of sight stays unseen. false: only the floor cue shows the floor free.
+  bool features_show_free = true;
   // Wedges of the free polygon narrower than 2·spike_half_width + 1 vertex rays are cut to
   // their neighbours (open_spikes): a ray or two the fit leaves open through a wall, or that a
   // stray far reading kept seen. 0 keeps them (the first wave's polygon).
@@ -71,7 +83,9 @@ struct LocalModelStats {
 
 // One look's local model. start() takes the look's readings (robot/PTU frame, §4.5.2):
 // stereo features, the floor cue's obstacle bases (occupied) and its farthest free floor
-// points (m = 0: the line of sight to them is free). The spans must stay valid until done().
+// points (m = 0: the line of sight to them is free), and optionally, in step with those, the
+// horizontal distance [m] at which each floor walk began (FloorCue::process); without them
+// every walk counts as joined to the robot. The spans must stay valid until done().
 // step() does one bounded unit of work; nothing allocates. Make the object static (MBs).
 class LocalModelBuilder {
  public:
@@ -81,7 +95,8 @@ class LocalModelBuilder {
 
   void start(const LocalModelParams& params, std::span<const evidence::Reading> features,
              std::span<const evidence::Reading> floor_obstacles,
-             std::span<const evidence::Reading> floor_free);
+             std::span<const evidence::Reading> floor_free,
+             std::span<const float> floor_free_near_m = {});
   // One unit of work; true when the local map is ready.
   bool step();
   // Runs to the end (tests, benchmarks).
@@ -132,6 +147,7 @@ class LocalModelBuilder {
   std::span<const evidence::Reading> features_{};
   std::span<const evidence::Reading> obstacles_{};
   std::span<const evidence::Reading> free_{};
+  std::span<const float> free_near_{};
   std::size_t cursor_ = 0;
   std::size_t guard_cursor_ = 0;  // next guard candidate to corroborate
   core::FixedVector<evidence::RaySample, kLookMaxSamples> ray_samples_;

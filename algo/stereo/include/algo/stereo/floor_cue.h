@@ -35,10 +35,21 @@ struct FloorCueParams {
   float spread_factor = 4.0F;                // tolerance in robust standard deviations
   float min_tolerance_luma = 10.0F;          // smallest luma tolerance [grey levels]
   float min_tolerance_chroma = 5.0F;         // smallest chroma tolerance [chroma levels]
+  // A region whose spread asks for more than these is not one surface (kNotUniform): half
+  // wall, half floor, its median between the two and 4σ wide enough to call both floor. A
+  // plain floor's own spread is the sensor noise (σ ≈ 2 grey levels, so the minimum applies).
+  float max_tolerance_luma = 30.0F;    // [grey levels]
+  float max_tolerance_chroma = 15.0F;  // [chroma levels]
   // Learning accepts a region only if at least this fraction of its pixels look like floor,
   // both to the region's own model and to the model already known (if any).
   float consistency_min = 0.9F;
-  float learn_rate = 0.5F;         // weight of a fresh region when updating a model, (0, 1]
+  float learn_rate = 0.5F;  // weight of a fresh region when updating a model, (0, 1]
+  // The first model needs two regions that agree, seen from pans at least this far apart
+  // [rad]: a plain box or wall filling one view's region (the robot beside it) is uniform and
+  // would be learned as the floor, and every later region of the real floor would then be
+  // refused as inconsistent. The floor is what views in different directions share. 0 trusts
+  // the first region (the reference area of Ulrich & Nourbakhsh, assumed free).
+  float confirm_separation_rad = 1.0F;
   std::uint32_t column_step = 2;   // every column_step-th column is walked [px]
   std::uint32_t boundary_run = 3;  // k: non-floor pixels in a row that end the floor [px]
   // Obstacle readings at the base's ρ, at these heights above the floor [m] (the robot must
@@ -66,6 +77,7 @@ enum class FloorLearn : std::uint8_t {
   kNoRegion,      // the geometry gives too few reference pixels at this tilt
   kNotUniform,    // the region does not agree with itself (something else in it)
   kInconsistent,  // the region does not look like the known floor (obstacle in front)
+  kPending,       // no model yet: the region waits for one from another direction to agree
 };
 
 // One walk of the last process() call: up the image of the vertical plane through the
@@ -93,6 +105,9 @@ struct FloorCueResult {
   std::size_t boundaries = 0;         // columns ending at an obstacle base
   bool truncated = false;             // an output was full: some readings were dropped
   bool model_valid = false;           // false: nothing was done (no floor model yet)
+  std::size_t deferred_walked = 0;    // kept frames walked first (the model just came)
+  bool deferred = false;              // no model yet: the frame was kept for later
+  bool deferred_dropped = false;      // no model yet and no room (or too large): frame lost
 };
 
 class FloorCue {
@@ -102,12 +117,26 @@ class FloorCue {
   explicit FloorCue(const RigModel& rig, const FloorCueParams& params = {});
   [[nodiscard]] const FloorCueParams& params() const { return params_; }
   [[nodiscard]] const FloorModel& model() const { return model_; }
-  void reset() { model_ = FloorModel{}; }
+  void reset() {
+    model_ = FloorModel{};
+    pending_ = FloorModel{};
+    deferred_count_ = deferred_next_ = 0;
+  }
+  // A new look (the robot may have moved): kept frames belong to the last pose, drop them.
+  void begin_look() { deferred_count_ = deferred_next_ = 0; }
+  // Frames kept while the first model waits for a second direction (walked once it is
+  // confirmed, one per process() call besides the current frame, so the views before it lose
+  // nothing and no call walks more than two frames): slots of the rig's low-resolution size
+  // (about 115 KB each).
+  static constexpr std::size_t kDeferredSlots = 10;
+  static constexpr std::size_t kDeferredPixels = std::size_t{160} * 120;
 
   // Learns (or, if one is known, updates) the floor model from the frame's reference
   // region for the PTU at pan/tilt [rad]. Nothing changes unless kLearned or kUpdated.
   FloorLearn learn(const image::LowResFrame& frame, float pan_rad, float tilt_rad);
 
+  // Without a model yet, keeps the frame (up to kDeferredSlots) and returns; with one, walks
+  // the oldest kept frame first, if any (its readings are appended as well), then this one.
   // Walks one frame (the rig's low resolution) seen at pan/tilt [rad] with the current
   // model: every column_step-th pixel of the highest row that sees the floor within max
   // range gives one walk up its vertical plane from where that plane enters the image.
@@ -116,9 +145,15 @@ class FloorCue {
   // contrast) and to `free` one reading per column with m = 0 at the farthest floor point connected
   // to the bottom of the image (the line of sight to it is free). Never writes past either
   // capacity. Nothing is allocated.
+  // `free_near_m`, if given, gets in step with `free` the horizontal distance [m] of each
+  // walk's near end (where it entered the image): the walk saw the floor from there to its
+  // free reading. A walk that starts beyond an obstacle (a high view looking over a low box,
+  // or over a wall the floor model took for floor) says nothing about the floor before it;
+  // the Think stage joins walks to the robot only where they meet (LocalModelBuilder).
   FloorCueResult process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                          core::FixedVectorBase<evidence::Reading>& obstacles,
-                         core::FixedVectorBase<evidence::Reading>& free);
+                         core::FixedVectorBase<evidence::Reading>& free,
+                         core::FixedVectorBase<float>* free_near_m = nullptr);
 
   // Columns of the last process() call.
   [[nodiscard]] std::size_t column_count() const { return column_count_; }
@@ -142,6 +177,10 @@ class FloorCue {
   // Ray of pixel (u, v) meets the floor: the floor point (PTU frame) and its ρ [m].
   bool floor_point(const CameraPose& pose, float u, float v, Eigen::Vector3f& point,
                    float& rho_m) const;
+  FloorCueResult walk(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
+                      core::FixedVectorBase<evidence::Reading>& obstacles,
+                      core::FixedVectorBase<evidence::Reading>& free,
+                      core::FixedVectorBase<float>* free_near_m);
   void pixel_values(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
                     std::array<float, 3>& values) const;
   float contrast_to(const FloorModel& model, const std::array<float, 3>& values) const;
@@ -149,6 +188,21 @@ class FloorCue {
   RigModel rig_;
   FloorCueParams params_;
   FloorModel model_;
+  FloorModel pending_;  // the first region's model, until another direction's agrees
+  float pending_pan_rad_ = 0.0F;
+  struct DeferredFrame {
+    std::uint32_t width = 0;
+    std::uint32_t height = 0;
+    float pan_rad = 0.0F;
+    float tilt_rad = 0.0F;
+    std::array<float, kDeferredPixels> luma{};
+    std::array<std::uint8_t, kDeferredPixels> chroma_u{};
+    std::array<std::uint8_t, kDeferredPixels> chroma_v{};
+  };
+  std::array<DeferredFrame, kDeferredSlots> deferred_{};
+  std::size_t deferred_count_ = 0;
+  std::size_t deferred_next_ = 0;  // the next kept frame to walk
+  image::LowResFrame scratch_{};   // a kept frame, unpacked for its walk
   std::array<FloorColumn, kMaxColumns> columns_{};
   std::size_t column_count_ = 0;
   // Reference pixels of the region being learned (compensated values), for the robust stats.
