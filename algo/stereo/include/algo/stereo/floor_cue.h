@@ -122,7 +122,7 @@ class FloorCue {
     pending_ = FloorModel{};
     deferred_count_ = deferred_next_ = 0;
   }
-  // A new look (the robot may have moved): kept frames belong to the last pose, drop them.
+  // Another look begins (the robot may have moved): kept frames belong to the last pose, drop them.
   void begin_look() { deferred_count_ = deferred_next_ = 0; }
   // Frames kept while the first model waits for a second direction (walked once it is
   // confirmed, one per process() call besides the current frame, so the views before it lose
