@@ -497,3 +497,37 @@ TEST(LocalModelBuilder, AFloorWalkThatStartsBeyondAPlainBoxShowsNoFloorBeforeIt)
   g_other.run();
   CHECK(widest_over_box(g_other.map().free) > kBox_m + 0.5F);
 }
+
+TEST(LocalModelBuilder, AFeatureInTheBandShowsTheFloorBeforeItFreeOnlyWhenFeaturesShowFree) {
+  static Look look;
+  static FixedVector<Reading, 1024> free;
+  static FixedVector<float, 1024> near_m;
+  look.features.clear();
+  look.obstacles.clear();
+  free.clear();
+  near_m.clear();
+  // A featured wall all round; the floor cue walked only the half 0–180°.
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    for (const float z : {0.1F, 0.4F}) (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
+    if (d < 180) {
+      (void)free.push_back(at(alpha, kWall_m - 0.03F, 0.0F, 0.0F));
+      (void)near_m.push_back(0.35F);
+    }
+  }
+  mapping::LocalModelParams params = make_params();
+  params.features_show_free = true;
+  g_other.start(params, look.features.span(), look.obstacles.span(), free.span(), near_m.span());
+  g_other.run();
+  // The walked half is seen to the walks' ends either way; the other half only by features
+  // (2 δr before them).
+  CHECK(g_other.seen_free().radius_at_m(deg(90.0F)) > kWall_m - 0.1F);
+  CHECK(g_other.seen_free().radius_at_m(deg(270.0F)) > 0.7F * kWall_m);
+  params.features_show_free = false;
+  g_other.start(params, look.features.span(), look.obstacles.span(), free.span(), near_m.span());
+  g_other.run();
+  CHECK(g_other.seen_free().radius_at_m(deg(90.0F)) > kWall_m - 0.1F);
+  // Unwalked: only the robot's own disc.
+  CHECK(g_other.seen_free().radius_at_m(deg(270.0F)) < 0.5F);
+  CHECK(g_other.map().free.radius_at_m(deg(270.0F)) < 0.5F);
+}
