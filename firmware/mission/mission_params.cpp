@@ -85,8 +85,9 @@ MissionParams make_mission_params(const BoardConfig& c) {
 
   // Stereo features show their line of sight free as well as the floor cue's walks. With
   // only the walks (features_show_free = false) the cluttered room's look safety rises from
-  // 0.9975 to 0.999, but the free space ends within the walks' 3 m and the mission crawls: the
-  // corridor is not found in 45 cycles (found in 23 with features). docs/benchmarks.md.
+  // 0.9975 to 0.999, but the corridor is not found in 45 cycles (23 with features): the smaller
+  // seen-free polygon leaves the open west end's exploration points unexplored and the robot
+  // walks out of it. docs/benchmarks.md.
   m.features_show_free = true;
 
   // Floor walks that start within the lowest view's bottom row (its farthest point, at the
