@@ -439,6 +439,24 @@ TEST(LocalModelBuilder, AShelfSeenOnlyWithLowEvidenceIsNotDrivenUnder) {
   CHECK_TEXT(worst_m >= kRobotRadius_m, "a navigable point puts the robot under the weak shelf");
 }
 
+// A look with the floor cue's walks: their far ends and, in step, where each began.
+struct WalkedLook {
+  Look look;
+  FixedVector<Reading, 1024> free;
+  FixedVector<float, 1024> near_m;
+};
+
+// The one shared WalkedLook, emptied.
+WalkedLook& walked_look() {
+  static WalkedLook w;
+  w.look.features.clear();
+  w.look.obstacles.clear();
+  w.look.free.clear();
+  w.free.clear();
+  w.near_m.clear();
+  return w;
+}
+
 // A plain low box (0.3 m tall, front 1.0 m away, pan 60°–90°) that neither the stereo nor the
 // floor cue's appearance test sees: the low view's walks there end at its front (their
 // floor stops), and a high view's walks, whose bottom row already lies beyond the box, see
@@ -447,13 +465,10 @@ TEST(LocalModelBuilder, AShelfSeenOnlyWithLowEvidenceIsNotDrivenUnder) {
 // it through. The wall's features in the sector lie above the robot's band (they show
 // nothing about the floor).
 TEST(LocalModelBuilder, AFloorWalkThatStartsBeyondAPlainBoxShowsNoFloorBeforeIt) {
-  static Look look;
-  static FixedVector<Reading, 1024> free;
-  static FixedVector<float, 1024> near_m;
-  look.features.clear();
-  look.obstacles.clear();
-  free.clear();
-  near_m.clear();
+  WalkedLook& w = walked_look();
+  Look& look = w.look;
+  auto& free = w.free;
+  auto& near_m = w.near_m;
   constexpr float kBox_m = 1.0F;
   constexpr float kLowStart_m = 0.35F;
   constexpr float kHighStart_m = 1.7F;
@@ -499,13 +514,10 @@ TEST(LocalModelBuilder, AFloorWalkThatStartsBeyondAPlainBoxShowsNoFloorBeforeIt)
 }
 
 TEST(LocalModelBuilder, AFeatureInTheBandShowsTheFloorBeforeItFreeOnlyWhenFeaturesShowFree) {
-  static Look look;
-  static FixedVector<Reading, 1024> free;
-  static FixedVector<float, 1024> near_m;
-  look.features.clear();
-  look.obstacles.clear();
-  free.clear();
-  near_m.clear();
+  WalkedLook& w = walked_look();
+  Look& look = w.look;
+  auto& free = w.free;
+  auto& near_m = w.near_m;
   // A featured wall all round; the floor cue walked only the half 0–180°.
   for (int d = 0; d < 360; ++d) {
     const float alpha = deg(static_cast<float>(d));

@@ -212,8 +212,9 @@ void LocalModelBuilder::build_seen_free() {
   }
   const float h_lo = slice_height_m(p, 0);
   const float h_hi = slice_height_m(p, p.height_count == 0 ? 0 : p.height_count - 1);
-  for (const evidence::Reading& r : features_) {
-    if (!params_.features_show_free) break;
+  const std::span<const evidence::Reading> band_features =
+      params_.features_show_free ? features_ : std::span<const evidence::Reading>{};
+  for (const evidence::Reading& r : band_features) {
     if (r.h_m >= h_lo && r.h_m <= h_hi && r.m >= p.safe_occupancy) {
       see(r.alpha_rad, horizontal_m(r) * (1.0F - 2.0F * dr));
     }

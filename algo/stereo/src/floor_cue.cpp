@@ -62,6 +62,14 @@ std::uint8_t to_byte(float x) {
   return static_cast<std::uint8_t>(std::clamp(std::lround(x), 0L, 255L));
 }
 
+// Adds one walked frame's readings to a process() call's result.
+void add_walk(const FloorCueResult& r, FloorCueResult& total) {
+  total.obstacle_readings += r.obstacle_readings;
+  total.free_readings += r.free_readings;
+  total.boundaries += r.boundaries;
+  total.truncated = total.truncated || r.truncated;
+}
+
 }  // namespace
 
 FloorCue::FloorCue(const RigModel& rig, const FloorCueParams& params) : rig_(rig), params_(params) {
@@ -273,20 +281,13 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
     std::copy_n(d.luma.begin(), n, scratch_.luma.begin());
     std::copy_n(d.chroma_u.begin(), n, scratch_.chroma_u.begin());
     std::copy_n(d.chroma_v.begin(), n, scratch_.chroma_v.begin());
-    const FloorCueResult r = walk(scratch_, d.pan_rad, d.tilt_rad, obstacles, free, free_near_m);
-    total.obstacle_readings += r.obstacle_readings;
-    total.free_readings += r.free_readings;
-    total.boundaries += r.boundaries;
-    total.truncated = total.truncated || r.truncated;
+    add_walk(walk(scratch_, d.pan_rad, d.tilt_rad, obstacles, free, free_near_m), total);
     ++total.deferred_walked;
     if (deferred_next_ == deferred_count_) deferred_next_ = deferred_count_ = 0;
   }
   const FloorCueResult r = walk(frame, pan_rad, tilt_rad, obstacles, free, free_near_m);
-  total.obstacle_readings += r.obstacle_readings;
-  total.free_readings += r.free_readings;
-  total.boundaries += r.boundaries;
-  total.columns = r.columns;
-  total.truncated = total.truncated || r.truncated;
+  add_walk(r, total);
+  total.columns = r.columns;  // the columns (and column()) are this frame's
   total.model_valid = r.model_valid;
   return total;
 }
