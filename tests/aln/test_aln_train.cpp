@@ -265,7 +265,8 @@ TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
 }
 
 TEST(AlnTrain, DifferentSeedsGiveDifferentModelsOfTheSameQuality) {
-  // The seed only jitters the split tilts: another seed, another model, fitted as well.
+  // The seed picks among near-equal split candidates and shifts the hinge a little: another
+  // seed, another model, fitted as well.
   const std::size_t n = fill_room(2000, 0.0, 12);
   set_room_ranges(g_model3);
   set_room_ranges(g_model3b);

@@ -77,7 +77,10 @@ void configure_model(Model& model, const SyntheticRoom& room) {
 std::vector<AlnSample> build_samples(const SyntheticRoom& room,
                                      const std::vector<evidence::Reading>& readings) {
   g_ray_samples.clear();
-  const evidence::RaySampleParams params;
+  evidence::RaySampleParams params;
+  // δr / r of the sensor model; default the thesis's 0.1 (§3.7.3).
+  const char* dr = std::getenv("BOTICELLI_VS_OCTOMAP_DELTA_R_FRACTION");
+  if (dr != nullptr && *dr != '\0') params.delta_r_fraction = static_cast<float>(std::atof(dr));
   (void)evidence::append_ray_samples(readings, params, g_ray_samples,
                                      evidence::OccupancyBound::kPlausibility);
   evidence::PadRegion region;
@@ -111,7 +114,9 @@ void train(const std::vector<AlnSample>& samples) {
   aln::TrainerConfig cfg;
   const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
   cfg.epsilon = eps != nullptr && *eps != '\0' ? std::atof(eps) : 0.15;
-  cfg.max_iterations = 10;
+  const char* rounds = std::getenv("BOTICELLI_VS_OCTOMAP_ROUNDS");  // split rounds, default 10
+  cfg.max_iterations =
+      rounds != nullptr && *rounds != '\0' ? std::strtoul(rounds, nullptr, 10) : 10;
   cfg.max_pieces = kMaxPieces;
   g_trainer.configure(cfg);
   double best = std::numeric_limits<double>::infinity();

@@ -41,7 +41,7 @@ struct TrainerConfig {
   // Rounds whose splits were undone (they did not lower the error) before training gives up;
   // each such round tries other pieces than the last.
   std::size_t max_failed_rounds = 8;
-  std::uint32_t seed = 1;  // jitter of the split tilt; same seed, same model
+  std::uint32_t seed = 1;  // tie-break of equal split candidates; same seed, same model
 };
 
 struct TrainerStats {
@@ -63,22 +63,29 @@ struct TrainerStats {
 // assigns each sample to its responsible piece (alpha-beta evaluation) and accumulates that
 // piece's normal equations; then each piece is refitted exactly by box-constrained least
 // squares (its weight bounds, Eqs 4.27-4.28), a k-plane / Lloyd iteration. When the error
-// stops falling, pieces whose error exceeds epsilon are split into MIN or MAX of two tilted
-// copies (MAX if the data rise above the piece at the rim of its region, i.e. convex, else
-// MIN), pieces no sample uses are pruned, and the next round starts. Stops at epsilon, at the
-// piece cap or at the iteration cap; the model is always one that was evaluated, with every
-// piece inside its bounds. Models are compared by the robust loss at a fixed scale
+// stops falling, pieces whose error exceeds epsilon are split, pieces no sample uses are
+// pruned, and the next round starts. A split is the best of many candidates scored from the
+// same pass's sums (as in max-affine regression, Magnani & Boyd 2009): a hinge on each input
+// at each of kSplitBins - 1 positions across the piece's samples, on either side, as
+// MAX(piece, piece + tilt) where the residuals rise beyond the hinge or MIN where they fall. Stops
+// at epsilon, at the piece cap or at the iteration cap; the model is always one that was evaluated,
+// with every piece inside its bounds. Models are compared by the robust loss at a fixed scale
 // (TrainerStats::robust_loss), not by the robust-weighted squared error, which a Tukey fit
 // could lower by pushing its samples out of the weights' window: a refit is kept only if it
 // lowers that loss, a round's splits are undone unless they lower it, so the model returned
 // has the least loss of all models training evaluated.
 // Resumable: step(budget) visits at most about `budget` samples and returns; the sequence of
 // operations does not depend on the budgets, so sliced training equals one-shot training.
-// All working memory is inside the object (about 1.2 KB per piece for N = 3, 318 KB for
-// 256 pieces; no per-sample memory, so the sample count is unbounded): make it static.
+// All working memory is inside the object (about 9 KB per piece for N = 3, 2.3 MB for 256
+// pieces, most of it four copies of the split candidates' sums; no per-sample memory, so the
+// sample count is unbounded): make it static.
 template <typename Scalar, int N, std::size_t MaxPieces>
 class Trainer {
  public:
+  // Hinge positions per input a split chooses from: the edges between kSplitBins equal bins
+  // over the range the piece's samples spanned in the pass before.
+  static constexpr std::size_t kSplitBins = 16;
+
   using Model = Aln<Scalar, N, MaxPieces>;
   using PieceType = Piece<Scalar, N>;
   using Vec = Eigen::Matrix<Scalar, N, 1>;
@@ -115,6 +122,11 @@ class Trainer {
     first.set(w0.template cast<Scalar>(), centre, Scalar(0));
     model.reset(first);
     scale_[0] = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < N; ++i) {
+      const Range<Scalar> r = model.input_range(i);
+      span_lo_[0](i) = static_cast<double>(r.lo);
+      span_hi_[0](i) = static_cast<double>(r.hi);
+    }
     cursor_ = 0;
     pass_in_round_ = 0;
     best_objective_ = 0.0;
@@ -157,6 +169,15 @@ class Trainer {
   [[nodiscard]] const TrainerStats& stats() const { return stats_; }
 
  private:
+  // Sums of one bin of one input's split candidates, in coordinates u = x - the bin's centre.
+  struct HingeBin {
+    double sw = 0.0;   // sum w
+    double su = 0.0;   // sum w u
+    double suu = 0.0;  // sum w u^2
+    double sr = 0.0;   // sum w r (r the sample's residual)
+    double sru = 0.0;  // sum w r u
+  };
+
   // Per-piece sums over the samples it is responsible for, in coordinates shifted by the
   // piece's centroid at the start of the pass (better conditioned).
   struct Accumulator {
@@ -170,11 +191,15 @@ class Trainer {
     double loss = 0.0;       // robust loss at the fixed scale (sse without robust weights)
     double sse_plain = 0.0;  // sample-weighted squared residuals
     double sw_plain = 0.0;
-    // For the split: |d_j| = |x_j - centroid_j| / width_j (the V a split would add).
-    VecD sra = VecD::Zero();  // sum w r |d_j|
-    VecD sa = VecD::Zero();   // sum w |d_j|
-    VecD saa = VecD::Zero();  // sum w d_j^2
-    double sr = 0.0;          // sum w r
+    double sr = 0.0;   // sum w r
+    double srr = 0.0;  // sum w r^2 (the residuals' spread the split candidates are scored on)
+    // Split candidates: kSplitBins equal bins per input over [bin_lo, bin_lo + kSplitBins
+    // bin_step), samples outside in the end bins; and the span the samples really had.
+    VecD bin_lo = VecD::Zero();
+    VecD bin_step = VecD::Ones();
+    VecD seen_lo = VecD::Constant(std::numeric_limits<double>::infinity());
+    VecD seen_hi = VecD::Constant(-std::numeric_limits<double>::infinity());
+    std::array<std::array<HingeBin, kSplitBins>, static_cast<std::size_t>(N)> bins{};
   };
   using Accumulators = std::array<Accumulator, MaxPieces>;
 
@@ -229,7 +254,16 @@ class Trainer {
 
   void begin_pass() {
     Accumulators& acc = *current_;
-    for (std::size_t p = 0; p < model_->piece_count(); ++p) acc[p] = Accumulator{};
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+      acc[p] = Accumulator{};
+      for (int j = 0; j < N; ++j) {
+        const double lo_j = span_lo_[p](j);
+        const double span = span_hi_[p](j) - lo_j;
+        acc[p].bin_lo(j) = lo_j;
+        acc[p].bin_step(j) =
+            span > 0.0 && std::isfinite(span) ? span / static_cast<double>(kSplitBins) : 1.0;
+      }
+    }
   }
 
   void visit(const Sample<Scalar, N>& s) {
@@ -252,11 +286,31 @@ class Trainer {
     a.sse += w * r * r;
     a.loss += config_.robust == RobustWeighting::kNone ? w * r * r : w_plain * robust_loss(r);
     a.sr += w * r;
+    a.srr += w * r * r;
     for (int j = 0; j < N; ++j) {
-      const double d = std::fabs(x(j)) / width(j);
-      a.sa(j) += w * d;
-      a.saa(j) += w * d * d;
-      a.sra(j) += w * r * d;
+      const double xj = static_cast<double>(s.x(j));
+      a.seen_lo(j) = std::min(a.seen_lo(j), xj);
+      a.seen_hi(j) = std::max(a.seen_hi(j), xj);
+      const double t = (xj - a.bin_lo(j)) / a.bin_step(j);
+      const std::size_t b =
+          t <= 0.0 ? 0 : std::min(static_cast<std::size_t>(t), kSplitBins - 1);  // NaN-free: t > 0
+      const double u = xj - (a.bin_lo(j) + (static_cast<double>(b) + 0.5) * a.bin_step(j));
+      HingeBin& bin = a.bins[static_cast<std::size_t>(j)][b];
+      bin.sw += w;
+      bin.su += w * u;
+      bin.suu += w * u * u;
+      bin.sr += w * r;
+      bin.sru += w * r * u;
+    }
+  }
+
+  // The span of each piece's samples in the pass whose sums `acc` holds: where the next
+  // pass puts its split candidates' bins.
+  void keep_spans(const Accumulators& acc) {
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+      if (acc[p].count == 0) continue;
+      span_lo_[p] = acc[p].seen_lo;
+      span_hi_[p] = acc[p].seen_hi;
     }
   }
 
@@ -331,6 +385,7 @@ class Trainer {
       return;
     }
     update_scales(evaluated);
+    keep_spans(evaluated);
     for (std::size_t p = 0; p < pieces; ++p) refit(p, evaluated[p]);
     pass_in_round_ += 1;
     next_pass();
@@ -498,57 +553,133 @@ class Trainer {
     stats_.pieces = model_->piece_count();
   }
 
-  // Splits piece p into kind(A, B): two copies of it tilted up and down along one input,
-  // crossing at its centroid, so kind(A, B) = piece + c0 + k |x_j - c_j|. For each input j,
-  // k and c0 are the least-squares fit of the residuals r ~ c0 + k |d_j|; the input with the
-  // largest reduction cov(r, |d_j|)^2 / var(|d_j|) is used, and MAX if k > 0 (the data rise
-  // above the piece towards the rim of its region: convex), MIN if k < 0 (concave).
-  bool split(std::size_t p, const Accumulator& a) {
-    const PieceType old = model_->piece(p);
-    const double rbar = a.sr / a.sw;
+  // Splits piece p into kind(A', B) with A' = A + c0 and B = A' + g (x_j - t) on the hinge's
+  // side (g (t - x_j) on the other), so kind(A', B) = A + c0 + max(0, g h) for MAX (g > 0) or
+  // A + c0 + min(0, g h) for MIN (g < 0), h = max(0, +-(x_j - t)): a hinge along input j at
+  // t. Every bin edge of every input, on both sides, is a candidate; c0 and g are the
+  // weighted least-squares fit of the piece's residuals r ~ c0 + g h from the bins' sums,
+  // with g held so that B's weight stays inside its bounds. The candidate is drawn (seeded)
+  // from those that lower the squared error within kSplitTie of the most (neighbouring hinge
+  // positions score almost alike) and its hinge shifted a little (seeded), so another seed
+  // gives another model to retry with.
+  struct SplitChoice {
     int axis = -1;
-    double best_gain = -1.0;
-    double best_k = 0.0;
-    double best_c0 = 0.0;
+    double t = 0.0;
+    double side = 1.0;
+    double g = 0.0;
+    double c0 = 0.0;
+    double gain = 0.0;
+  };
+  static constexpr double kSplitTie = 0.95;
+
+  static constexpr std::size_t kSplitCandidates =
+      static_cast<std::size_t>(N) * (kSplitBins - 1) * 2;
+
+  // Every candidate of piece `piece` from its pass's sums `a`, in O(kSplitBins) per input:
+  // the bins' moments about the span's low end, summed from either end, give each edge's
+  // sums of h = max(0, +-(x - t)), h^2 and r h directly.
+  void split_candidates(const Accumulator& a, const PieceType& piece,
+                        std::array<SplitChoice, kSplitCandidates>& out) const {
+    const double sw = a.sw;
+    const double rbar = a.sr / sw;
+    std::size_t k = 0;
     for (int j = 0; j < N; ++j) {
-      const double mean_a = a.sa(j) / a.sw;
-      const double var_a = a.saa(j) / a.sw - mean_a * mean_a;
-      const double w = static_cast<double>(old.weight(j));
-      const bool room = hi(j) > w || lo(j) < w;
-      if (!(var_a > 1e-12) || !room) continue;
-      const double cov = a.sra(j) / a.sw - rbar * mean_a;
-      const double gain = cov * cov / var_a;
-      if (gain > best_gain) {
-        best_gain = gain;
-        best_k = cov / var_a;
-        best_c0 = rbar - best_k * mean_a;
-        axis = j;
+      const auto& bins = a.bins[static_cast<std::size_t>(j)];
+      const double step = a.bin_step(j);
+      // Moments of v = x - bin_lo per bin: m0 = sum w, m1 = sum w v, m2 = sum w v^2,
+      // r0 = sum w r, r1 = sum w r v.
+      std::array<std::array<double, 5>, kSplitBins> m{};
+      for (std::size_t b = 0; b < kSplitBins; ++b) {
+        const HingeBin& bin = bins[b];
+        const double c = (static_cast<double>(b) + 0.5) * step;
+        m[b] = {bin.sw, bin.su + c * bin.sw, bin.suu + 2.0 * c * bin.su + c * c * bin.sw, bin.sr,
+                bin.sru + c * bin.sr};
+      }
+      std::array<double, 5> total{};
+      for (const auto& mb : m) {
+        for (std::size_t i = 0; i < 5; ++i) total[i] += mb[i];
+      }
+      std::array<double, 5> left{};  // the bins below the edge
+      const double w_j = static_cast<double>(piece.weight(j));
+      for (std::size_t e = 1; e < kSplitBins; ++e) {
+        for (std::size_t i = 0; i < 5; ++i) left[i] += m[e - 1][i];
+        const double tau = static_cast<double>(e) * step;
+        for (const double side : {1.0, -1.0}) {
+          std::array<double, 5> s{};
+          for (std::size_t i = 0; i < 5; ++i) s[i] = side > 0.0 ? total[i] - left[i] : left[i];
+          const double sh = side * (s[1] - tau * s[0]);
+          const double shh = s[2] - 2.0 * tau * s[1] + tau * tau * s[0];
+          const double srh = side * (s[4] - tau * s[3]);
+          out[k++] = candidate(j, a.bin_lo(j) + tau, side, w_j, sw, rbar, sh, shh, srh, step);
+        }
       }
     }
-    if (axis < 0) return false;
-    // A little seeded jitter in the tilt keeps the copies from being exactly symmetric.
-    const double jitter = 0.9 + 0.2 * static_cast<double>(next_random() >> 8) / 16777216.0;
-    double tilt = jitter * std::fabs(best_k) / width(axis);  // output units per input unit
-    if (!(tilt > 0.0)) tilt = 1e-6 / width(axis);
-    const double w = static_cast<double>(old.weight(axis));
-    const double up = std::max(std::min(tilt, hi(axis) - w), 0.0);
-    const double down = std::max(std::min(tilt, w - lo(axis)), 0.0);
-    if (!(up + down > 0.0)) return false;
-    Vec wa = old.weight;
+  }
+
+  // The least-squares hinge r ~ c0 + g h from its sums, g held so that B's weight along j,
+  // w_j + side g, stays inside the bounds; gain = the fall in the squared error.
+  SplitChoice candidate(int j, double t, double side, double w_j, double sw, double rbar, double sh,
+                        double shh, double srh, double step) const {
+    const double hbar = sh / sw;
+    const double var_h = shh / sw - hbar * hbar;
+    if (!(var_h > 1e-12 * step * step)) return SplitChoice{};
+    const double cov = srh / sw - rbar * hbar;
+    const double g_lo = side > 0.0 ? lo(j) - w_j : w_j - hi(j);
+    const double g_hi = side > 0.0 ? hi(j) - w_j : w_j - lo(j);
+    const double g = std::clamp(cov / var_h, std::min(g_lo, 0.0), std::max(g_hi, 0.0));
+    const double gain = sw * (2.0 * g * cov - g * g * var_h);
+    if (!(gain > 0.0) || g == 0.0) return SplitChoice{};
+    return SplitChoice{j, t, side, g, rbar - g * hbar, gain};
+  }
+
+  bool split(std::size_t p, const Accumulator& a) {
+    if (!(a.sw > 0.0)) return false;
+    const PieceType old = model_->piece(p);
+    std::array<SplitChoice, kSplitCandidates> candidates{};
+    split_candidates(a, old, candidates);
+    // The best gain, then a seeded draw among the candidates close to it.
+    double top = 0.0;
+    for (const SplitChoice& c : candidates) top = std::max(top, c.gain);
+    std::size_t near = 0;
+    for (const SplitChoice& c : candidates) near += c.axis >= 0 && c.gain >= kSplitTie * top;
+    if (near == 0) return false;
+    std::size_t pick = next_random() % near;
+    SplitChoice best{};
+    for (const SplitChoice& c : candidates) {
+      if (c.axis < 0 || c.gain < kSplitTie * top) continue;
+      if (pick == 0) {
+        best = c;
+        break;
+      }
+      --pick;
+    }
+    if (best.axis < 0) return false;
+    const int j = best.axis;
+    // A seeded shift of the hinge within a quarter bin either way: the bins' edges are not
+    // special, the refits move the hinge to where the data put it, and another seed starts
+    // them elsewhere.
+    best.t += (static_cast<double>(next_random() >> 8) / 16777216.0 - 0.5) * 0.5 * a.bin_step(j);
+    const double slope = best.side * best.g;  // B's extra weight along j
     Vec wb = old.weight;
-    wa(axis) =
-        std::clamp(static_cast<Scalar>(w + up), model_->weight_lo(axis), model_->weight_hi(axis));
-    wb(axis) =
-        std::clamp(static_cast<Scalar>(w - down), model_->weight_lo(axis), model_->weight_hi(axis));
-    const Scalar cy = old.centroid_output + static_cast<Scalar>(best_c0);
+    wb(j) = std::clamp(static_cast<Scalar>(static_cast<double>(old.weight(j)) + slope),
+                       model_->weight_lo(j), model_->weight_hi(j));
+    const double at_centroid = static_cast<double>(old.centroid(j)) - best.t;
     PieceType first{};
     PieceType second{};
-    first.set(wa, old.centroid, cy);
-    second.set(wb, old.centroid, cy);
-    const NodeKind kind = best_k > 0.0 ? NodeKind::kMax : NodeKind::kMin;
+    first.set(old.weight, old.centroid, old.centroid_output + static_cast<Scalar>(best.c0));
+    second.set(wb, old.centroid,
+               old.centroid_output + static_cast<Scalar>(best.c0 + slope * at_centroid));
+    const NodeKind kind = best.g > 0.0 ? NodeKind::kMax : NodeKind::kMin;
     const std::size_t q = model_->piece_count();
     if (!model_->split_piece(p, kind, first, second)) return false;
     scale_[q] = scale_[p];
+    // Both halves start from the parent's span; the next pass narrows them.
+    if (a.count > 0) {
+      span_lo_[p] = a.seen_lo;
+      span_hi_[p] = a.seen_hi;
+    }
+    span_lo_[q] = span_lo_[p];
+    span_hi_[q] = span_hi_[p];
     return true;
   }
 
@@ -591,6 +722,8 @@ class Trainer {
         tmp_pieces_[new_pieces] = model_->piece(n.a);
         tmp_acc_[new_pieces] = acc[n.a];
         tmp_scale_[new_pieces] = scale_[n.a];
+        tmp_span_lo_[new_pieces] = span_lo_[n.a];
+        tmp_span_hi_[new_pieces] = span_hi_[n.a];
         tmp_nodes_[job.to] =
             typename Model::Node{NodeKind::kPiece, static_cast<std::uint16_t>(new_pieces), 0};
         ++new_pieces;
@@ -610,6 +743,8 @@ class Trainer {
     for (std::size_t p = 0; p < new_pieces; ++p) {
       acc[p] = tmp_acc_[p];
       scale_[p] = tmp_scale_[p];
+      span_lo_[p] = tmp_span_lo_[p];
+      span_hi_[p] = tmp_span_hi_[p];
     }
   }
 
@@ -654,6 +789,11 @@ class Trainer {
   std::array<PieceType, MaxPieces> tmp_pieces_{};
   std::array<typename Model::Node, Model::kMaxNodes> tmp_nodes_{};
   std::array<double, MaxPieces> tmp_scale_{};
+  // Per piece, the span of its samples in the last evaluated pass (split candidates' bins).
+  std::array<VecD, MaxPieces> span_lo_{};
+  std::array<VecD, MaxPieces> span_hi_{};
+  std::array<VecD, MaxPieces> tmp_span_lo_{};
+  std::array<VecD, MaxPieces> tmp_span_hi_{};
 };
 
 }  // namespace boticelli::aln
