@@ -67,6 +67,7 @@ TEST(RoomFit, TheRectangleRoomWithASharperSensorModelIsFittedToEpsilon) {
   aln::TrainerConfig cfg;
   cfg.epsilon = 0.15;
   cfg.max_iterations = 15;
+  cfg.split = aln::SplitCandidates::kHinges;
   g_trainer.configure(cfg);
   CHECK(g_trainer.train(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model));
   const double rms = rms_of(g_model, samples);

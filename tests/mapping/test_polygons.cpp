@@ -282,6 +282,50 @@ TEST(ExcludePoints, PointsAcrossTheSeamAndAtTheCentreAreHandled) {
   DOUBLES_EQUAL(0.0, free.max_rho_m(), 0.0);  // an obstacle at the centre closes it
 }
 
+TEST(ExcludePoints, ADiscAroundAPointCutsEveryRayThatMeetsItAtItsNearEdgeAndNoOther) {
+  // A feature 1 m away with 0.1 m of surface around it: the rays within asin(0.1) of its
+  // bearing (about 5.7 degrees at 1 degree per vertex) stop before they enter the disc, and
+  // the free polygon holds no point of the disc, sampled densely.
+  StarPolygon free(360);
+  free.fill(2.0F);
+  const float bearing = 0.5F;
+  const Point2 q{std::cos(bearing), std::sin(bearing)};
+  boticelli::mapping::exclude_discs(std::span<const Point2>(&q, 1), 0.1F, free);
+  for (int i = 0; i <= 40; ++i) {
+    for (int j = 0; j < 72; ++j) {
+      const float r = 0.1F * static_cast<float>(i) / 40.0F;
+      const float t = 6.2831853F * static_cast<float>(j) / 72.0F;
+      CHECK_FALSE(free.contains({q.x_m + r * std::cos(t), q.y_m + r * std::sin(t)}));
+    }
+  }
+  std::size_t cut = 0;
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) {
+    const float off = free.angle_rad(k) - bearing;
+    const float across = std::sin(off);
+    if (std::fabs(off) < 0.5F && std::fabs(across) <= 0.1F) {
+      ++cut;
+      const float enter = std::cos(off) - std::sqrt(0.01F - across * across);
+      CHECK_TRUE(free.rho_m(k) <= enter + 1e-5F);
+      CHECK_TRUE(free.rho_m(k) >= 0.9F - 0.02F);  // no nearer than the sector's nearest point
+    } else if (std::fabs(off) > 0.12F) {
+      DOUBLES_EQUAL(2.0, free.rho_m(k), 0.0);  // rays that miss the disc keep their range
+    }
+  }
+  CHECK_TRUE(cut >= 11);
+}
+
+TEST(ExcludePoints, ADiscAroundAPointNearerThanItsRadiusCutsOnlyThePoint) {
+  // A stray reading inside the robot's own reach must not close the whole polygon.
+  StarPolygon free(360);
+  free.fill(2.0F);
+  const Point2 q{0.05F, 0.02F};
+  boticelli::mapping::exclude_discs(std::span<const Point2>(&q, 1), 0.1F, free);
+  CHECK_FALSE(free.contains(q));
+  std::size_t untouched = 0;
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) untouched += free.rho_m(k) == 2.0F;
+  CHECK_TRUE(untouched >= 356);
+}
+
 TEST(Shrink, StraightWallsSeenHeadOnStopEveryRayIncludingThoseThroughTheJoints) {
   // A square room 1 m from the centre on each side: along a wall the vertices are
   // collinear, so neighbouring inner sides meet end to end, and the rays at 0°, 90°, ...

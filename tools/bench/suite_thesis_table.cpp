@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <string_view>
 #include <vector>
 
 #include "algo/aln/aln.h"
@@ -369,6 +370,11 @@ int run_thesis_table() {
         cfg.max_pieces = kMaxPieces;
         cfg.split_rule = run.rule;
         cfg.robust = run.robust;
+        // Hinge splits unless BOTICELLI_THESIS_SPLIT=v (the V at the centroid, as the mission).
+        const char* split = std::getenv("BOTICELLI_THESIS_SPLIT");
+        cfg.split = split != nullptr && std::string_view(split) == "v"
+                        ? aln::SplitCandidates::kCentroidV
+                        : aln::SplitCandidates::kHinges;
         g_trainer.configure(cfg);
         const std::int64_t t0 = now_ns();
         const BestRound best =

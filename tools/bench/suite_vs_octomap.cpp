@@ -118,6 +118,7 @@ void train(const std::vector<AlnSample>& samples) {
   cfg.max_iterations =
       rounds != nullptr && *rounds != '\0' ? std::strtoul(rounds, nullptr, 10) : 10;
   cfg.max_pieces = kMaxPieces;
+  cfg.split = aln::SplitCandidates::kHinges;
   g_trainer.configure(cfg);
   double best = std::numeric_limits<double>::infinity();
   if (!g_trainer.start(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model)) {

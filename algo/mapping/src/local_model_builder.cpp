@@ -260,7 +260,7 @@ void LocalModelBuilder::extract() {
   } else {
     obstacle_polygon_.set_vertex_count(p.vertex_count);  // nothing known: nothing free
   }
-  exclude_points(guard_.span(), obstacle_polygon_);
+  exclude_discs(guard_.span(), params_.guard_disc_m, obstacle_polygon_);
   // The floor cue's obstacle bases are obstacles whatever the fit says: nothing beyond a
   // base along its ray is free at the robot's lowest slice.
   for (const evidence::Reading& r : obstacles_) {

@@ -619,6 +619,43 @@ void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
   }
 }
 
+void exclude_discs(std::span<const core::Point2> points, float radius_m, StarPolygon& free) {
+  exclude_points(points, free);
+  const std::size_t n = free.vertex_count();
+  if (n == 0 || !(radius_m > 0.0F)) return;
+  const float step = free.angle_step_rad();
+  const auto count = static_cast<std::ptrdiff_t>(n);
+  for (const core::Point2& q : points) {
+    const float d = std::hypot(q.x_m, q.y_m);
+    if (!(d > radius_m)) continue;
+    float theta = std::atan2(q.y_m, q.x_m);
+    if (theta < 0.0F) theta += core::kTwoPi<float>;
+    const float half = std::asin(radius_m / d);  // the disc's half-angle seen from the centre
+    // Each sector [k, k + 1] the disc reaches into: its nearest point there is d - radius
+    // where the sector holds the bearing, else where the sector's ray nearer the bearing
+    // enters the disc. Both vertices are cut to that, so the sector's triangle (inside the
+    // circle of its larger vertex) holds no point of the disc.
+    const auto first = static_cast<std::ptrdiff_t>(std::floor((theta - half) / step));
+    const auto last = static_cast<std::ptrdiff_t>(std::floor((theta + half) / step));
+    for (std::ptrdiff_t i = first; i <= last; ++i) {
+      const float a0 = static_cast<float>(i) * step;
+      float nearest = d - radius_m;
+      if (!(theta >= a0 && theta <= a0 + step)) {
+        const float off = theta < a0 ? a0 - theta : a0 + step - theta;
+        const float across = d * std::sin(off);
+        const float inside = radius_m * radius_m - across * across;
+        if (!(inside >= 0.0F)) continue;  // rounding at the disc's tangent
+        nearest = d * std::cos(off) - std::sqrt(inside);
+      }
+      const float cut = std::max(nearest, 0.0F) * (1.0F - 1e-6F);
+      for (const std::ptrdiff_t j : {i, i + 1}) {
+        const auto v = static_cast<std::size_t>(((j % count) + count) % count);
+        free.set_rho_m(v, std::min(free.rho_m(v), cut));
+      }
+    }
+  }
+}
+
 void open_spikes(StarPolygon& free, std::size_t half_width) {
   const std::size_t n = free.vertex_count();
   if (half_width == 0 || n < 3) {

@@ -64,6 +64,12 @@ struct LocalModelParams {
   std::size_t spike_half_width = 0;
   // A floor-cue obstacle base cuts the polygon's vertex ray this much in front of it [m].
   float base_margin_m = 0.05F;
+  // A guard point (a corroborated feature the fit calls free) stands for a patch of surface,
+  // not a point: with guard_disc_m > 0 the polygon is pulled in front of a disc of this
+  // radius around it [m], so the rays between two features of a textured obstacle are cut
+  // too (exclude_discs). 0 (the default) pulls in front of the point only; docs/mapping.md
+  // has what 0.05 m gained and cost.
+  float guard_disc_m = 0.0F;
   std::size_t readings_per_unit = 64;           // work per unit while building samples
   std::size_t visits_per_unit = 1024;           // trainer sample visits per unit
   std::size_t guard_candidates_per_unit = 256;  // guard candidates corroborated per unit

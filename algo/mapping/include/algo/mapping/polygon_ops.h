@@ -39,6 +39,13 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
 // vertex ray cuts both sectors beside that ray. Points at the centre close the polygon.
 void exclude_points(std::span<const core::Point2> points, StarPolygon& free);
 
+// Pulls the polygon in front of a disc of radius_m around each point (robot frame): both
+// vertices of every sector the disc reaches into are cut to the disc's nearest distance
+// within that sector, so no sector's triangle holds a point of the disc. A point nearer the centre
+// than radius_m cuts only itself (a disc around the robot would close the polygon on a single stray
+// reading).
+void exclude_discs(std::span<const core::Point2> points, float radius_m, StarPolygon& free);
+
 // Morphological opening of the radial function over a circular window of 2·half_width + 1
 // vertices: every vertex takes the largest, over the windows holding it, of the window's
 // smallest ρ. A wedge narrower than the window (a ray or two the fit left open through a
