@@ -288,6 +288,26 @@ TEST(AlnTrain, DifferentSeedsGiveDifferentModelsOfTheSameQuality) {
   }
 }
 
+TEST(AlnTrain, ATrainerWithoutHingeSumsSplitsByTheVWhateverItIsConfigured) {
+  // SplitBins = 0 (the mission's trainers) keeps no hinge sums: asked for hinges, it gives
+  // exactly the model the V gives.
+  static aln::Trainer<float, 3, 256, 0> no_hinges;
+  const std::size_t n = fill_room(2000, 0.05, 9);
+  set_room_ranges(g_model3);
+  set_room_ranges(g_model3b);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.03;
+  cfg.split = aln::SplitCandidates::kCentroidV;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  cfg.split = aln::SplitCandidates::kHinges;
+  no_hinges.configure(cfg);
+  CHECK(no_hinges.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  CHECK(g_model3.piece_count() > 2);
+  CHECK(same_model(g_model3, g_model3b));
+  CHECK(sizeof(no_hinges) * 4 < sizeof(g_trainer3));
+}
+
 TEST(AlnTrain, EveryPieceOfATrainedModelIsResponsibleForSomeSample) {
   // Pieces no sample uses are pruned after each round (they would only cost evaluation
   // time and could take over where there are no data).

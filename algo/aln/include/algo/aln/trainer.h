@@ -89,15 +89,18 @@ struct TrainerStats {
 // has the least loss of all models training evaluated.
 // Resumable: step(budget) visits at most about `budget` samples and returns; the sequence of
 // operations does not depend on the budgets, so sliced training equals one-shot training.
-// All working memory is inside the object (about 9 KB per piece for N = 3, 2.3 MB for 256
-// pieces, most of it four copies of the split candidates' sums; no per-sample memory, so the
-// sample count is unbounded): make it static.
-template <typename Scalar, int N, std::size_t MaxPieces>
+// All working memory is inside the object (no per-sample memory, so the sample count is
+// unbounded): make it static. For N = 3 about 1.3 KB per piece (330 KB for 256) with
+// SplitBins = 0, which keeps no hinge sums and splits every piece by the V whatever the
+// configuration says; about 9 KB per piece (2.4 MB for 256) with the default 16, most of it
+// four copies of the hinge candidates' sums.
+template <typename Scalar, int N, std::size_t MaxPieces, std::size_t SplitBins = 16>
 class Trainer {
  public:
+  static_assert(SplitBins == 0 || SplitBins >= 2, "a hinge needs at least one inner bin edge");
   // Hinge positions per input a split chooses from: the edges between kSplitBins equal bins
   // over the range the piece's samples spanned in the pass before.
-  static constexpr std::size_t kSplitBins = 16;
+  static constexpr std::size_t kSplitBins = SplitBins;
 
   using Model = Aln<Scalar, N, MaxPieces>;
   using PieceType = Piece<Scalar, N>;
@@ -276,8 +279,9 @@ class Trainer {
         const double lo_j = span_lo_[p](j);
         const double span = span_hi_[p](j) - lo_j;
         acc[p].bin_lo(j) = lo_j;
-        acc[p].bin_step(j) =
-            span > 0.0 && std::isfinite(span) ? span / static_cast<double>(kSplitBins) : 1.0;
+        acc[p].bin_step(j) = kSplitBins > 0 && span > 0.0 && std::isfinite(span)
+                                 ? span / static_cast<double>(kSplitBins)
+                                 : 1.0;
       }
     }
   }
@@ -302,7 +306,7 @@ class Trainer {
     a.sse += w * r * r;
     a.loss += config_.robust == RobustWeighting::kNone ? w * r * r : w_plain * robust_loss(r);
     a.sr += w * r;
-    if (config_.split == SplitCandidates::kCentroidV) {
+    if (!hinges()) {
       for (int j = 0; j < N; ++j) {
         const double d = std::fabs(x(j)) / width(j);
         a.sa(j) += w * d;
@@ -311,6 +315,16 @@ class Trainer {
       }
       return;
     }
+    if constexpr (kSplitBins > 0) add_to_bins(s, w, r, a);
+  }
+
+  // Hinge splits only where the trainer keeps their sums (SplitBins > 0).
+  [[nodiscard]] bool hinges() const {
+    return kSplitBins > 0 && config_.split == SplitCandidates::kHinges;
+  }
+
+  // A sample's share of its piece's hinge sums: its bin on each input.
+  void add_to_bins(const Sample<Scalar, N>& s, double w, double r, Accumulator& a) const {
     for (int j = 0; j < N; ++j) {
       const double xj = static_cast<double>(s.x(j));
       a.seen_lo(j) = std::min(a.seen_lo(j), xj);
@@ -597,7 +611,7 @@ class Trainer {
   static constexpr double kSplitTie = 0.95;
 
   static constexpr std::size_t kSplitCandidates =
-      static_cast<std::size_t>(N) * (kSplitBins - 1) * 2;
+      static_cast<std::size_t>(N) * (kSplitBins > 0 ? kSplitBins - 1 : 0) * 2;
 
   // Every candidate of piece `piece` from its pass's sums `a`, in O(kSplitBins) per input:
   // the bins' moments about the span's low end, summed from either end, give each edge's
@@ -657,7 +671,7 @@ class Trainer {
   }
 
   bool split(std::size_t p, const Accumulator& a) {
-    return config_.split == SplitCandidates::kHinges ? split_hinge(p, a) : split_v(p, a);
+    return hinges() ? split_hinge(p, a) : split_v(p, a);
   }
 
   bool split_hinge(std::size_t p, const Accumulator& a) {

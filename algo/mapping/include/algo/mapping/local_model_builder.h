@@ -26,7 +26,8 @@ inline constexpr std::size_t kLookMaxPieces = 256;
 inline constexpr std::size_t kLookMaxSamples = 196608;
 
 using OccupancyModel = aln::Aln<float, 3, kLookMaxPieces>;
-using OccupancyTrainer = aln::Trainer<float, 3, kLookMaxPieces>;
+// The mission splits by the V (TrainerConfig::split, docs/architecture.md): no hinge sums.
+using OccupancyTrainer = aln::Trainer<float, 3, kLookMaxPieces, 0>;
 using OccupancySample = aln::Sample<float, 3>;
 
 // Everything the Think stage of one look needs, in one place (the mission derives it from the

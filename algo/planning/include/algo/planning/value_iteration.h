@@ -79,7 +79,7 @@ class ValueIteration {
 
  private:
   enum class Phase : std::uint8_t { kIdle, kSample, kRewards, kTargets, kFit, kDone };
-  using Trainer = aln::Trainer<float, 2, kMaxValuePieces>;
+  using Trainer = aln::Trainer<float, 2, kMaxValuePieces, 0>;  // V splits, no hinge sums
   using Sample = aln::Sample<float, 2>;
 
   std::size_t sample_states(std::size_t budget);
