@@ -5,6 +5,10 @@
 #include <cmath>
 #include <cstdlib>
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/Core>
+
 namespace boticelli::image {
 
 namespace {
@@ -174,7 +178,8 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
       }
     }
   }
-  if (interior == 0) {
+  const bool thin = interior == 0;
+  if (thin) {
     sum_cb = int{frame.chroma_u[greenest]} - 128;
     sum_cr = int{frame.chroma_v[greenest]} - 128;
     sum_y = static_cast<double>(frame.luma[greenest]);
@@ -202,6 +207,13 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   double white_y = 0.0;
   double white_cb = 0.0;
   double white_cr = 0.0;
+  // Normal equations of the paper's brightness as a plane over the image, a + b·du + c·dv
+  // (du, dv from the box's centre): vignetting and uneven light darken the paper across
+  // the triangle, and a single mean would bias the edges on the side it darkens.
+  const double uc = 0.5 * static_cast<double>(u_min + u_max);
+  const double vc = 0.5 * static_cast<double>(v_min + v_max);
+  Eigen::Matrix3d plane_ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d plane_atb = Eigen::Vector3d::Zero();
   for (std::uint32_t v = sv0; v <= sv1; ++v) {
     for (std::uint32_t u = su0; u <= su1; ++u) {
       const std::size_t i = frame.index(u, v);
@@ -226,6 +238,9 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
         white_y += bright;
         white_cb += cb;
         white_cr += cr;
+        const Eigen::Vector3d x(1.0, static_cast<double>(u) - uc, static_cast<double>(v) - vc);
+        plane_ata += x * x.transpose();
+        plane_atb += bright * x;
       }
     }
   }
@@ -253,6 +268,44 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   if (luma_contrast < 3.0) {
     return out;
   }
+  // The paper's plane; the mean alone when the white pixels do not span one (a sliver).
+  Eigen::Vector3d paper(white_y, 0.0, 0.0);
+  // (The determinant is n³ times the white pixels' variances across and along, less their
+  // covariance: at least a tenth of a pixel² each way.)
+  const double n_white = plane_ata(0, 0);
+  if (plane_ata.determinant() > 0.01 * n_white * n_white * n_white) {
+    const Eigen::Vector3d fitted = plane_ata.ldlt().solve(plane_atb);
+    if (fitted.allFinite()) paper = fitted;
+  }
+  const auto paper_at = [&](std::uint32_t u, std::uint32_t v) {
+    return paper.x() + paper.y() * (static_cast<double>(u) - uc) +
+           paper.z() * (static_cast<double>(v) - vc);
+  };
+  // The green's share of the paper's brightness: light and vignetting scale both alike.
+  double green_share = 0.0;
+  int shares = 0;
+  for (std::uint32_t v = v_min; v <= v_max; ++v) {
+    for (std::uint32_t u = u_min; u <= u_max; ++u) {
+      const std::size_t i = frame.index(u, v);
+      const bool inner = labels_[i - 1] == label && labels_[i + 1] == label &&
+                         labels_[i - w] == label && labels_[i + w] == label;
+      if (labels_[i] != label || (thin ? i != greenest : !inner)) {
+        continue;
+      }
+      const double local = paper_at(u, v);
+      if (local > 1.0) {
+        green_share += static_cast<double>(frame.luma[i] - params_.black_luma) / local;
+        ++shares;
+      }
+    }
+  }
+  if (shares == 0) {
+    return out;
+  }
+  green_share /= shares;
+  if (!(green_share < 1.0 - 3.0 / white_y)) {
+    return out;
+  }
   const auto coverage = [&](std::size_t i) {
     const double cb = int{frame.chroma_u[i]} - 128 - white_cb;
     const double cr = int{frame.chroma_v[i]} - 128 - white_cr;
@@ -260,7 +313,12 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
       return 0.0;  // not greener than the paper: a dark edge or shadow, not the triangle
     }
     const double bright = static_cast<double>(frame.luma[i] - params_.black_luma);
-    return std::clamp((white_y - bright) / luma_contrast, 0.0, 1.0);
+    const double local =
+        paper_at(static_cast<std::uint32_t>(i % w), static_cast<std::uint32_t>(i / w));
+    if (!(local > 1.0)) {
+      return 0.0;
+    }
+    return std::clamp((1.0 - bright / local) / (1.0 - green_share), 0.0, 1.0);
   };
   // Row extents; a hole or a second run in a row breaks the triangle. Edges are sub-pixel:
   // a row's green width is the sum of its pixels' coverage, centred on their

@@ -53,8 +53,10 @@ struct TargetDetection {
 // straight and converging to a vertex at the top, the base at the bottom, about half the
 // bounding box filled) and surrounded by paper brighter than the green and grey; the
 // vertex is where the two edge lines fit to the blob's rows meet, each row's extent
-// measured to a fraction of a pixel from how far its pixels' chroma lies between the
-// paper's and the triangle's. Returns the most confident candidate. Allocation-free.
+// measured to a fraction of a pixel from how far its pixels' luma lies between the paper's
+// (a plane fitted to the paper around the triangle: vignetting and uneven light darken it
+// across the image) and the triangle's (the same share of the paper's everywhere).
+// Returns the most confident candidate. Allocation-free.
 class TargetDetector {
  public:
   explicit TargetDetector(const TargetParams& params = {}) : params_(params) {}
