@@ -346,6 +346,7 @@ void Mission::begin_look(std::uint64_t now_us) {
   view_ready_ = false;
   view_part_ = 0;
   look_pose_ = odometry_pose();
+  last_sighting_ = {};  // the robot has moved: no earlier frame pairs with this look's
   aim_at_target();
   step_deadline_us_ = now_us + params_.ptu_timeout_us;
   think_started_ = false;
@@ -696,14 +697,15 @@ bool Mission::process_view(std::uint8_t part) {
     case 1:
       if (view_pair_) {
         const stereo::TargetFix fix = stereo_.locate_target(first_, second_, pair_pose_);
-        if (fix.found) {
-          // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
-          const core::Point2 w =
-              core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
-          const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
-          tracker_.add(world, fix.confidence,
-                       static_cast<std::uint32_t>(state_.cycle * 256U + view_),
-                       fix.point_ptu_m.norm());
+        const auto view = static_cast<std::uint32_t>(state_.cycle * 256U + view_);
+        add_target_fix(fix, view);
+        // The vertex in this first frame and in the look's last one at another pan: a pair
+        // with a longer baseline than the tilt's (the later view's sighting).
+        if (fix.first.found) {
+          const stereo::TargetSighting here{fix.first, pair_pose_.pan_rad,
+                                            pair_pose_.first_tilt_rad};
+          add_target_fix(stereo_.locate_target_across(last_sighting_, here), view);
+          last_sighting_ = here;
         }
       }
       // The aimed pair looks up at the target, not at the floor.
@@ -721,6 +723,14 @@ bool Mission::process_view(std::uint8_t part) {
                                floor_obstacles_, floor_free_, &floor_free_near_);
       return true;
   }
+}
+
+void Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {
+  if (!fix.found) return;
+  // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
+  const core::Point2 w = core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
+  const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
+  tracker_.add(world, fix.confidence, view, fix.range_error_m);
 }
 
 void Mission::begin_think() {

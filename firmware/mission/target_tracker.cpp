@@ -7,14 +7,14 @@
 namespace boticelli::firmware::mission {
 
 void TargetTracker::add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view,
-                        float range_m) {
+                        float range_error_m) {
   // A non-finite confidence would make the group's weighted mean NaN, and a NaN centre
   // counts every sighting as within the radius.
-  if (!point_world_m.allFinite() || !std::isfinite(confidence) || !std::isfinite(range_m)) {
+  if (!point_world_m.allFinite() || !std::isfinite(confidence) || !std::isfinite(range_error_m)) {
     return;
   }
-  const float r = std::max(range_m, 0.5F);
-  sightings_[next_] = {point_world_m, confidence, (0.1F + confidence) / (r * r), view};
+  const float e = std::max(range_error_m, kMinRangeError_m);
+  sightings_[next_] = {point_world_m, confidence, (0.1F + confidence) / (e * e), view};
   next_ = (next_ + 1) % kMaxSightings;
   if (count_ < kMaxSightings) ++count_;
   update_estimate();

@@ -90,11 +90,11 @@ TEST(TargetTracker, AConfidentSightingWeighsMoreThanAnUnsureOne) {
   CHECK(tracker.estimate_m().x() < sure.x());
 }
 
-TEST(TargetTracker, ACloseSightingWeighsMoreThanAFarOne) {
+TEST(TargetTracker, APreciseSightingWeighsMoreThanACoarseOne) {
   const Eigen::Vector3f close = kTarget + Eigen::Vector3f(0.1F, 0.0F, 0.0F);
   const Eigen::Vector3f far = kTarget - Eigen::Vector3f(0.1F, 0.0F, 0.0F);
-  tracker.add(close, 0.5F, 1, 1.0F);
-  tracker.add(far, 0.5F, 2, 4.0F);  // 16 times less weight
+  tracker.add(close, 0.5F, 1, 0.05F);
+  tracker.add(far, 0.5F, 2, 0.2F);  // 16 times less weight
   CHECK(tracker.confirmed());
   DOUBLES_EQUAL(kTarget.x() + 0.1F * 15.0F / 17.0F, tracker.estimate_m().x(), 1e-4);
 }
@@ -109,15 +109,15 @@ TEST(TargetTracker, OnceConfirmedTheEstimateTakesInSightingsScatteredAlongTheLin
   const Eigen::Vector3f beyond = kTarget + Eigen::Vector3f(0.4F, 0.0F, 0.0F);
   const Eigen::Vector3f beyond2 = kTarget + Eigen::Vector3f(0.4F, 0.1F, 0.0F);
   const Eigen::Vector3f short_of = kTarget - Eigen::Vector3f(0.4F, -0.05F, 0.0F);
-  tracker.add(beyond, 0.5F, 1, 3.0F);
-  tracker.add(beyond2, 0.5F, 2, 3.0F);
+  tracker.add(beyond, 0.5F, 1, 0.3F);
+  tracker.add(beyond2, 0.5F, 2, 0.3F);
   CHECK(tracker.confirmed());
-  tracker.add(short_of, 0.5F, 3, 2.12F);  // twice the weight of each of the others
+  tracker.add(short_of, 0.5F, 3, 0.212F);  // twice the weight of each of the others
   DOUBLES_EQUAL(kTarget.x(), tracker.estimate_m().x(), 0.02);
   DOUBLES_EQUAL(kTarget.y() + 0.05F, tracker.estimate_m().y(), 0.02);
 }
 
-TEST(TargetTracker, ANonFiniteRangeIsIgnored) {
+TEST(TargetTracker, ANonFiniteRangeErrorIsIgnored) {
   tracker.add(kTarget, 0.5F, 1, std::numeric_limits<float>::quiet_NaN());
   UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
 }

@@ -331,6 +331,7 @@ struct WorldStats {
   std::vector<double> render_ms, stereo_ms, target_ms, floor_ms, think_ms;
   std::size_t target_views = 0, target_found = 0, target_far = 0, target_false = 0;
   std::vector<double> target_error_m, target_far_error_m;
+  std::vector<double> target_across_error_m;  // fixes across pans, target in view
   // Per look, as the mission acts on it: the look's fixes in the mission's TargetTracker.
   std::size_t pose_target_views = 0, pose_target_found = 0, pose_target_confirmed = 0;
   std::vector<double> pose_target_error_m;
@@ -396,6 +397,8 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     bool pose_in_view = false;
     std::uint32_t view_number = 0;
     double render_ns = 0, stereo_ns = 0, target_ns = 0, floor_ns = 0;
+    stereo::TargetSighting last_sighting;  // as Mission::process_view: across pans
+    hal::sim::RigidTransform last_sighting_pose;
     for (const firmware::mission::LookView& view : views) {
       stereo::PairPose pp;
       pp.pan_rad = quantise(view.pan_rad, lim.pan_resolution_rad);
@@ -450,11 +453,43 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
                 kTargetViewM;
         st.target_views += in_view ? 1U : 0U;
         pose_in_view = pose_in_view || in_view;
+        stereo::TargetFix across;
+        bool across_in_view = false;
+        bool across_anywhere = false;
+        if (fix.first.found) {
+          const stereo::TargetSighting here{fix.first, pp.pan_rad, pp.first_tilt_rad};
+          t0 = cpu_ns();
+          across = stereo.locate_target_across(last_sighting, here);
+          target_ns += static_cast<double>(cpu_ns() - t0);
+          if (across.found) {
+            // In view, or false, as for a pair: the two first frames.
+            across_in_view =
+                target_in_image(last_sighting_pose, first_pose, cam, kTargetMarginPx) &&
+                static_cast<double>((g_world.target_point_m - first_pose.translation_m).norm()) <=
+                    kTargetViewM;
+            across_anywhere =
+                target_in_image(last_sighting_pose, first_pose, cam, -kTargetMarginPx);
+          }
+          last_sighting = here;
+          last_sighting_pose = first_pose;
+        }
+        if (across.found) {
+          const core::Point2 w =
+              core::to_world(pose, {across.point_ptu_m.x(), across.point_ptu_m.y()});
+          const Eigen::Vector3f p(w.x_m, w.y_m, across.point_ptu_m.z() + params.rig.ptu_height_m);
+          tracker.add(p, across.confidence, view_number, across.range_error_m);
+          const double e = (p - g_world.target_point_m).norm();
+          if (across_in_view) {
+            st.target_across_error_m.push_back(e);
+          } else if (!across_anywhere) {
+            ++st.target_false;
+          }
+        }
         if (fix.found) {
           const core::Point2 w = core::to_world(pose, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
           const Eigen::Vector3f p(w.x_m, w.y_m, fix.point_ptu_m.z() + params.rig.ptu_height_m);
           const double e = (p - g_world.target_point_m).norm();
-          tracker.add(p, fix.confidence, view_number, fix.point_ptu_m.norm());
+          tracker.add(p, fix.confidence, view_number, fix.range_error_m);
           if (in_view) {
             ++st.target_found;
             st.target_error_m.push_back(e);
@@ -576,6 +611,13 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
                                                [](double e) { return e <= 0.1; })))
       .num("target_err_median_m", percentile(st.target_error_m, 0.5))
       .num("target_err_max_m", percentile(st.target_error_m, 1.0))
+      .integer("target_across", static_cast<std::int64_t>(st.target_across_error_m.size()))
+      .integer("target_across_within_0_1m",
+               static_cast<std::int64_t>(std::count_if(st.target_across_error_m.begin(),
+                                                       st.target_across_error_m.end(),
+                                                       [](double e) { return e <= 0.1; })))
+      .num("target_across_err_median_m", percentile(st.target_across_error_m, 0.5))
+      .num("target_across_err_max_m", percentile(st.target_across_error_m, 1.0))
       .integer("target_far", static_cast<std::int64_t>(st.target_far))
       .num("target_far_err_median_m", percentile(st.target_far_error_m, 0.5))
       .integer("target_false", static_cast<std::int64_t>(st.target_false))

@@ -137,8 +137,54 @@ TargetFix StereoProcessor::locate_target(const image::LowResFrame& first,
   if (params_.target_range_from_edges) {
     refine_target_range(first, second, pose1, pose2, fix);
   }
+  fix.range_error_m = evidence::range_error_m((fix.point_ptu_m - pose1.centre_m).norm(),
+                                              (pose2.centre_m - pose1.centre_m).norm(),
+                                              rig_.low_res_camera().focal_px);  // Eq 3.7
   fix.confidence =
       fix.first.confidence < fix.second.confidence ? fix.first.confidence : fix.second.confidence;
+  fix.reading = reading_from_point(fix.point_ptu_m, fix.confidence);
+  fix.found = true;
+  return fix;
+}
+
+TargetFix StereoProcessor::locate_target_across(const TargetSighting& earlier,
+                                                const TargetSighting& later) const {
+  TargetFix fix;
+  fix.first = earlier.detection;
+  fix.second = later.detection;
+  if (!earlier.detection.found || !later.detection.found) {
+    return fix;
+  }
+  const CameraIntrinsics& camera = rig_.low_res_camera();
+  const CameraPose pose1 = rig_.camera_pose(earlier.pan_rad, earlier.tilt_rad);
+  const CameraPose pose2 = rig_.camera_pose(later.pan_rad, later.tilt_rad);
+  const float baseline = (pose2.centre_m - pose1.centre_m).norm();
+  if (!(baseline > rig_.baseline_m())) {
+    return fix;
+  }
+  const Eigen::Vector3f d1 = RigModel::ray_ptu(
+      pose1, camera, Eigen::Vector2f(earlier.detection.u_px, earlier.detection.v_px));
+  const Eigen::Vector3f d2 =
+      RigModel::ray_ptu(pose2, camera, Eigen::Vector2f(later.detection.u_px, later.detection.v_px));
+  Eigen::Vector3f point;
+  if (!triangulate_exact(pose1.centre_m, d1, pose2.centre_m, d2, point)) {
+    return fix;
+  }
+  const float range = (point - pose1.centre_m).norm();
+  if (range < params_.min_range_m) {
+    return fix;
+  }
+  // The midpoint lies half the rays' gap from each: the gap against the pixel's footprint.
+  const Eigen::Vector3f off = point - pose1.centre_m;
+  const float gap = 2.0F * (off - off.dot(d1) * d1).norm();
+  if (!(gap <= params_.target_across_max_gap_px * range / camera.focal_px)) {
+    return fix;
+  }
+  fix.point_ptu_m = point;
+  fix.range_error_m = evidence::range_error_m(range, baseline, camera.focal_px);  // Eq 3.7
+  fix.confidence = earlier.detection.confidence < later.detection.confidence
+                       ? earlier.detection.confidence
+                       : later.detection.confidence;
   fix.reading = reading_from_point(fix.point_ptu_m, fix.confidence);
   fix.found = true;
   return fix;

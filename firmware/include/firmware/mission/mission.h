@@ -155,6 +155,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // One part of the grabbed view's processing: 0 stereo, 1 target, 2 and 3 the floor cue on
   // the first and second frame. True when the view is done.
   bool process_view(std::uint8_t part);
+  // A fix (found or not) into the tracker, in the world frame of this look's pose.
+  void add_target_fix(const stereo::TargetFix& fix, std::uint32_t view);
   void begin_think();
   void after_think();
   void begin_plan();
@@ -244,6 +246,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   core::FixedVector<evidence::Reading, kMaxLookFloorFree> floor_free_;
   core::FixedVector<float, kMaxLookFloorFree> floor_free_near_;  // each walk's near end [m]
   TargetTracker tracker_;
+  stereo::TargetSighting last_sighting_{};  // this look's latest first frame with the target
   std::uint32_t last_features_ = 0;
   std::uint32_t last_pieces_ = 0;
   std::uint32_t guard_truncated_looks_ = 0;

@@ -34,10 +34,13 @@ class TargetTracker {
   }
   // `view` identifies where it was seen from (e.g. cycle·64 + view index): two sightings of
   // the same view count once.
-  // `range_m` is how far the camera was: a stereo fix's error grows with the square of the
-  // range, so a sighting's weight in the mean is (0.1 + confidence) / max(range, 0.5 m)².
+  // `range_error_m` is how far off the fix may be along its line of sight: δr of Eq 3.7 at
+  // its range and its two frames' baseline (TargetFix::range_error_m), which grows with the
+  // square of the range and shrinks with the baseline; a sighting's weight in the mean is
+  // (0.1 + confidence) / max(δr, kMinRangeError_m)².
+  static constexpr float kMinRangeError_m = 0.01F;
   void add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view,
-           float range_m = 1.0F);
+           float range_error_m = 0.1F);
 
   [[nodiscard]] bool confirmed() const { return confirmed_; }
   [[nodiscard]] const Eigen::Vector3f& estimate_m() const { return estimate_; }

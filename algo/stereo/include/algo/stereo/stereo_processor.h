@@ -37,6 +37,12 @@ struct StereoParams {
   // off tracked something other than the triangle.
   float target_edge_window = 0.2F;
   float target_edge_min_strength = 4.0F;  // |∂Y/∂v| of an edge pixel [grey levels per px]
+  // Two views of one look at different pans are a stereo pair too, with a baseline of
+  // 2L·sin(Δpan/2) across (0.077 m for a look's 0.37 rad pan step, 2.7 times the tilt
+  // pair's): locate_target_across triangulates their vertices if the rays pass within this
+  // many pixels (at the point's range) of each other, a mismatch between the two rows the
+  // vertex was found at.
+  float target_across_max_gap_px = 1.5F;
 };
 
 // Where the PTU was for the two frames [rad]: same pan; the second frame after tilting
@@ -58,11 +64,21 @@ struct StereoPoint {
   evidence::Reading reading;                              // {α, h, r, m}
 };
 
+// The target's vertex seen in one frame: the detection and where the PTU pointed [rad].
+struct TargetSighting {
+  image::TargetDetection detection;
+  float pan_rad = 0.0F;
+  float tilt_rad = 0.0F;
+};
+
 // The target (§3.4.2) found in both frames of a pair and triangulated like a feature.
 struct TargetFix {
   bool found = false;       // seen in both frames and triangulated
   float confidence = 0.0F;  // the lower of the two detections'
   std::size_t edges = 0;    // tracked edge pixels that set the range (0: the vertex's own)
+  // δr of Eq 3.7 at the fix's range with its two frames' baseline: one pixel of disparity
+  // [m]. What a fix's error scales with, to weigh it against others.
+  float range_error_m = 0.0F;
   Eigen::Vector3f point_ptu_m = Eigen::Vector3f::Zero();  // the corner, PTU frame [m]
   evidence::Reading reading;     // {α, h, r} of the corner; m = confidence
   image::TargetDetection first;  // per-frame detections (low-res px)
@@ -104,6 +120,15 @@ class StereoProcessor {
   // triangulates its corner with the same routine as the features (§3.4.2).
   TargetFix locate_target(const image::LowResFrame& first, const image::LowResFrame& second,
                           const PairPose& pose);
+
+  // The vertex triangulated from two frames of one look (the robot still) at different pans,
+  // each detection where it was found: a horizontal baseline, longer than the tilt pair's for
+  // pans apart by more than the tilt step Φ. found = false if either detection is missing,
+  // the baseline is no longer than the tilt pair's, the rays do not meet in front of both
+  // cameras or pass farther apart than target_across_max_gap_px. first/second are the two
+  // detections; edges = 0 (the vertex's own). Nothing is allocated.
+  [[nodiscard]] TargetFix locate_target_across(const TargetSighting& earlier,
+                                               const TargetSighting& later) const;
 
   [[nodiscard]] const image::LowResFrame& first_frame() const { return first_; }
   [[nodiscard]] const image::LowResFrame& second_frame() const { return second_; }
