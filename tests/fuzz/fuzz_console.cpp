@@ -79,7 +79,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (console.shutdown_requested()) break;
   }
   // Every reply line ends in CRLF and holds printable text only (raw input may be echoed).
-  const std::string& out = port.written();
+  // With echo on, a line the console sends while a command is half typed first clears the
+  // terminal's line ("\r\x1b[K", VT100) and types the command again after it: taken out.
+  std::string out = port.written();
+  constexpr std::string_view kClearLine = "\r\x1b[K";
+  for (std::size_t at = out.find(kClearLine); at != std::string::npos; at = out.find(kClearLine)) {
+    out.erase(at, kClearLine.size());
+  }
   for (std::size_t i = 0; i < out.size() && !raw; ++i) {
     const auto u = static_cast<unsigned char>(out[i]);
     if (u == '\r' && (i + 1 >= out.size() || out[i + 1] != '\n')) std::abort();
