@@ -604,6 +604,7 @@ StepResult Mission::step(SliceBudget& budget) {
       floor_obstacles_.clear();
       floor_free_.clear();
       floor_free_near_.clear();
+      floor_blocked_.clear();
       floor_cue_.begin_look();  // frames kept from the last look were seen from elsewhere
       look_lists_stale_ = false;
     }
@@ -715,12 +716,12 @@ bool Mission::process_view(std::uint8_t part) {
       // the columns; a low pair's second frame sees nearer floor than its first.
       (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
       (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad,
-                               floor_obstacles_, floor_free_, &floor_free_near_);
+                               floor_obstacles_, floor_free_, &floor_free_near_, &floor_blocked_);
       return !(view_pair_ && pair_pose_.second_tilt_rad < -0.3F);
     default:
       (void)floor_cue_.learn(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad);
       (void)floor_cue_.process(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad,
-                               floor_obstacles_, floor_free_, &floor_free_near_);
+                               floor_obstacles_, floor_free_, &floor_free_near_, &floor_blocked_);
       return true;
   }
 }
@@ -737,7 +738,7 @@ void Mission::begin_think() {
   think_started_ = true;
   (void)evidence::filter_readings(features_, params_.limits);
   builder_.start(params_.model, features_.span(), floor_obstacles_.span(), floor_free_.span(),
-                 floor_free_near_.span());
+                 floor_free_near_.span(), floor_blocked_.span());
 }
 
 void Mission::after_think() {

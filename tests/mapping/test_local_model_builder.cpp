@@ -543,3 +543,60 @@ TEST(LocalModelBuilder, AFeatureInTheBandShowsTheFloorBeforeItFreeOnlyWhenFeatur
   CHECK(g_other.seen_free().radius_at_m(deg(270.0F)) < 0.5F);
   CHECK(g_other.map().free.radius_at_m(deg(270.0F)) < 0.5F);
 }
+
+// A floor walk whose bottom row already shows no floor (FloorCue's kBlockedAtBottom): an
+// obstacle stands somewhere between the robot's disc and that row, which no view sees. In
+// the lowest view (its bottom row within seen_floor_start_m) its ray keeps only the robot's
+// disc, unless a walk of another frame started on floor nearer than the blocked row; and it
+// gives no map point (where the obstacle is, is not known).
+TEST(LocalModelBuilder, AWalkBlockedAtTheLowestViewsBottomRowLeavesTheRobotOnlyItsDiscThatWay) {
+  WalkedLook& w = walked_look();
+  Look& look = w.look;
+  FixedVector<Reading, 1024> blocked;
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    for (const float z : {0.1F, 0.4F}) (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
+    const bool low_blocked = (d >= 30 && d < 210) || (d >= 240 && d < 270);
+    const bool high_blocked = d >= 300 && d < 330;
+    if (low_blocked) (void)blocked.push_back(at(alpha, 0.6F, 0.0F, 0.5F));
+    if (high_blocked) (void)blocked.push_back(at(alpha, 1.7F, 0.0F, 0.5F));
+    // Walks everywhere but where the low view is blocked; at 240-270° another frame's
+    // walk starts at 0.35 m, nearer than the blocked row, and ends before a box at 1.2 m.
+    if (!(d >= 30 && d < 210)) {
+      (void)w.free.push_back(at(alpha, d >= 240 && d < 270 ? 1.2F : kWall_m - 0.03F, 0.0F, 0.0F));
+      (void)w.near_m.push_back(0.35F);
+    }
+  }
+  mapping::LocalModelParams params = make_params();
+  params.seen_floor_start_m = 0.78F;
+  const float own = kRobotRadius_m + kMargin_m;
+  g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(), w.near_m.span(),
+                blocked.span());
+  CHECK_NO_ALLOCATION(g_other.run());
+  const mapping::StarPolygon& free = g_other.map().free;
+  for (const float d : {32.0F, 90.0F, 150.0F, 207.0F}) {
+    CHECK(free.radius_at_m(deg(d)) < own + 0.05F);
+  }
+  CHECK(g_other.stats().blocked_rays >= 170U);
+  CHECK(free.radius_at_m(deg(255.0F)) > 1.0F);  // a nearer walk saw the floor there
+  CHECK(free.radius_at_m(deg(315.0F)) > 1.5F);  // a higher view's bottom row: nothing said
+  CHECK(free.radius_at_m(deg(0.0F)) > 1.5F);
+  // No map point on the blocked rays (half a circle at the disc's edge, wide enough to be
+  // a frontier): where the obstacle is, is not known, and it is nowhere to explore.
+  FixedVector<Point2, 2048> obstacles;
+  FixedVector<Point2, 2048> exploration;
+  CHECK(g_other.map_points(mapping::MapPointParams{}, obstacles, exploration));
+  for (const FixedVector<Point2, 2048>* list : {&obstacles, &exploration}) {
+    for (const Point2& p : *list) {
+      float a = std::atan2(p.y_m, p.x_m) * 57.29578F;
+      if (a < 0.0F) a += 360.0F;
+      CHECK_TEXT(!(a > 31.0F && a < 209.0F), "a map point on a blocked ray");
+    }
+  }
+  // Without the blocked walks the rays are open to the fit and the features.
+  g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(),
+                w.near_m.span());
+  g_other.run();
+  CHECK(g_other.map().free.radius_at_m(deg(90.0F)) > 1.0F);
+  CHECK_EQUAL(0U, g_other.stats().blocked_rays);
+}

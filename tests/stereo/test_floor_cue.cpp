@@ -538,3 +538,80 @@ TEST(FloorCue, CoverageOfTheLookTiltsAndTheirStereoPartners) {
   CHECK(cue.floor_coverage(0.0F, near0, far0));
   CHECK(std::isinf(far0));  // level: the top rows see the horizon
 }
+
+// A cluttered place can show unlike regions in turn before two agree: the floor at one pan,
+// a plain box at the next, the floor again beyond it. With one waiting region the box's
+// took the first floor's place and the third region, unlike the box, waited again; the
+// cue keeps several, and the floor's two regions confirm each other across the box.
+TEST(FloorCue, TheFloorIsConfirmedAcrossAnUnlikeRegionSeenBetweenItsTwo) {
+  load(plain_box("crate", "0.75 0 0.3", "0.5 0.8 0.6", "0.5 0.4 0.3"));
+  static FloorCue fresh{g_rig};
+  fresh.reset();
+  render(-1.6F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, -1.6F, kLookTilt));
+  render(0.0F, kLookTilt, 2, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));  // the crate's face
+  render(1.6F, kLookTilt, 3, g_frame);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 1.6F, kLookTilt));
+  CHECK(fresh.model().median[0] > 110.0F);  // the floor's, not the crate's
+}
+
+// A walk whose bottom row is not floor says nothing of where the obstacle stands, but that
+// it stands nearer than the bottom row's floor point: each such walk is reported there, the
+// walks whose bottom row is floor are not.
+TEST(FloorCue, AWalkBlockedAtItsBottomRowIsReportedAtThatRowsFloorPoint) {
+  // The crate's front face at 0.5 m, nearer than the low view's bottom row (about 0.75 m).
+  load(plain_box("crate", "0.75 0 0.3", "0.5 0.8 0.6", "0.5 0.4 0.3"));
+  render(1.6F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 1.6F, kLookTilt));
+  render(0.0F, kLookTilt, 2, g_frame);
+  FixedVector<Reading, 128> blocked;
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = cue.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free, nullptr, &blocked);
+  CHECK_EQUAL(blocked.size(), out.result.blocked_readings);
+  std::size_t blocked_columns = 0;
+  std::size_t in_front = 0;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < cue.column_count(); ++i) {
+    const FloorColumn& c = cue.column(i);
+    if (c.end != FloorColumn::End::kBlockedAtBottom) continue;
+    ++blocked_columns;
+    const Reading& r = blocked[k++];
+    DOUBLES_EQUAL(c.near_rho_m, std::sqrt(r.r_m * r.r_m - r.h_m * r.h_m), 1e-3);
+    DOUBLES_EQUAL(-g_rig.params().ptu_height_m, r.h_m, 1e-3);  // on the floor
+    const Eigen::Vector3f p = floor_point_of(r);
+    in_front += std::fabs(p.y()) < 0.4F ? 1U : 0U;  // behind the crate's face
+  }
+  CHECK_EQUAL(blocked_columns, blocked.size());
+  CHECK(blocked.size() >= 20U);           // the crate spans most of the view's bottom row
+  CHECK_EQUAL(blocked.size(), in_front);  // and only it blocks a walk at the bottom
+}
+
+// The lowest row's two frames a view, kept while the first model waits: a cluttered place
+// may confirm it only at its twelfth view, and the frames before it are all walked.
+TEST(FloorCue, TwentyFourFramesSeenBeforeTheModelAreKeptAndWalked) {
+  load("");
+  static FloorCue fresh{g_rig};
+  fresh.reset();
+  render(0.0F, kLookTilt, 1, g_frame);
+  std::size_t kept = 0;
+  for (int i = 0; i < 24; ++i) {
+    out.obstacles.clear();
+    out.free.clear();
+    const FloorCueResult r = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+    CHECK_FALSE(r.deferred_dropped);
+    kept += r.deferred ? 1U : 0U;
+  }
+  CHECK_EQUAL(24U, kept);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  render(1.2F, kLookTilt, 2, g_frame2);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame2, 1.2F, kLookTilt));
+  std::size_t walked = 0;
+  for (int i = 0; i < 30; ++i) {
+    FixedVector<Reading, 512> free;
+    out.obstacles.clear();
+    walked += fresh.process(g_frame2, 1.2F, kLookTilt, out.obstacles, free).deferred_walked;
+  }
+  CHECK_EQUAL(24U, walked);
+}

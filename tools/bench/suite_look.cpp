@@ -61,6 +61,7 @@ Readings g_features;
 FloorObstacles g_floor_obstacles;
 FloorFree g_floor_free;
 core::FixedVector<float, firmware::mission::kMaxLookFloorFree> g_floor_free_near;
+core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFloorBlocked> g_floor_blocked;
 mapping::LocalModelBuilder g_builder;
 
 firmware::SnapshotWriter g_snapshots;
@@ -391,6 +392,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     g_floor_obstacles.clear();
     g_floor_free.clear();
     g_floor_free_near.clear();
+    g_floor_blocked.clear();
     floor_cue.reset();  // the mission's first look: nothing known about the floor yet
     firmware::mission::TargetTracker tracker;
     tracker.configure(params.target);
@@ -507,11 +509,11 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       t0 = cpu_ns();
       (void)floor_cue.learn(g_first, pp.pan_rad, pp.first_tilt_rad);
       (void)floor_cue.process(g_first, pp.pan_rad, pp.first_tilt_rad, g_floor_obstacles,
-                              g_floor_free, &g_floor_free_near);
+                              g_floor_free, &g_floor_free_near, &g_floor_blocked);
       if (view.pair && pp.second_tilt_rad < -0.3F) {
         (void)floor_cue.learn(g_second, pp.pan_rad, pp.second_tilt_rad);
         (void)floor_cue.process(g_second, pp.pan_rad, pp.second_tilt_rad, g_floor_obstacles,
-                                g_floor_free, &g_floor_free_near);
+                                g_floor_free, &g_floor_free_near, &g_floor_blocked);
       }
       floor_ns += static_cast<double>(cpu_ns() - t0);
     }
@@ -538,7 +540,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     const std::int64_t t0 = cpu_ns();
     (void)evidence::filter_readings(g_features, params.limits);
     g_builder.start(params.model, g_features.span(), g_floor_obstacles.span(), g_floor_free.span(),
-                    g_floor_free_near.span());
+                    g_floor_free_near.span(), g_floor_blocked.span());
     g_builder.run();
     st.think_ms.push_back(static_cast<double>(cpu_ns() - t0) * 1e-6);
     st.pieces.push_back(static_cast<double>(g_builder.stats().pieces));

@@ -29,17 +29,23 @@ float own_disc_m(const ExtractionParams& p) {
   return p.robot_radius_m + p.clearance_margin_m + 0.02F;
 }
 
+// A walk that started this much nearer than a blocked one in the same vertex ray saw the
+// floor before the blocked row (two frames' bottom rows, or two columns, differ) [m].
+constexpr float kBlockedTolerance_m = 0.02F;
+
 }  // namespace
 
 void LocalModelBuilder::start(const LocalModelParams& params,
                               std::span<const evidence::Reading> features,
                               std::span<const evidence::Reading> floor_obstacles,
                               std::span<const evidence::Reading> floor_free,
-                              std::span<const float> floor_free_near_m) {
+                              std::span<const float> floor_free_near_m,
+                              std::span<const evidence::Reading> floor_blocked) {
   params_ = params;
   features_ = features;
   obstacles_ = floor_obstacles;
   free_ = floor_free;
+  blocked_ = floor_blocked;
   // Out of step with the free readings: not used (every walk then counts as joined).
   free_near_ =
       floor_free_near_m.size() == floor_free.size() ? floor_free_near_m : std::span<const float>{};
@@ -268,6 +274,31 @@ void LocalModelBuilder::extract() {
     const float base = std::max(horizontal_m(r) - params_.base_margin_m, 0.0F);
     obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), base));
   }
+  // A walk blocked at the bottom row of a view that sees the floor from seen_floor_start_m
+  // on: something stands between the robot's disc and that row, which no view sees. Its
+  // vertex ray keeps only the robot's disc, unless a walk of another frame started on floor
+  // nearer than the blocked row (its own base, above, then cuts where the obstacle is).
+  blocked_ray_.fill(false);
+  if (!blocked_.empty()) {
+    scratch_.set_vertex_count(p.vertex_count);
+    scratch_.fill(std::numeric_limits<float>::infinity());  // nearest walk start per ray
+    for (std::size_t i = 0; i < free_near_.size(); ++i) {
+      const std::size_t k = vertex_of(scratch_, free_[i].alpha_rad);
+      scratch_.set_rho_m(k, std::min(scratch_.rho_m(k), free_near_[i]));
+    }
+    const float own = own_disc_m(p);
+    for (const evidence::Reading& r : blocked_) {
+      const float near = horizontal_m(r);
+      const std::size_t k = vertex_of(obstacle_polygon_, r.alpha_rad);
+      if (near > params_.seen_floor_start_m || scratch_.rho_m(k) < near - kBlockedTolerance_m ||
+          obstacle_polygon_.rho_m(k) <= own) {
+        continue;
+      }
+      obstacle_polygon_.set_rho_m(k, own);
+      blocked_ray_[k] = true;
+      ++stats_.blocked_rays;
+    }
+  }
   build_seen_free();
   // Nearest evidence of an obstacle per vertex ray (for the map points).
   evidence_.set_vertex_count(p.vertex_count);
@@ -309,15 +340,18 @@ bool LocalModelBuilder::map_points(const MapPointParams& params, PointList& obst
   };
   // Each vertex: an obstacle (evidence within its range error, and the shrink's margin, of
   // the boundary), on the bounding circle, or unknown (the fit alone, or floor not seen).
-  enum Kind : std::uint8_t { kObstacle, kCircle, kUnknown };
+  // A ray cut to the robot's disc by a blocked walk (kBlocked) has something on it nearer
+  // than the lowest view's bottom row, but not where: neither an obstacle point nor a frontier.
+  enum Kind : std::uint8_t { kObstacle, kCircle, kUnknown, kBlocked };
   std::array<Kind, kMaxPolygonVertices> kind{};
   for (std::size_t k = 0; k < n; ++k) {
     const float rho = free.rho_m(k);
     const float e = evidence_.rho_m(k);
     const bool backed = std::isfinite(e) && std::fabs(e - rho) <= 2.0F * dr * e + 0.1F;
-    kind[k] = rho >= radius - params.on_circle_tolerance_m ? kCircle
-              : backed                                     ? kObstacle
-                                                           : kUnknown;
+    kind[k] = blocked_ray_[k]                                ? kBlocked
+              : rho >= radius - params.on_circle_tolerance_m ? kCircle
+              : backed                                       ? kObstacle
+                                                             : kUnknown;
   }
   // An unknown stretch narrower than min_frontier_width_m (a shadow behind a box, a few
   // vertices the floor cue missed) leads the robot nowhere: no exploration points there.

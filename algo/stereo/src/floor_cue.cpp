@@ -66,6 +66,7 @@ std::uint8_t to_byte(float x) {
 void add_walk(const FloorCueResult& r, FloorCueResult& total) {
   total.obstacle_readings += r.obstacle_readings;
   total.free_readings += r.free_readings;
+  total.blocked_readings += r.blocked_readings;
   total.boundaries += r.boundaries;
   total.truncated = total.truncated || r.truncated;
 }
@@ -188,14 +189,16 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   // part of it fails here) and to the model already known (one covering all of it).
   std::size_t own = 0;
   std::size_t known = 0;
-  std::size_t pending = 0;
+  std::array<std::size_t, kPendingSlots> pending{};
   for (std::size_t i = 0; i < count; ++i) {
     const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
                                       static_cast<float>(reference_[i][1]) - 128.0F,
                                       static_cast<float>(reference_[i][2]) - 128.0F};
     own += contrast_to(candidate, values) <= 1.0F ? 1U : 0U;
     known += model_.valid && contrast_to(model_, values) <= 1.0F ? 1U : 0U;
-    pending += pending_.valid && contrast_to(pending_, values) <= 1.0F ? 1U : 0U;
+    for (std::size_t j = 0; j < kPendingSlots; ++j) {
+      pending[j] += pending_[j].valid && contrast_to(pending_[j], values) <= 1.0F ? 1U : 0U;
+    }
   }
   const auto needed =
       static_cast<std::size_t>(std::ceil(params_.consistency_min * static_cast<float>(count)));
@@ -210,20 +213,35 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
       model_ = candidate;
       return FloorLearn::kLearned;
     }
-    const float apart = std::fabs(std::remainder(pan_rad - pending_pan_rad_, core::kTwoPi<float>));
-    if (pending_.valid && pending >= needed && apart >= params_.confirm_separation_rad) {
-      // Two directions agree: the floor. The model starts between their two regions.
-      model_ = pending_;
-      for (std::size_t c = 0; c < 3; ++c) {
-        model_.median[c] = 0.5F * (pending_.median[c] + candidate.median[c]);
-        model_.tolerance[c] = 0.5F * (pending_.tolerance[c] + candidate.tolerance[c]);
+    // The waiting region that agrees best from far enough away, if any.
+    std::size_t best = kPendingSlots;
+    bool agrees_nearby = false;
+    for (std::size_t j = 0; j < kPendingSlots; ++j) {
+      if (!pending_[j].valid || pending[j] < needed) continue;
+      const float apart =
+          std::fabs(std::remainder(pan_rad - pending_pan_rad_[j], core::kTwoPi<float>));
+      if (apart < params_.confirm_separation_rad) {
+        agrees_nearby = true;
+      } else if (best == kPendingSlots || pending[j] > pending[best]) {
+        best = j;
       }
-      pending_ = FloorModel{};
+    }
+    if (best < kPendingSlots) {
+      // Two directions agree: the floor. The model starts between their two regions.
+      const FloorModel& other = pending_[best];
+      model_ = other;
+      for (std::size_t c = 0; c < 3; ++c) {
+        model_.median[c] = 0.5F * (other.median[c] + candidate.median[c]);
+        model_.tolerance[c] = 0.5F * (other.tolerance[c] + candidate.tolerance[c]);
+      }
+      pending_.fill(FloorModel{});
       return FloorLearn::kLearned;
     }
-    if (!(pending_.valid && pending >= needed)) {
-      pending_ = candidate;  // the first region, or one unlike it: the latest waits
-      pending_pan_rad_ = pan_rad;
+    if (!agrees_nearby) {
+      // A region unlike every waiting one (or the first) waits too; the oldest gives way.
+      pending_[pending_next_] = candidate;
+      pending_pan_rad_[pending_next_] = pan_rad;
+      pending_next_ = (pending_next_ + 1) % kPendingSlots;
     }
     return FloorLearn::kPending;
   }
@@ -251,7 +269,8 @@ bool FloorCue::sight_floor_point(const CameraPose& pose, float azimuth_rad, floa
 FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                                  core::FixedVectorBase<evidence::Reading>& obstacles,
                                  core::FixedVectorBase<evidence::Reading>& free,
-                                 core::FixedVectorBase<float>* free_near_m) {
+                                 core::FixedVectorBase<float>* free_near_m,
+                                 core::FixedVectorBase<evidence::Reading>* blocked) {
   const std::size_t pixels = std::size_t{frame.width} * frame.height;
   if (!model_.valid) {
     FloorCueResult result;
@@ -262,7 +281,10 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
       d.height = frame.height;
       d.pan_rad = pan_rad;
       d.tilt_rad = tilt_rad;
-      std::copy_n(frame.luma.begin(), pixels, d.luma.begin());
+      std::transform(frame.luma.begin(), frame.luma.begin() + static_cast<std::ptrdiff_t>(pixels),
+                     d.luma.begin(), [](float y) {
+                       return static_cast<std::uint8_t>(std::lround(std::clamp(y, 0.0F, 255.0F)));
+                     });
       std::copy_n(frame.chroma_u.begin(), pixels, d.chroma_u.begin());
       std::copy_n(frame.chroma_v.begin(), pixels, d.chroma_v.begin());
       result.deferred = true;
@@ -278,14 +300,15 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
     const std::size_t n = std::size_t{d.width} * d.height;
     scratch_.width = d.width;
     scratch_.height = d.height;
-    std::copy_n(d.luma.begin(), n, scratch_.luma.begin());
+    std::transform(d.luma.begin(), d.luma.begin() + static_cast<std::ptrdiff_t>(n),
+                   scratch_.luma.begin(), [](std::uint8_t y) { return static_cast<float>(y); });
     std::copy_n(d.chroma_u.begin(), n, scratch_.chroma_u.begin());
     std::copy_n(d.chroma_v.begin(), n, scratch_.chroma_v.begin());
-    add_walk(walk(scratch_, d.pan_rad, d.tilt_rad, obstacles, free, free_near_m), total);
+    add_walk(walk(scratch_, d.pan_rad, d.tilt_rad, obstacles, free, free_near_m, blocked), total);
     ++total.deferred_walked;
     if (deferred_next_ == deferred_count_) deferred_next_ = deferred_count_ = 0;
   }
-  const FloorCueResult r = walk(frame, pan_rad, tilt_rad, obstacles, free, free_near_m);
+  const FloorCueResult r = walk(frame, pan_rad, tilt_rad, obstacles, free, free_near_m, blocked);
   add_walk(r, total);
   total.columns = r.columns;  // the columns (and column()) are this frame's
   total.model_valid = r.model_valid;
@@ -295,7 +318,8 @@ FloorCueResult FloorCue::process(const image::LowResFrame& frame, float pan_rad,
 FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                               core::FixedVectorBase<evidence::Reading>& obstacles,
                               core::FixedVectorBase<evidence::Reading>& free,
-                              core::FixedVectorBase<float>* free_near_m) {
+                              core::FixedVectorBase<float>* free_near_m,
+                              core::FixedVectorBase<evidence::Reading>* blocked) {
   FloorCueResult result;
   column_count_ = 0;
   result.model_valid = model_.valid;
@@ -358,6 +382,7 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
     col.azimuth_rad = core::wrap_two_pi(azimuth);
     bool have_floor = false;  // a floor pixel connected to the bottom
     Eigen::Vector3f free_point = Eigen::Vector3f::Zero();
+    Eigen::Vector3f near_point = Eigen::Vector3f::Zero();  // the walk's bottom-row floor point
     std::uint32_t run = 0;
     std::uint32_t run_start = 0;  // step of the first non-floor pixel of the run
     std::array<float, kMaxRun> run_contrast{};
@@ -372,6 +397,7 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
       }
       if (step == 0) {
         col.near_rho_m = rho;
+        near_point = point;
       }
       Eigen::Vector2f pixel;
       if (!RigModel::project_ptu(pose, camera, point, pixel)) {
@@ -436,6 +462,14 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
         }
       } else {
         col.end = FloorColumn::End::kBlockedAtBottom;
+      }
+    }
+    if (col.end == FloorColumn::End::kBlockedAtBottom && blocked != nullptr) {
+      // Something stands on the floor somewhere nearer than the bottom row's floor point.
+      if (blocked->push_back(reading_from_point(near_point, params_.evidence_weak))) {
+        ++result.blocked_readings;
+      } else {
+        result.truncated = true;
       }
     }
     if (have_floor) {

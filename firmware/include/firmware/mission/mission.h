@@ -71,6 +71,8 @@ const char* phase_name(Phase phase);
 inline constexpr std::size_t kMaxLookFeatures = 16384;
 inline constexpr std::size_t kMaxLookFloorObstacles = 12288;
 inline constexpr std::size_t kMaxLookFloorFree = 8192;
+// Walks blocked at their bottom row: at most one per column walked, 80 columns a frame.
+inline constexpr std::size_t kMaxLookFloorBlocked = 4096;
 
 // What the mission needs from around it (references valid for its lifetime).
 struct MissionContext {
@@ -245,6 +247,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   core::FixedVector<evidence::Reading, kMaxLookFloorObstacles> floor_obstacles_;
   core::FixedVector<evidence::Reading, kMaxLookFloorFree> floor_free_;
   core::FixedVector<float, kMaxLookFloorFree> floor_free_near_;  // each walk's near end [m]
+  core::FixedVector<evidence::Reading, kMaxLookFloorBlocked> floor_blocked_;
   TargetTracker tracker_;
   stereo::TargetSighting last_sighting_{};  // this look's latest first frame with the target
   std::uint32_t last_features_ = 0;

@@ -2,6 +2,7 @@
 // resumable in small units of work.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -84,6 +85,7 @@ struct LocalModelStats {
   std::size_t guard_points = 0;
   std::size_t guard_dropped = 0;   // unexplained readings that found the candidate list full
   bool guard_points_full = false;  // corroborated points were dropped (the list was full)
+  std::size_t blocked_rays = 0;    // vertex rays cut to the robot's disc by floor_blocked
   std::size_t units = 0;
   bool model_valid = false;  // the fit was invertible (monotone in r)
 };
@@ -92,7 +94,11 @@ struct LocalModelStats {
 // stereo features, the floor cue's obstacle bases (occupied) and its farthest free floor
 // points (m = 0: the line of sight to them is free), and optionally, in step with those, the
 // horizontal distance [m] at which each floor walk began (FloorCue::process); without them
-// every walk counts as joined to the robot. The spans must stay valid until done().
+// every walk counts as joined to the robot. `floor_blocked` (FloorCue::process's `blocked`):
+// the bottom-row floor points of walks whose bottom row showed no floor; one within
+// seen_floor_start_m, with no walk in its direction starting nearer, leaves the free
+// polygon only the robot's own disc in its direction (something stands in the ring round
+// the robot that no view sees). The spans must stay valid until done().
 // step() does one bounded unit of work; nothing allocates. Make the object static (MBs).
 class LocalModelBuilder {
  public:
@@ -103,7 +109,8 @@ class LocalModelBuilder {
   void start(const LocalModelParams& params, std::span<const evidence::Reading> features,
              std::span<const evidence::Reading> floor_obstacles,
              std::span<const evidence::Reading> floor_free,
-             std::span<const float> floor_free_near_m = {});
+             std::span<const float> floor_free_near_m = {},
+             std::span<const evidence::Reading> floor_blocked = {});
   // One unit of work; true when the local map is ready.
   bool step();
   // Runs to the end (tests, benchmarks).
@@ -155,6 +162,7 @@ class LocalModelBuilder {
   std::span<const evidence::Reading> obstacles_{};
   std::span<const evidence::Reading> free_{};
   std::span<const float> free_near_{};
+  std::span<const evidence::Reading> blocked_{};
   std::size_t cursor_ = 0;
   std::size_t guard_cursor_ = 0;  // next guard candidate to corroborate
   core::FixedVector<evidence::RaySample, kLookMaxSamples> ray_samples_;
@@ -168,6 +176,7 @@ class LocalModelBuilder {
   StarPolygon seen_free_{};
   StarPolygon scratch_{};
   StarPolygon evidence_{};  // nearest evidence of an obstacle along each vertex ray [m]
+  std::array<bool, kMaxPolygonVertices> blocked_ray_{};  // cut to the disc by floor_blocked
   LocalMap map_{};
   LocalModelStats stats_{};
 };

@@ -101,6 +101,7 @@ struct FloorColumn {
 struct FloorCueResult {
   std::size_t obstacle_readings = 0;  // appended to `obstacles`
   std::size_t free_readings = 0;      // appended to `free`
+  std::size_t blocked_readings = 0;   // appended to `blocked`
   std::size_t columns = 0;            // columns walked
   std::size_t boundaries = 0;         // columns ending at an obstacle base
   bool truncated = false;             // an output was full: some readings were dropped
@@ -119,16 +120,19 @@ class FloorCue {
   [[nodiscard]] const FloorModel& model() const { return model_; }
   void reset() {
     model_ = FloorModel{};
-    pending_ = FloorModel{};
+    pending_.fill(FloorModel{});
+    pending_next_ = 0;
     deferred_count_ = deferred_next_ = 0;
   }
   // Another look begins (the robot may have moved): kept frames belong to the last pose, drop them.
   void begin_look() { deferred_count_ = deferred_next_ = 0; }
   // Frames kept while the first model waits for a second direction (walked once it is
   // confirmed, one per process() call besides the current frame, so the views before it lose
-  // nothing and no call walks more than two frames): slots of the rig's low-resolution size
-  // (about 115 KB each).
-  static constexpr std::size_t kDeferredSlots = 10;
+  // nothing and no call walks more than two frames): slots of the rig's low-resolution size,
+  // luma rounded to whole levels (about 58 KB each). A look's lowest row walks two frames a
+  // view, so 24 slots keep the first 12 views of 15 (a cluttered place's first model can wait
+  // that long).
+  static constexpr std::size_t kDeferredSlots = 24;
   static constexpr std::size_t kDeferredPixels = std::size_t{160} * 120;
 
   // Learns (or, if one is known, updates) the floor model from the frame's reference
@@ -150,10 +154,14 @@ class FloorCue {
   // free reading. A walk that starts beyond an obstacle (a high view looking over a low box,
   // or over a wall the floor model took for floor) says nothing about the floor before it;
   // the Think stage joins walks to the robot only where they meet (LocalModelBuilder).
+  // `blocked`, if given, gets one reading (m = evidence_weak) at the bottom-row floor point of
+  // each walk whose bottom row already does not look like floor (kBlockedAtBottom):
+  // something stands on the floor nearer than that point, or on it.
   FloorCueResult process(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                          core::FixedVectorBase<evidence::Reading>& obstacles,
                          core::FixedVectorBase<evidence::Reading>& free,
-                         core::FixedVectorBase<float>* free_near_m = nullptr);
+                         core::FixedVectorBase<float>* free_near_m = nullptr,
+                         core::FixedVectorBase<evidence::Reading>* blocked = nullptr);
 
   // Columns of the last process() call.
   [[nodiscard]] std::size_t column_count() const { return column_count_; }
@@ -180,7 +188,8 @@ class FloorCue {
   FloorCueResult walk(const image::LowResFrame& frame, float pan_rad, float tilt_rad,
                       core::FixedVectorBase<evidence::Reading>& obstacles,
                       core::FixedVectorBase<evidence::Reading>& free,
-                      core::FixedVectorBase<float>* free_near_m);
+                      core::FixedVectorBase<float>* free_near_m,
+                      core::FixedVectorBase<evidence::Reading>* blocked);
   void pixel_values(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
                     std::array<float, 3>& values) const;
   float contrast_to(const FloorModel& model, const std::array<float, 3>& values) const;
@@ -188,14 +197,18 @@ class FloorCue {
   RigModel rig_;
   FloorCueParams params_;
   FloorModel model_;
-  FloorModel pending_;  // the first region's model, until another direction's agrees
-  float pending_pan_rad_ = 0.0F;
+  // Regions waiting for one from another direction to agree (a cluttered place can show
+  // several unlike ones before two agree), with their pans; the oldest gives way.
+  static constexpr std::size_t kPendingSlots = 4;
+  std::array<FloorModel, kPendingSlots> pending_{};
+  std::array<float, kPendingSlots> pending_pan_rad_{};
+  std::size_t pending_next_ = 0;
   struct DeferredFrame {
     std::uint32_t width = 0;
     std::uint32_t height = 0;
     float pan_rad = 0.0F;
     float tilt_rad = 0.0F;
-    std::array<float, kDeferredPixels> luma{};
+    std::array<std::uint8_t, kDeferredPixels> luma{};  // rounded: the floor test allows ≥ 10 levels
     std::array<std::uint8_t, kDeferredPixels> chroma_u{};
     std::array<std::uint8_t, kDeferredPixels> chroma_v{};
   };
