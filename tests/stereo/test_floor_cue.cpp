@@ -568,7 +568,8 @@ TEST(FloorCue, AWalkBlockedAtItsBottomRowIsReportedAtThatRowsFloorPoint) {
   FixedVector<Reading, 128> blocked;
   out.obstacles.clear();
   out.free.clear();
-  out.result = cue.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free, nullptr, &blocked);
+  CHECK_NO_ALLOCATION(out.result = cue.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free,
+                                               nullptr, &blocked));
   CHECK_EQUAL(blocked.size(), out.result.blocked_readings);
   std::size_t blocked_columns = 0;
   std::size_t in_front = 0;
