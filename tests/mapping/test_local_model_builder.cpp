@@ -593,9 +593,16 @@ TEST(LocalModelBuilder, AWalkBlockedAtTheLowestViewsBottomRowLeavesTheRobotOnlyI
       CHECK_TEXT(!(a > 31.0F && a < 209.0F), "a map point on a blocked ray");
     }
   }
-  // Without the blocked walks the rays are open to the fit and the features.
+  // Without the blocked walks, or with the setting off, the rays are open to the fit and the
+  // features.
   g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(),
                 w.near_m.span());
+  g_other.run();
+  CHECK(g_other.map().free.radius_at_m(deg(90.0F)) > 1.0F);
+  CHECK_EQUAL(0U, g_other.stats().blocked_rays);
+  params.close_blocked_rays = false;
+  g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(), w.near_m.span(),
+                blocked.span());
   g_other.run();
   CHECK(g_other.map().free.radius_at_m(deg(90.0F)) > 1.0F);
   CHECK_EQUAL(0U, g_other.stats().blocked_rays);

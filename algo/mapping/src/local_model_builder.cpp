@@ -279,7 +279,7 @@ void LocalModelBuilder::extract() {
   // vertex ray keeps only the robot's disc, unless a walk of another frame started on floor
   // nearer than the blocked row (its own base, above, then cuts where the obstacle is).
   blocked_ray_.fill(false);
-  if (!blocked_.empty()) {
+  if (params_.close_blocked_rays && !blocked_.empty()) {
     scratch_.set_vertex_count(p.vertex_count);
     scratch_.fill(std::numeric_limits<float>::infinity());  // nearest walk start per ray
     for (std::size_t i = 0; i < free_near_.size(); ++i) {
