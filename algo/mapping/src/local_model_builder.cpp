@@ -32,6 +32,9 @@ float own_disc_m(const ExtractionParams& p) {
 // A walk that started this much nearer than a blocked one in the same vertex ray saw the
 // floor before the blocked row (two frames' bottom rows, or two columns, differ) [m].
 constexpr float kBlockedTolerance_m = 0.02F;
+// Evidence of an obstacle this far beyond a blocked walk's bottom-row floor point can still be
+// what blocks it: a wall's features scatter about its base by the stereo's range error [m].
+constexpr float kBlockedEvidenceSlack_m = 0.1F;
 
 }  // namespace
 
@@ -274,33 +277,7 @@ void LocalModelBuilder::extract() {
     const float base = std::max(horizontal_m(r) - params_.base_margin_m, 0.0F);
     obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), base));
   }
-  // A walk blocked at the bottom row of a view that sees the floor from seen_floor_start_m
-  // on: something stands between the robot's disc and that row, which no view sees. Its
-  // vertex ray keeps only the robot's disc, unless a walk of another frame started on floor
-  // nearer than the blocked row (its own base, above, then cuts where the obstacle is).
-  blocked_ray_.fill(false);
-  if (params_.close_blocked_rays && !blocked_.empty()) {
-    scratch_.set_vertex_count(p.vertex_count);
-    scratch_.fill(std::numeric_limits<float>::infinity());  // nearest walk start per ray
-    for (std::size_t i = 0; i < free_near_.size(); ++i) {
-      const std::size_t k = vertex_of(scratch_, free_[i].alpha_rad);
-      scratch_.set_rho_m(k, std::min(scratch_.rho_m(k), free_near_[i]));
-    }
-    const float own = own_disc_m(p);
-    for (const evidence::Reading& r : blocked_) {
-      const float near = horizontal_m(r);
-      const std::size_t k = vertex_of(obstacle_polygon_, r.alpha_rad);
-      if (near > params_.seen_floor_start_m || scratch_.rho_m(k) < near - kBlockedTolerance_m ||
-          obstacle_polygon_.rho_m(k) <= own) {
-        continue;
-      }
-      obstacle_polygon_.set_rho_m(k, own);
-      blocked_ray_[k] = true;
-      ++stats_.blocked_rays;
-    }
-  }
-  build_seen_free();
-  // Nearest evidence of an obstacle per vertex ray (for the map points).
+  // Nearest evidence of an obstacle per vertex ray (for the blocked walks and the map points).
   evidence_.set_vertex_count(p.vertex_count);
   evidence_.fill(std::numeric_limits<float>::infinity());
   auto evidence_at = [&](float alpha, float rho) {
@@ -318,6 +295,40 @@ void LocalModelBuilder::extract() {
       evidence_at(r.alpha_rad, horizontal_m(r));
     }
   }
+  // A walk blocked at the bottom row of a view that sees the floor from seen_floor_start_m
+  // on: something stands between the robot's disc and that row, which no view sees. Its
+  // vertex ray keeps only the robot's disc, unless a walk of another frame started on floor
+  // nearer than the blocked row (its own base, above, then cuts where the obstacle is), or
+  // evidence of an obstacle (a base, a guard point, a feature in the band) lies on the ray
+  // before the row: that is what blocks it, and the ray is cut in front of it.
+  blocked_ray_.fill(false);
+  if (params_.close_blocked_rays && !blocked_.empty()) {
+    scratch_.set_vertex_count(p.vertex_count);
+    scratch_.fill(std::numeric_limits<float>::infinity());  // nearest walk start per ray
+    for (std::size_t i = 0; i < free_near_.size(); ++i) {
+      const std::size_t k = vertex_of(scratch_, free_[i].alpha_rad);
+      scratch_.set_rho_m(k, std::min(scratch_.rho_m(k), free_near_[i]));
+    }
+    const float own = own_disc_m(p);
+    for (const evidence::Reading& r : blocked_) {
+      const float near = horizontal_m(r);
+      const std::size_t k = vertex_of(obstacle_polygon_, r.alpha_rad);
+      if (near > params_.seen_floor_start_m || scratch_.rho_m(k) < near - kBlockedTolerance_m ||
+          obstacle_polygon_.rho_m(k) <= own) {
+        continue;
+      }
+      const float e = evidence_.rho_m(k);
+      if (e <= near + kBlockedEvidenceSlack_m) {
+        const float cut = std::max(e - params_.base_margin_m, own);
+        obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), cut));
+      } else {
+        obstacle_polygon_.set_rho_m(k, own);
+        blocked_ray_[k] = true;
+      }
+      ++stats_.blocked_rays;
+    }
+  }
+  build_seen_free();
   map_.free = obstacle_polygon_;
   if (params_.clamp_to_seen_free) {
     (void)intersect_into(map_.free, seen_free_);
