@@ -35,6 +35,8 @@ constexpr float kBlockedTolerance_m = 0.02F;
 // Evidence of an obstacle this far beyond a blocked walk's bottom-row floor point can still be
 // what blocks it: a wall's features scatter about its base by the stereo's range error [m].
 constexpr float kBlockedEvidenceSlack_m = 0.1F;
+// ... and on the vertex rays this many either side of a blocked one.
+constexpr std::size_t kBlockedEvidenceRays = 2;
 
 }  // namespace
 
@@ -317,7 +319,12 @@ void LocalModelBuilder::extract() {
           obstacle_polygon_.rho_m(k) <= own) {
         continue;
       }
-      const float e = evidence_.rho_m(k);
+      // Features do not fall on every vertex ray: the nearest evidence of the rays around.
+      const std::size_t n = evidence_.vertex_count();
+      float e = evidence_.rho_m(k);
+      for (std::size_t d = 1; d <= kBlockedEvidenceRays; ++d) {
+        e = std::min({e, evidence_.rho_m((k + d) % n), evidence_.rho_m((k + n - d) % n)});
+      }
       if (e <= near + kBlockedEvidenceSlack_m) {
         const float cut = std::max(e - params_.base_margin_m, own);
         obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), cut));

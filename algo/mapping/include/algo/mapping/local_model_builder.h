@@ -59,7 +59,8 @@ struct LocalModelParams {
   // A walk blocked at the lowest view's bottom row (start()'s floor_blocked) closes its vertex
   // ray: in front of evidence of an obstacle on it before the row (a base, a guard point, a
   // band feature), else to the robot's own disc. Measured (docs/benchmarks.md): the look
-  // bench's cluttered room 0.9982 -> 0.9990 safe. false: blocked walks are ignored.
+  // bench's cluttered room 0.9982 -> 0.9990 safe, but the mission lost its way through a
+  // doorway (off there). false: blocked walks are ignored.
   bool close_blocked_rays = true;
   // A stereo feature in the robot's height band (m ≥ m_safe) counts the band as seen free up
   // to 2 δr before it. Its line of sight is free, but not the floor under it: a box lower
