@@ -716,12 +716,12 @@ bool Mission::process_view(std::uint8_t part) {
       // the columns; a low pair's second frame sees nearer floor than its first.
       (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
       (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad,
-                               floor_obstacles_, floor_free_, &floor_free_near_, &floor_blocked_);
+                               floor_obstacles_, floor_free_, &floor_free_near_, blocked_output());
       return !(view_pair_ && pair_pose_.second_tilt_rad < -0.3F);
     default:
       (void)floor_cue_.learn(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad);
       (void)floor_cue_.process(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad,
-                               floor_obstacles_, floor_free_, &floor_free_near_, &floor_blocked_);
+                               floor_obstacles_, floor_free_, &floor_free_near_, blocked_output());
       return true;
   }
 }

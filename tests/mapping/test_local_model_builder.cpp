@@ -544,6 +544,21 @@ TEST(LocalModelBuilder, AFeatureInTheBandShowsTheFloorBeforeItFreeOnlyWhenFeatur
   CHECK(g_other.map().free.radius_at_m(deg(270.0F)) < 0.5F);
 }
 
+// The blocked-walk tests: a featured wall all round at kWall_m, and the parameters with the
+// lowest view's bottom row 0.78 m out (the sim board's).
+void add_featured_wall(Look& look) {
+  for (int d = 0; d < 360; ++d) {
+    for (const float z : {0.1F, 0.4F}) {
+      (void)look.features.push_back(at(deg(static_cast<float>(d)), kWall_m, z, 0.9F));
+    }
+  }
+}
+mapping::LocalModelParams blocked_walk_params() {
+  mapping::LocalModelParams params = make_params();
+  params.seen_floor_start_m = 0.78F;
+  return params;
+}
+
 // A floor walk whose bottom row already shows no floor (FloorCue's kBlockedAtBottom): an
 // obstacle stands somewhere between the robot's disc and that row, which no view sees. In
 // the lowest view (its bottom row within seen_floor_start_m) its ray keeps only the robot's
@@ -553,9 +568,9 @@ TEST(LocalModelBuilder, AWalkBlockedAtTheLowestViewsBottomRowLeavesTheRobotOnlyI
   WalkedLook& w = walked_look();
   Look& look = w.look;
   FixedVector<Reading, 1024> blocked;
+  add_featured_wall(look);
   for (int d = 0; d < 360; ++d) {
     const float alpha = deg(static_cast<float>(d));
-    for (const float z : {0.1F, 0.4F}) (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
     const bool low_blocked = (d >= 30 && d < 210) || (d >= 240 && d < 270);
     const bool high_blocked = d >= 300 && d < 330;
     if (low_blocked) (void)blocked.push_back(at(alpha, 0.6F, 0.0F, 0.5F));
@@ -567,8 +582,7 @@ TEST(LocalModelBuilder, AWalkBlockedAtTheLowestViewsBottomRowLeavesTheRobotOnlyI
       (void)w.near_m.push_back(0.35F);
     }
   }
-  mapping::LocalModelParams params = make_params();
-  params.seen_floor_start_m = 0.78F;
+  mapping::LocalModelParams params = blocked_walk_params();
   const float own = kRobotRadius_m + kMargin_m;
   g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(), w.near_m.span(),
                 blocked.span());
@@ -615,9 +629,9 @@ TEST(LocalModelBuilder, ABlockedWalkWithEvidenceBeforeItsRowIsCutInFrontOfTheEvi
   WalkedLook& w = walked_look();
   Look& look = w.look;
   FixedVector<Reading, 1024> blocked;
+  add_featured_wall(look);
   for (int d = 0; d < 360; ++d) {
     const float alpha = deg(static_cast<float>(d));
-    for (const float z : {0.1F, 0.4F}) (void)look.features.push_back(at(alpha, kWall_m, z, 0.9F));
     if (d >= 30 && d < 90) {
       (void)blocked.push_back(at(alpha, 0.6F, 0.0F, 0.5F));
     } else {
@@ -626,8 +640,7 @@ TEST(LocalModelBuilder, ABlockedWalkWithEvidenceBeforeItsRowIsCutInFrontOfTheEvi
     }
   }
   (void)look.features.push_back(at(deg(60.0F), 0.55F, 0.3F, 0.9F));
-  mapping::LocalModelParams params = make_params();
-  params.seen_floor_start_m = 0.78F;
+  mapping::LocalModelParams params = blocked_walk_params();
   const float own = kRobotRadius_m + kMargin_m;
   g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(), w.near_m.span(),
                 blocked.span());

@@ -217,6 +217,23 @@ image::LowResFrame& second_frame() {
   return instance;
 }
 
+// The stereo pair of a view (tilt, then tilt − Φ), grabbed into first_frame() and
+// second_frame(), with the two cameras' true poses.
+struct GrabbedPair {
+  stereo::PairPose pair;
+  RigidTransform first;
+  RigidTransform second;
+};
+GrabbedPair grab_pair(SimCamera& camera, const View& view) {
+  GrabbedPair g;
+  g.pair = {view.pan_rad, view.tilt_rad, view.tilt_rad - rig().params().tilt_step_rad};
+  g.first = camera.sim().camera_pose(view.robot, g.pair.pan_rad, g.pair.first_tilt_rad);
+  g.second = camera.sim().camera_pose(view.robot, g.pair.pan_rad, g.pair.second_tilt_rad);
+  camera.grab(g.first, 0, first_frame());
+  camera.grab(g.second, 1, second_frame());
+  return g;
+}
+
 struct Timing {
   double total_us = 0.0;
   int frames = 0;
@@ -346,13 +363,9 @@ TEST(TargetOnSimFrames, APairLocatesTheTargetWithinTenCentimetresUpToThreeAndAHa
     SimCamera camera(shipped(k), 3);
     const View view =
         facing_target(camera.world(), c.distance_m, c.angle_deg * kDegree, 0.05F, 0.5F * phi);
-    const stereo::PairPose pair{view.pan_rad, view.tilt_rad, view.tilt_rad - phi};
-    const RigidTransform first =
-        camera.sim().camera_pose(view.robot, pair.pan_rad, pair.first_tilt_rad);
-    const RigidTransform second =
-        camera.sim().camera_pose(view.robot, pair.pan_rad, pair.second_tilt_rad);
-    camera.grab(first, 0, first_frame());
-    camera.grab(second, 1, second_frame());
+    const GrabbedPair grabbed = grab_pair(camera, view);
+    const stereo::PairPose& pair = grabbed.pair;
+    const RigidTransform& first = grabbed.first;
     stereo::TargetFix fix;
     CHECK_NO_ALLOCATION(fix = processor.locate_target(first_frame(), second_frame(), pair));
     const Eigen::Vector3f truth = camera.world().target_point_m;
@@ -393,11 +406,7 @@ TEST(TargetOnSimFrames, TheRangeFromTheTrianglesEdgesIsCloserThanTheVertexAlone)
       SimCamera camera(shipped(k), 21 + static_cast<std::uint32_t>(cases));
       const View view =
           facing_target(camera.world(), distance, angle_deg * kDegree, 0.05F, 0.5F * phi);
-      const stereo::PairPose pair{view.pan_rad, view.tilt_rad, view.tilt_rad - phi};
-      camera.grab(camera.sim().camera_pose(view.robot, pair.pan_rad, pair.first_tilt_rad), 0,
-                  first_frame());
-      camera.grab(camera.sim().camera_pose(view.robot, pair.pan_rad, pair.second_tilt_rad), 1,
-                  second_frame());
+      const stereo::PairPose pair = grab_pair(camera, view).pair;
       const stereo::TargetFix a = plain.locate_target(first_frame(), second_frame(), pair);
       stereo::TargetFix b;
       CHECK_NO_ALLOCATION(b = edges.locate_target(first_frame(), second_frame(), pair));
@@ -510,13 +519,10 @@ TEST(TargetOnSimFrames, TheVertexIsNotPulledByTheImagesVignetting) {
         SimCamera camera(shipped(k), 40 + static_cast<std::uint32_t>(views));
         const View view =
             facing_target(camera.world(), distance, angle_deg * kDegree, 0.05F, extra_tilt);
-        const stereo::PairPose pair{view.pan_rad, view.tilt_rad, view.tilt_rad - phi};
-        const RigidTransform first =
-            camera.sim().camera_pose(view.robot, pair.pan_rad, pair.first_tilt_rad);
-        const RigidTransform second =
-            camera.sim().camera_pose(view.robot, pair.pan_rad, pair.second_tilt_rad);
-        camera.grab(first, 0, first_frame());
-        camera.grab(second, 1, second_frame());
+        const GrabbedPair grabbed = grab_pair(camera, view);
+        const stereo::PairPose& pair = grabbed.pair;
+        const RigidTransform& first = grabbed.first;
+        const RigidTransform& second = grabbed.second;
         const Eigen::Vector3f truth = camera.world().target_point_m;
         Eigen::Vector2f truth_first;
         Eigen::Vector2f truth_second;

@@ -324,6 +324,12 @@ bool target_in_image(const hal::sim::RigidTransform& first, const hal::sim::Rigi
   return true;
 }
 
+// How many of the errors [m] are at most 0.1 m (the bar for a target fix).
+std::int64_t within_0_1m(const std::vector<double>& errors_m) {
+  return static_cast<std::int64_t>(
+      std::count_if(errors_m.begin(), errors_m.end(), [](double e) { return e <= 0.1; }));
+}
+
 struct WorldStats {
   std::vector<double> readings, floor_obstacles, floor_free, weak_share;
   std::vector<double> range_error_m, range_error_rel;  // |r − r_true| [m] and / δr (Eq 3.7)
@@ -357,6 +363,9 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     return 1;
   }
   const hal::PanTiltLimits lim = settings.physics.ptu.limits;
+  // As Mission::blocked_output: blocked walks are kept only if the Think stage uses them.
+  core::FixedVectorBase<evidence::Reading>* const blocked =
+      params.model.close_blocked_rays ? &g_floor_blocked : nullptr;
   const std::vector<firmware::mission::LookView> views = look_views(params, lim);
   const stereo::CameraIntrinsics& cam = rig.camera();
   const std::size_t stride = std::size_t{2} * cam.width_px;
@@ -475,10 +484,13 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
           last_sighting = here;
           last_sighting_pose = first_pose;
         }
+        // PTU frame → world, as Mission::add_target_fix.
+        const auto in_world = [&](const Eigen::Vector3f& ptu) {
+          const core::Point2 w = core::to_world(pose, {ptu.x(), ptu.y()});
+          return Eigen::Vector3f(w.x_m, w.y_m, ptu.z() + params.rig.ptu_height_m);
+        };
         if (across.found) {
-          const core::Point2 w =
-              core::to_world(pose, {across.point_ptu_m.x(), across.point_ptu_m.y()});
-          const Eigen::Vector3f p(w.x_m, w.y_m, across.point_ptu_m.z() + params.rig.ptu_height_m);
+          const Eigen::Vector3f p = in_world(across.point_ptu_m);
           tracker.add(p, across.confidence, view_number, across.range_error_m);
           const double e = (p - g_world.target_point_m).norm();
           if (across_in_view) {
@@ -488,8 +500,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
           }
         }
         if (fix.found) {
-          const core::Point2 w = core::to_world(pose, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
-          const Eigen::Vector3f p(w.x_m, w.y_m, fix.point_ptu_m.z() + params.rig.ptu_height_m);
+          const Eigen::Vector3f p = in_world(fix.point_ptu_m);
           const double e = (p - g_world.target_point_m).norm();
           tracker.add(p, fix.confidence, view_number, fix.range_error_m);
           if (in_view) {
@@ -509,11 +520,11 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       t0 = cpu_ns();
       (void)floor_cue.learn(g_first, pp.pan_rad, pp.first_tilt_rad);
       (void)floor_cue.process(g_first, pp.pan_rad, pp.first_tilt_rad, g_floor_obstacles,
-                              g_floor_free, &g_floor_free_near, &g_floor_blocked);
+                              g_floor_free, &g_floor_free_near, blocked);
       if (view.pair && pp.second_tilt_rad < -0.3F) {
         (void)floor_cue.learn(g_second, pp.pan_rad, pp.second_tilt_rad);
         (void)floor_cue.process(g_second, pp.pan_rad, pp.second_tilt_rad, g_floor_obstacles,
-                                g_floor_free, &g_floor_free_near, &g_floor_blocked);
+                                g_floor_free, &g_floor_free_near, blocked);
       }
       floor_ns += static_cast<double>(cpu_ns() - t0);
     }
@@ -608,16 +619,11 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .num("target_rate", st.target_views > 0 ? static_cast<double>(st.target_found) /
                                                     static_cast<double>(st.target_views)
                                               : std::numeric_limits<double>::quiet_NaN())
-      .integer("target_found_within_0_1m", static_cast<std::int64_t>(std::count_if(
-                                               st.target_error_m.begin(), st.target_error_m.end(),
-                                               [](double e) { return e <= 0.1; })))
+      .integer("target_found_within_0_1m", within_0_1m(st.target_error_m))
       .num("target_err_median_m", percentile(st.target_error_m, 0.5))
       .num("target_err_max_m", percentile(st.target_error_m, 1.0))
       .integer("target_across", static_cast<std::int64_t>(st.target_across_error_m.size()))
-      .integer("target_across_within_0_1m",
-               static_cast<std::int64_t>(std::count_if(st.target_across_error_m.begin(),
-                                                       st.target_across_error_m.end(),
-                                                       [](double e) { return e <= 0.1; })))
+      .integer("target_across_within_0_1m", within_0_1m(st.target_across_error_m))
       .num("target_across_err_median_m", percentile(st.target_across_error_m, 0.5))
       .num("target_across_err_max_m", percentile(st.target_across_error_m, 1.0))
       .integer("target_far", static_cast<std::int64_t>(st.target_far))
@@ -626,10 +632,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .integer("looks_target_in_view", static_cast<std::int64_t>(st.pose_target_views))
       .integer("looks_target_found", static_cast<std::int64_t>(st.pose_target_found))
       .integer("looks_target_confirmed", static_cast<std::int64_t>(st.pose_target_confirmed))
-      .integer("looks_target_within_0_1m",
-               static_cast<std::int64_t>(std::count_if(st.pose_target_error_m.begin(),
-                                                       st.pose_target_error_m.end(),
-                                                       [](double e) { return e <= 0.1; })))
+      .integer("looks_target_within_0_1m", within_0_1m(st.pose_target_error_m))
       .num("looks_target_err_median_m", percentile(st.pose_target_error_m, 0.5))
       .num("looks_target_err_max_m", percentile(st.pose_target_error_m, 1.0))
       .num("render_ms", mean(st.render_ms))

@@ -157,6 +157,10 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   }
   // Reference green: mean chroma and luma of the blob's interior (pixels whose 4 neighbours
   // are in it); a blob too thin for an interior uses its greenest pixel.
+  const auto inner = [&](std::size_t i) {
+    return labels_[i - 1] == label && labels_[i + 1] == label && labels_[i - w] == label &&
+           labels_[i + w] == label;
+  };
   double sum_cb = 0.0, sum_cr = 0.0, sum_y = 0.0;
   int interior = 0;
   std::size_t greenest = frame.index(u_min, v_min);
@@ -169,8 +173,7 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
       if (labels_[greenest] != label || frame.chroma_v[i] < frame.chroma_v[greenest]) {
         greenest = i;
       }
-      if (labels_[i - 1] == label && labels_[i + 1] == label && labels_[i - w] == label &&
-          labels_[i + w] == label) {
+      if (inner(i)) {
         sum_cb += int{frame.chroma_u[i]} - 128;
         sum_cr += int{frame.chroma_v[i]} - 128;
         sum_y += static_cast<double>(frame.luma[i]);
@@ -287,9 +290,7 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   for (std::uint32_t v = v_min; v <= v_max; ++v) {
     for (std::uint32_t u = u_min; u <= u_max; ++u) {
       const std::size_t i = frame.index(u, v);
-      const bool inner = labels_[i - 1] == label && labels_[i + 1] == label &&
-                         labels_[i - w] == label && labels_[i + w] == label;
-      if (labels_[i] != label || (thin ? i != greenest : !inner)) {
+      if (labels_[i] != label || (thin ? i != greenest : !inner(i))) {
         continue;
       }
       const double local = paper_at(u, v);

@@ -157,6 +157,11 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // One part of the grabbed view's processing: 0 stereo, 1 target, 2 and 3 the floor cue on
   // the first and second frame. True when the view is done.
   bool process_view(std::uint8_t part);
+  // Where the floor cue reports walks blocked at their bottom row: nowhere unless the
+  // Think stage closes their rays (LocalModelParams::close_blocked_rays).
+  core::FixedVectorBase<evidence::Reading>* blocked_output() {
+    return params_.model.close_blocked_rays ? &floor_blocked_ : nullptr;
+  }
   // A fix (found or not) into the tracker, in the world frame of this look's pose.
   void add_target_fix(const stereo::TargetFix& fix, std::uint32_t view);
   void begin_think();

@@ -91,7 +91,7 @@ struct LocalModelStats {
   std::size_t guard_points = 0;
   std::size_t guard_dropped = 0;   // unexplained readings that found the candidate list full
   bool guard_points_full = false;  // corroborated points were dropped (the list was full)
-  std::size_t blocked_rays = 0;    // vertex rays cut to the robot's disc by floor_blocked
+  std::size_t blocked_rays = 0;    // vertex rays closed by floor_blocked (close_blocked_rays)
   std::size_t units = 0;
   bool model_valid = false;  // the fit was invertible (monotone in r)
 };
@@ -101,10 +101,8 @@ struct LocalModelStats {
 // points (m = 0: the line of sight to them is free), and optionally, in step with those, the
 // horizontal distance [m] at which each floor walk began (FloorCue::process); without them
 // every walk counts as joined to the robot. `floor_blocked` (FloorCue::process's `blocked`):
-// the bottom-row floor points of walks whose bottom row showed no floor; one within
-// seen_floor_start_m, with no walk in its direction starting nearer, leaves the free
-// polygon only the robot's own disc in its direction (something stands in the ring round
-// the robot that no view sees). The spans must stay valid until done().
+// the bottom-row floor points of walks whose bottom row showed no floor, used only with
+// close_blocked_rays (see there). The spans must stay valid until done().
 // step() does one bounded unit of work; nothing allocates. Make the object static (MBs).
 class LocalModelBuilder {
  public:
