@@ -145,6 +145,7 @@ void Mission::start(std::uint64_t now_us) {
   trail_.clear();
   path_.clear();
   breadcrumbs_.clear();
+  has_prior_look_ = false;  // a resumed mission's first look has none
   retreating_ = false;
   snapshot_pending_ = false;
   snapshot_writing_ = false;
@@ -737,8 +738,16 @@ void Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {
 void Mission::begin_think() {
   think_started_ = true;
   (void)evidence::filter_readings(features_, params_.limits);
+  // The last look's free polygon, from where it stood as seen from here: what it saw free
+  // keeps rays whose walks this look finds blocked open that far.
+  mapping::PriorLook prior;
+  if (has_prior_look_) {
+    prior.free = &prior_look_free_;
+    prior.pose = prior_look_pose_;
+    prior.here = look_pose_;
+  }
   builder_.start(params_.model, features_.span(), floor_obstacles_.span(), floor_free_.span(),
-                 floor_free_near_.span(), floor_blocked_.span());
+                 floor_free_near_.span(), floor_blocked_.span(), prior);
 }
 
 void Mission::after_think() {
@@ -757,6 +766,9 @@ void Mission::after_think() {
   (void)map_.mark_explored(look_pose_, builder_.seen_free(), radius, params_.points);
   (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
                    params_.points);
+  prior_look_free_ = local.free;
+  prior_look_pose_ = look_pose_;
+  has_prior_look_ = true;
   // A sighting no second view has confirmed yet: look at it again from the stand-off (the
   // detector may miss it near the image's edge), unless the robot already looked from there.
   if (!tracker_.confirmed() && tracker_.sightings() > 0) {

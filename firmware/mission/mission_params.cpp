@@ -90,12 +90,7 @@ MissionParams make_mission_params(const BoardConfig& c) {
   // walks out of it. docs/benchmarks.md.
   m.features_show_free = true;
 
-  // Walks blocked at the lowest view's bottom row do not close their rays in the mission:
-  // that took the look bench's cluttered room from 0.9982 to 0.9990 safe (the navigable
-  // polygon is 1.000 safe either way), but beside walls nearer than the bottom row the robot
-  // lost its way through two_rooms_doorway's doorway (52-57 cycles instead of 15 at seed 1,
-  // not found in the test's 45). docs/benchmarks.md.
-  m.close_blocked_rays = false;
+  m.close_blocked_rays = true;
 
   // Floor walks that start within the lowest view's bottom row (its farthest point, at the
   // row's corners) are joined to the robot: the floor nearer than that is never in view.

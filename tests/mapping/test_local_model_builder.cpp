@@ -623,9 +623,9 @@ TEST(LocalModelBuilder, AWalkBlockedAtTheLowestViewsBottomRowLeavesTheRobotOnlyI
 
 // A blocked walk whose ray, or one of the two either side, holds evidence of an obstacle
 // before the blocked row (here a lone feature, too few to move the fit or to be corroborated
-// as a guard point): that is what blocks it, and the ray is cut in front of it, not at the
-// robot's disc.
-TEST(LocalModelBuilder, ABlockedWalkWithEvidenceBeforeItsRowIsCutInFrontOfTheEvidence) {
+// as a guard point): that is what blocks it, and the ray is cut at it, not at the robot's
+// disc.
+TEST(LocalModelBuilder, ABlockedWalkWithEvidenceBeforeItsRowIsCutAtTheEvidence) {
   WalkedLook& w = walked_look();
   Look& look = w.look;
   FixedVector<Reading, 1024> blocked;
@@ -647,9 +647,75 @@ TEST(LocalModelBuilder, ABlockedWalkWithEvidenceBeforeItsRowIsCutInFrontOfTheEvi
   CHECK_NO_ALLOCATION(g_other.run());
   const mapping::StarPolygon& free = g_other.map().free;
   for (const float d : {58.0F, 60.0F, 62.0F}) {
-    DOUBLES_EQUAL(0.55F - params.base_margin_m, free.radius_at_m(deg(d)), 0.01);
+    DOUBLES_EQUAL(0.55F, free.radius_at_m(deg(d)), 0.01);
   }
   for (const float d : {40.0F, 56.0F, 64.0F, 80.0F}) {
     CHECK(free.radius_at_m(deg(d)) < own + 0.05F);
   }
+}
+
+// Without evidence, a blocked ray keeps what an earlier look saw free of it (the prior: the
+// obstacle stands still, so it stands beyond), up to the blocked row: here the earlier look
+// stood 0.2 m behind this one, both at heading 0.5 rad, and its free polygon is a disc of
+// 0.7 m. Without the prior the rays keep only the robot's disc; the rays stay without map
+// points either way.
+TEST(LocalModelBuilder, ABlockedRayKeepsWhatAnEarlierLookSawFreeOfIt) {
+  WalkedLook& w = walked_look();
+  Look& look = w.look;
+  FixedVector<Reading, 1024> blocked;
+  add_featured_wall(look);
+  constexpr float kRow_m = 0.6F;
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    if (d >= 30 && d < 150) {
+      (void)blocked.push_back(at(alpha, kRow_m, 0.0F, 0.5F));
+    } else {
+      (void)w.free.push_back(at(alpha, kWall_m - 0.03F, 0.0F, 0.0F));
+      (void)w.near_m.push_back(0.35F);
+    }
+  }
+  static mapping::StarPolygon prior_free(mapping::kDefaultPolygonVertices);
+  prior_free.fill(0.7F);
+  mapping::PriorLook prior;
+  prior.free = &prior_free;
+  prior.here = {2.0F, 1.0F, 0.5F};
+  prior.pose = {2.0F - 0.2F * std::cos(0.5F), 1.0F - 0.2F * std::sin(0.5F), 0.5F};
+  // Where the ray at α leaves the prior's disc: its centre is 0.2 m behind, at (-0.2, 0).
+  auto leaves_m = [](float alpha) {
+    const float b = 0.2F * std::cos(alpha);
+    return -b + std::sqrt(b * b - 0.04F + 0.49F);
+  };
+  mapping::LocalModelParams params = blocked_walk_params();
+  const float own = kRobotRadius_m + kMargin_m;
+  g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(), w.near_m.span(),
+                blocked.span(), prior);
+  CHECK_NO_ALLOCATION(g_other.run());
+  const mapping::StarPolygon& free = g_other.map().free;
+  for (const float d : {35.0F, 50.0F, 60.0F}) {
+    const float expected = leaves_m(deg(d));
+    CHECK(expected < kRow_m);
+    DOUBLES_EQUAL(expected - 0.01F, free.radius_at_m(deg(d)), 0.012);
+  }
+  for (const float d : {100.0F, 145.0F}) {  // the disc reaches past the blocked row
+    CHECK(leaves_m(deg(d)) > kRow_m);
+    DOUBLES_EQUAL(kRow_m - 0.01F, free.radius_at_m(deg(d)), 0.012);
+  }
+  CHECK(g_other.stats().blocked_by_prior >= 110U);
+  FixedVector<Point2, 2048> obstacles;
+  FixedVector<Point2, 2048> exploration;
+  CHECK(g_other.map_points(mapping::MapPointParams{}, obstacles, exploration));
+  for (const FixedVector<Point2, 2048>* list : {&obstacles, &exploration}) {
+    for (const Point2& p : *list) {
+      float a = std::atan2(p.y_m, p.x_m) * 57.29578F;
+      if (a < 0.0F) a += 360.0F;
+      CHECK_TEXT(!(a > 31.0F && a < 149.0F), "a map point on a blocked ray");
+    }
+  }
+  g_other.start(params, look.features.span(), look.obstacles.span(), w.free.span(), w.near_m.span(),
+                blocked.span());
+  g_other.run();
+  for (const float d : {35.0F, 70.0F, 145.0F}) {
+    CHECK(g_other.map().free.radius_at_m(deg(d)) < own + 0.05F);
+  }
+  CHECK_EQUAL(0U, g_other.stats().blocked_by_prior);
 }

@@ -37,6 +37,23 @@ constexpr float kBlockedTolerance_m = 0.02F;
 constexpr float kBlockedEvidenceSlack_m = 0.1F;
 // ... and on the vertex rays this many either side of a blocked one.
 constexpr std::size_t kBlockedEvidenceRays = 2;
+// A blocked ray is followed through the prior look's free polygon in steps this long [m].
+constexpr float kPriorStep_m = 0.02F;
+
+// How far along direction θ (robot frame) from `from_m` to `to_m` the prior look's free
+// polygon (standing at `prior_pose` in the robot frame) holds every step: `from_m` if it
+// does not hold the first.
+float prior_free_reach_m(const StarPolygon& prior_free, const core::Pose2& prior_pose,
+                         float theta_rad, float from_m, float to_m) {
+  const float c = std::cos(theta_rad);
+  const float s = std::sin(theta_rad);
+  float reach = from_m;
+  for (float d = from_m; d <= to_m; d += kPriorStep_m) {
+    if (!prior_free.contains(core::to_robot(prior_pose, {d * c, d * s}))) break;
+    reach = d;
+  }
+  return reach;
+}
 
 }  // namespace
 
@@ -45,12 +62,14 @@ void LocalModelBuilder::start(const LocalModelParams& params,
                               std::span<const evidence::Reading> floor_obstacles,
                               std::span<const evidence::Reading> floor_free,
                               std::span<const float> floor_free_near_m,
-                              std::span<const evidence::Reading> floor_blocked) {
+                              std::span<const evidence::Reading> floor_blocked, PriorLook prior) {
   params_ = params;
   features_ = features;
   obstacles_ = floor_obstacles;
   free_ = floor_free;
   blocked_ = floor_blocked;
+  prior_free_ = prior.free;
+  prior_pose_ = core::compose(core::inverse(prior.here), prior.pose);
   // Out of step with the free readings: not used (every walk then counts as joined).
   free_near_ =
       floor_free_near_m.size() == floor_free.size() ? floor_free_near_m : std::span<const float>{};
@@ -302,7 +321,11 @@ void LocalModelBuilder::extract() {
   // vertex ray keeps only the robot's disc, unless a walk of another frame started on floor
   // nearer than the blocked row (its own base, above, then cuts where the obstacle is), or
   // evidence of an obstacle (a base, a guard point, a feature in the band) lies on the ray
-  // before the row: that is what blocks it, and the ray is cut in front of it.
+  // before the row: that is what blocks it, and the ray is cut at it (the robot-radius
+  // shrink keeps the clearance; cut 5 cm in front of it, the rays beside a doorway's jamb
+  // left the robot no way through). Without such evidence, an earlier look (the prior) that
+  // saw the ray's first stretch free keeps that stretch: the obstacle stands still, so it
+  // stands beyond.
   blocked_ray_.fill(false);
   if (params_.close_blocked_rays && !blocked_.empty()) {
     scratch_.set_vertex_count(p.vertex_count);
@@ -326,10 +349,16 @@ void LocalModelBuilder::extract() {
         e = std::min({e, evidence_.rho_m((k + d) % n), evidence_.rho_m((k + n - d) % n)});
       }
       if (e <= near + kBlockedEvidenceSlack_m) {
-        const float cut = std::max(e - params_.base_margin_m, own);
+        const float cut = std::max(e, own);  // the shrink keeps the robot's clearance
         obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), cut));
       } else {
-        obstacle_polygon_.set_rho_m(k, own);
+        float cut = own;
+        if (prior_free_ != nullptr) {
+          cut = prior_free_reach_m(*prior_free_, prior_pose_, obstacle_polygon_.angle_rad(k), own,
+                                   near);
+          stats_.blocked_by_prior += cut > own ? 1U : 0U;
+        }
+        obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), cut));
         blocked_ray_[k] = true;
       }
       ++stats_.blocked_rays;

@@ -261,6 +261,10 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
 
   // Think and plan.
   mapping::LocalModelBuilder builder_;
+  // The last look's free polygon and pose (mission frame), the next look's prior.
+  mapping::StarPolygon prior_look_free_{};
+  core::Pose2 prior_look_pose_{};
+  bool has_prior_look_ = false;
   mapping::GlobalMap map_;
   core::FixedVector<core::Point2, mapping::kMaxObstaclePoints> cycle_obstacles_;
   core::FixedVector<core::Point2, mapping::kMaxExplorationPoints> cycle_exploration_;

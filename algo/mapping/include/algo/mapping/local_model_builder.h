@@ -57,10 +57,10 @@ struct LocalModelParams {
   float seen_floor_start_m = 0.7F;
   float seen_floor_gap_m = 0.1F;
   // A walk blocked at the lowest view's bottom row (start()'s floor_blocked) closes its vertex
-  // ray: in front of evidence of an obstacle on it before the row (a base, a guard point, a
-  // band feature), else to the robot's own disc. Measured (docs/benchmarks.md): the look
-  // bench's cluttered room 0.9982 -> 0.9990 safe, but the mission lost its way through a
-  // doorway (off there). false: blocked walks are ignored.
+  // ray: at evidence of an obstacle on it before the row (a base, a guard point, a
+  // band feature), else where the ray leaves the free polygon of an earlier look (start()'s
+  // prior: that look saw the space before it free, and the obstacle stands still), else to
+  // the robot's own disc. false: blocked walks are ignored. docs/mapping.md.
   bool close_blocked_rays = true;
   // A stereo feature in the robot's height band (m ≥ m_safe) counts the band as seen free up
   // to 2 δr before it. Its line of sight is free, but not the floor under it: a box lower
@@ -83,15 +83,25 @@ struct LocalModelParams {
   std::size_t guard_candidates_per_unit = 256;  // guard candidates corroborated per unit
 };
 
+// An earlier look's free polygon (LocalMap::free, in that look's robot frame), where that
+// look stood and where this one stands (both in one frame, the mission's): what it showed
+// free, for the blocked walks (close_blocked_rays).
+struct PriorLook {
+  const StarPolygon* free = nullptr;  // none: no earlier look (the first, or after a resume)
+  core::Pose2 pose{};
+  core::Pose2 here{};
+};
+
 struct LocalModelStats {
   std::size_t samples = 0;
   std::size_t pieces = 0;
   double rms = 0.0;
   std::size_t guard_candidates = 0;
   std::size_t guard_points = 0;
-  std::size_t guard_dropped = 0;   // unexplained readings that found the candidate list full
-  bool guard_points_full = false;  // corroborated points were dropped (the list was full)
-  std::size_t blocked_rays = 0;    // vertex rays closed by floor_blocked (close_blocked_rays)
+  std::size_t guard_dropped = 0;     // unexplained readings that found the candidate list full
+  bool guard_points_full = false;    // corroborated points were dropped (the list was full)
+  std::size_t blocked_rays = 0;      // vertex rays closed by floor_blocked (close_blocked_rays)
+  std::size_t blocked_by_prior = 0;  // ... of which the prior look's free polygon kept open
   std::size_t units = 0;
   bool model_valid = false;  // the fit was invertible (monotone in r)
 };
@@ -102,7 +112,8 @@ struct LocalModelStats {
 // horizontal distance [m] at which each floor walk began (FloorCue::process); without them
 // every walk counts as joined to the robot. `floor_blocked` (FloorCue::process's `blocked`):
 // the bottom-row floor points of walks whose bottom row showed no floor, used only with
-// close_blocked_rays (see there). The spans must stay valid until done().
+// close_blocked_rays (see there), as is `prior`. The spans and the prior's polygon must stay
+// valid until done().
 // step() does one bounded unit of work; nothing allocates. Make the object static (MBs).
 class LocalModelBuilder {
  public:
@@ -114,7 +125,7 @@ class LocalModelBuilder {
              std::span<const evidence::Reading> floor_obstacles,
              std::span<const evidence::Reading> floor_free,
              std::span<const float> floor_free_near_m = {},
-             std::span<const evidence::Reading> floor_blocked = {});
+             std::span<const evidence::Reading> floor_blocked = {}, PriorLook prior = {});
   // One unit of work; true when the local map is ready.
   bool step();
   // Runs to the end (tests, benchmarks).
@@ -167,6 +178,8 @@ class LocalModelBuilder {
   std::span<const evidence::Reading> free_{};
   std::span<const float> free_near_{};
   std::span<const evidence::Reading> blocked_{};
+  const StarPolygon* prior_free_ = nullptr;
+  core::Pose2 prior_pose_{};  // the prior look's pose in this look's robot frame
   std::size_t cursor_ = 0;
   std::size_t guard_cursor_ = 0;  // next guard candidate to corroborate
   core::FixedVector<evidence::RaySample, kLookMaxSamples> ray_samples_;
