@@ -312,6 +312,41 @@ TEST(Planner, TheStepChooserTakesOneActionPerUnitAndEndsOnTheWholeDecision) {
   CHECK(chooser.decision().kind == planning::StepKind::kAtGoal);
 }
 
+// Room to move only in a wedge at 18-27° (a doorway askew to the frame): none of the eight
+// actions has a step there, sixteen headings have one at 22.5°.
+TEST(Planner, SixteenStepHeadingsFindAWayBetweenTheEightActions) {
+  TestWorld& w = world();
+  w.reset({0.0F, 0.0F, 0.0F});
+  w.add_room(4.0F);
+  constexpr float kWay_rad = 22.5F * 3.14159265F / 180.0F;
+  w.has_goal = true;
+  w.goal = {2.5F * std::cos(kWay_rad), 2.5F * std::sin(kWay_rad)};
+  w.value.start(w.vi_params, w.reward_params, w.sources(), {w.pose.x_m, w.pose.y_m});
+  while (!w.value.step(4096)) {
+  }
+  mapping::StarPolygon nav(360);
+  nav.fill(0.02F);
+  for (std::size_t k = 18; k <= 27; ++k) nav.set_rho_m(k, 1.0F);
+  planning::StepParams params = w.step_params;
+  CHECK(planning::choose_step(w.value, nav, w.pose, params).kind ==
+        planning::StepKind::kNoSafeAction);
+  params.step_headings = 16;
+  const planning::StepDecision d = planning::choose_step(w.value, nav, w.pose, params);
+  CHECK(d.kind == planning::StepKind::kMove);
+  DOUBLES_EQUAL(kWay_rad, d.heading_rad, 1e-5);
+  CHECK_EQUAL(1U, d.action);
+  DOUBLES_EQUAL(w.vi_params.step_m, d.distance_m, 1e-5);
+  // One heading per unit.
+  planning::StepChooser chooser;
+  chooser.start(w.value, nav, w.pose, params);
+  std::size_t units = 0;
+  while (!chooser.done()) {
+    ++units;
+    (void)chooser.step();
+  }
+  CHECK_EQUAL(16U, units);
+}
+
 TEST(Planner, SlicedValueIterationEqualsOneShot) {
   static planning::ValueIteration sliced;
   static planning::ValueIteration whole;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "algo/core/angles.h"
+
 namespace boticelli::planning {
 namespace {
 
@@ -55,12 +57,13 @@ void StepChooser::start(const ValueIteration& value, const mapping::StarPolygon&
   params_ = params;
   best_ = StepDecision{};
   best_q_ = -std::numeric_limits<float>::infinity();
+  headings_ = std::clamp(params.step_headings, kActionCount, kMaxStepHeadings);
   next_action_ = 0;
   const RewardSources& sources = value.sources();
   if (sources.has_goal && core::distance_m({pose.x_m, pose.y_m}, sources.goal) <=
                               value.rewards().goal_standoff_m + params.arrival_tolerance_m) {
     best_.kind = StepKind::kAtGoal;
-    next_action_ = kActionCount;
+    next_action_ = headings_;
   }
 }
 
@@ -72,7 +75,7 @@ bool StepChooser::step() {
   const RewardParams& rewards = value.rewards();
   const core::Point2 here{pose_.x_m, pose_.y_m};
   const float standoff = rewards.goal_standoff_m;
-  const float heading = action_heading_rad(a);
+  const float heading = static_cast<float>(a) * core::kTwoPi<float> / static_cast<float>(headings_);
   const float ux = std::cos(heading);
   const float uy = std::sin(heading);
   float step = cut_step_m(*navigable_, pose_, heading, value.params().step_m);
