@@ -812,15 +812,12 @@ void Mission::begin_plan() {
 bool Mission::start_step_choice() {
   const core::Pose2 here = odometry_pose();
   if (map_.exploration().size() == 0 && !tracker_.confirmed()) {
-    // The sector behind the robot that the PTU cannot pan to was never seen here: turn
-    // round and look once more before giving up.
-    const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
-    const float fov_rad = 2.0F * std::atan(0.5F * static_cast<float>(params_.rig.camera.width_px) /
-                                           params_.rig.camera.focal_px);
-    const bool blind = lim.pan_max_rad - lim.pan_min_rad + fov_rad < 2.0F * core::kPi<float>;
+    // Turn round and look once more before giving up: the sector behind the robot is seen
+    // only by the image's edges at the PTU's pan limits (or not at all, if the pans and the
+    // field of view leave a gap), and a fresh look refits the model.
     const bool turned_here =
         turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
-    if (!blind || turned_here) {
+    if (turned_here) {
       end_cycle("nothing left to explore");
       finish(Result::kNotFound, "nothing left to explore");
       return false;
