@@ -1,7 +1,10 @@
-// Tests of ALN evaluation: plain, alpha-beta, DTREE and fixed point agree, without allocating.
+// Tests of ALN evaluation: plain, alpha-beta, block, DTREE and fixed point agree, without
+// allocating.
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include <Eigen/Core>
 
@@ -87,6 +90,62 @@ TEST(AlnEval, AlphaBetaAndDtreeEqualPlainEvaluationOnManyRandomInputs) {
   }
   CHECK(total_ab < total_plain);
   CHECK(total_dt < total_ab);
+}
+
+namespace {
+// Checks every lane of evaluate_block() against evaluate() over blocks of 1..kBlock random
+// points: the lane's value, and its piece, which must give that value there and, unless
+// another piece gives it within the tolerance (a tie the two summations may break apart), be
+// plain evaluation's piece. Lanes beyond the block's count are not written.
+template <typename Model>
+void check_block_against_plain(Model& model, aln_test::Rng& rng, int blocks, double tol) {
+  using Scalar = typename Model::ScalarType;
+  constexpr std::size_t kB = Model::kBlock;
+  for (int b = 0; b < blocks; ++b) {
+    const std::size_t count = 1 + static_cast<std::size_t>(b) % kB;
+    std::array<typename Model::Vec, kB> x;
+    for (auto& xi : x) xi = aln_test::random_point<typename Model::Vec>(rng);
+    std::array<Scalar, kB> value;
+    std::array<std::uint16_t, kB> piece;
+    value.fill(Scalar(-99));
+    piece.fill(0xFFFF);
+    LONGS_EQUAL(count, model.evaluate_block(std::span<const typename Model::Vec>(x.data(), count),
+                                            value, piece));
+    for (std::size_t k = 0; k < kB; ++k) {
+      if (k >= count) {
+        CHECK(value[k] == Scalar(-99) && piece[k] == 0xFFFF);
+        continue;
+      }
+      const auto plain = model.evaluate(x[k]);
+      DOUBLES_EQUAL(plain.value, value[k], tol);
+      CHECK(piece[k] < model.piece_count());
+      DOUBLES_EQUAL(plain.value, model.piece(piece[k]).value(x[k]), tol);
+      const bool tie = piece[k] != plain.piece &&
+                       std::fabs(static_cast<double>(model.piece(plain.piece).value(x[k]) -
+                                                     model.piece(piece[k]).value(x[k]))) <= tol;
+      if (piece[k] != plain.piece && !tie) FAIL("block evaluation names another piece");
+    }
+  }
+}
+}  // namespace
+
+TEST(AlnEval, BlockEvaluationGivesEveryLaneThePlainValueAndItsPiece) {
+  aln_test::Rng rng(21);
+  for (const std::size_t pieces :
+       {std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{32}, std::size_t{100}}) {
+    aln_test::random_model(g_model, pieces, rng);
+    check_block_against_plain(g_model, rng, 2000, 1e-5);
+  }
+  aln::Aln<double, 1, 16> one;
+  aln_test::random_model(one, 16, rng);
+  check_block_against_plain(one, rng, 500, 1e-12);
+  aln::Aln<float, 4, 16> four;
+  aln_test::random_model(four, 16, rng);
+  check_block_against_plain(four, rng, 500, 1e-5);
+  // An empty block writes nothing.
+  std::array<float, Model3::kBlock> v{};
+  std::array<std::uint16_t, Model3::kBlock> p{};
+  LONGS_EQUAL(0, g_model.evaluate_block(std::span<const Model3::Vec>(), v, p));
 }
 
 TEST(AlnEval, AlphaBetaWithAHintGivesTheSameValueAndCutsMoreOnARay) {
@@ -189,12 +248,17 @@ TEST(AlnEval, EvaluationDoesNotAllocate) {
   CHECK(g_dtree.compile(g_model));
   CHECK(g_fixed.compile(g_model));
   float sum = 0.0F;
+  std::array<Model3::Vec, 3> xs;  // a block of three
+  std::array<float, Model3::kBlock> v{};
+  std::array<std::uint16_t, Model3::kBlock> p{};
   CHECK_NO_ALLOCATION({
     for (int k = 0; k < 1000; ++k) {
       const auto x = aln_test::random_point<Model3::Vec>(rng);
       sum += g_model.evaluate(x).value + g_model.evaluate_alpha_beta(x).value +
              g_dtree.evaluate(x).value;
       sum += static_cast<float>(g_fixed.evaluate({0, 65536, 32768}).value);
+      xs.fill(x);
+      sum += static_cast<float>(g_model.evaluate_block(xs, v, p)) * v[2];
     }
   });
   CHECK_NO_ALLOCATION(CHECK(g_dtree.compile(g_model)));

@@ -186,6 +186,25 @@ void bench_model(std::size_t cap) {
         return static_cast<std::size_t>(e.pieces_evaluated);
       },
       t_hint);
+  // Block evaluation (Aln::evaluate_block), kBlock queries per call: random queries and rays;
+  // ns per query.
+  const auto block_ns = [](const auto& queries) {
+    static constexpr std::size_t kB = Model::kBlock;
+    std::size_t unused = 0;
+    return ns_per_call(
+        [&queries](std::size_t k, double& sink) {
+          if (k % kB != 0) return std::size_t{0};
+          std::array<float, kB> v{};
+          std::array<std::uint16_t, kB> p{};
+          const std::size_t n = std::min(kB, kQueries - k);
+          g_model.evaluate_block(std::span<const Model::Vec>(&queries[k], n), v, p);
+          sink += static_cast<double>(v[0]);
+          return std::size_t{0};
+        },
+        unused);
+  };
+  const double block = block_ns(g_queries);
+  const double ray_block = block_ns(g_rays);
   const auto blocks = static_cast<std::int64_t>(g_dtree.block_count());
   const auto dtree_depth = static_cast<std::int64_t>(g_dtree.depth_used());
   // DTREE with up to 8 pieces per block: fewer thresholds per query.
@@ -211,6 +230,8 @@ void bench_model(std::size_t cap) {
       .num("ns_fixed", fx)
       .num("ns_alphabeta_rays", ray_ab)
       .num("ns_alphabeta_hint_rays", ray_hint)
+      .num("ns_block", block)
+      .num("ns_block_rays", ray_block)
       .num("touched_plain", per(t_plain))
       .num("touched_alphabeta", per(t_ab))
       .num("touched_dtree", per(t_dt))

@@ -45,7 +45,6 @@ using AlnSample = aln::Sample<float, 3>;
 
 // Large objects live outside the stack.
 Model g_model;
-Model g_best;
 Trainer g_trainer;
 mapping::AlnFreeRange<float, kMaxPieces> g_free_range;
 core::FixedVector<evidence::RaySample, kMaxRaySamples> g_ray_samples;
@@ -100,16 +99,8 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
   return samples;
 }
 
-double model_rms(const Model& m, const std::vector<AlnSample>& samples) {
-  double sse = 0.0;
-  for (const AlnSample& s : samples) {
-    const double r = static_cast<double>(m(s.x) - s.y);
-    sse += r * r;
-  }
-  return samples.empty() ? 0.0 : std::sqrt(sse / static_cast<double>(samples.size()));
-}
-
-// Trains and keeps the best model seen at the end of any split round (as suite thesis-table).
+// Trains g_model. The trainer returns the model with the least loss of all it evaluated
+// (TrainerStats::robust_loss; the squared error here), so nothing is kept on the side.
 void train(const std::vector<AlnSample>& samples) {
   aln::TrainerConfig cfg;
   const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
@@ -120,21 +111,7 @@ void train(const std::vector<AlnSample>& samples) {
   cfg.max_pieces = kMaxPieces;
   cfg.split = aln::SplitCandidates::kHinges;
   g_trainer.configure(cfg);
-  double best = std::numeric_limits<double>::infinity();
-  if (!g_trainer.start(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model)) {
-    return;
-  }
-  while (!g_trainer.done()) {
-    const std::size_t round = g_trainer.stats().iterations;
-    (void)g_trainer.step(samples.size());
-    if (g_trainer.stats().iterations != round || g_trainer.done()) {
-      const double rms = model_rms(g_model, samples);
-      if (rms < best) {
-        best = rms;
-        g_best = g_model;
-      }
-    }
-  }
+  (void)g_trainer.train(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model);
 }
 
 // Ground truth at a floor point: free at every slice height (inside the room, not in the
@@ -198,11 +175,20 @@ Quality quality(const SyntheticRoom& room, const mapping::ExtractionParams& p,
   return qy;
 }
 
+// Where our build time goes: the ray samples, the fit and the guard [ms], and the fit's size.
+struct BuildParts {
+  double samples_ms = 0.0;
+  double train_ms = 0.0;
+  double guard_ms = 0.0;
+  std::size_t samples = 0;
+  std::size_t passes = 0;
+};
+
 void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
           double build_ms, double extract_ms, double shrink_ms, const Quality& q,
-          std::size_t pieces, std::size_t guard_points) {
-  JsonLine(kSuite, spec.name)
-      .text("method", method)
+          std::size_t pieces, std::size_t guard_points, const BuildParts& parts = {}) {
+  JsonLine line(kSuite, spec.name);
+  line.text("method", method)
       .num("resolution_m", resolution_m)
       .integer("pieces", static_cast<std::int64_t>(pieces))
       .integer("guard_points", static_cast<std::int64_t>(guard_points))
@@ -212,8 +198,15 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
       .num("shrink_ms", shrink_ms)
       .num("safety", q.safety)
       .num("coverage", q.coverage)
-      .num("nav_safety", q.nav_safety)
-      .emit();
+      .num("nav_safety", q.nav_safety);
+  if (parts.samples > 0) {
+    line.num("samples_ms", parts.samples_ms)
+        .num("train_ms", parts.train_ms)
+        .num("guard_ms", parts.guard_ms)
+        .integer("samples", static_cast<std::int64_t>(parts.samples))
+        .integer("passes", static_cast<std::int64_t>(parts.passes));
+  }
+  line.emit();
 }
 
 // Thread CPU time [ns]: the host is shared, so wall time would measure the neighbours too.
@@ -289,22 +282,30 @@ int run() {
         room.generate_camera_readings(CameraScan{}, kFeatures, 7U);
 
     // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink.
+    BuildParts parts;
     std::int64_t t0 = cpu_ns();
     const std::vector<AlnSample> samples = build_samples(room, readings);
+    parts.samples_ms = ms_since(t0);
+    const std::int64_t t_train = cpu_ns();
     configure_model(g_model, room);
     train(samples);
+    parts.train_ms = ms_since(t_train);
+    parts.samples = samples.size();
+    parts.passes = g_trainer.stats().passes;
+    const std::int64_t t_guard = cpu_ns();
     // The feature guard: readings the fit calls free, kept where they cluster.
     g_candidates.clear();
     g_guard.clear();
     const auto occupancy = [](float a, float h, float r) {
-      return static_cast<float>(g_best(Model::Vec(a, h, r)));
+      return static_cast<float>(g_model(Model::Vec(a, h, r)));
     };
     (void)mapping::collect_unexplained_features(readings, occupancy, p,
                                                 mapping::FeatureGuardParams{}, g_candidates);
     (void)mapping::corroborated_points(g_candidates, mapping::FeatureGuardParams{}, g_guard);
+    parts.guard_ms = ms_since(t_guard);
     const double build_ms = ms_since(t0);
     const double extract_ms = median_ms(reps, [&] {
-      (void)g_free_range.set_model(g_best, p.safe_occupancy);
+      (void)g_free_range.set_model(g_model, p.safe_occupancy);
       mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
       do_not_optimize(g_map.navigable.rho_m(0));
     });
@@ -313,11 +314,12 @@ int run() {
                                       g_scratch);
       do_not_optimize(g_scratch.rho_m(0));
     });
-    const std::size_t bytes = g_best.piece_count() * sizeof(Model::PieceType) +
-                              g_best.node_count() * sizeof(Model::Node) +
+    const std::size_t bytes = g_model.piece_count() * sizeof(Model::PieceType) +
+                              g_model.node_count() * sizeof(Model::Node) +
                               g_guard.size() * sizeof(core::Point2);
     emit(*spec, "aln", 0.0, bytes, build_ms, extract_ms, shrink_ms,
-         quality(room, p, g_map.free, g_map.navigable), g_best.piece_count(), g_guard.size());
+         quality(room, p, g_map.free, g_map.navigable), g_model.piece_count(), g_guard.size(),
+         parts);
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
     for (const double res : {0.1, 0.05}) {

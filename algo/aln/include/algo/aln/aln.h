@@ -1,6 +1,7 @@
 // Adaptive Logic Network: a MIN/MAX tree over linear pieces, y = F(x), x in R^N (thesis Eq 4.26).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -274,8 +275,89 @@ class Aln {
 
   [[nodiscard]] Scalar operator()(const Vec& x) const { return evaluate_alpha_beta(x).value; }
 
+  // Block evaluation: kBlock inputs at once, every piece on every lane in fixed-size Eigen
+  // arrays (SSE on x86-64, NEON on aarch64 through the same code), children before parents
+  // with branch-free MIN/MAX per lane. Same values and pieces as evaluate() (ties to the first
+  // child; each piece's value summed in the order Piece::value sums it). For passes over
+  // many samples (training) and rays; a lone query is cheaper by evaluate_alpha_beta().
+  static constexpr std::size_t kBlock = 8;
+  using Lanes = Eigen::Array<Scalar, static_cast<int>(kBlock), 1>;
+  // Writes value[k] and piece[k] for k < count = min(x.size(), kBlock, value.size(),
+  // piece.size()); returns count.
+  std::size_t evaluate_block(std::span<const Vec> x, std::span<Scalar> value,
+                             std::span<std::uint16_t> piece) const {
+    const std::size_t count =
+        std::min(std::min(x.size(), kBlock), std::min(value.size(), piece.size()));
+    if (count == 0) return 0;
+    std::array<Lanes, static_cast<std::size_t>(N)> in;
+    for (int i = 0; i < N; ++i) {
+      for (std::size_t k = 0; k < kBlock; ++k) {
+        in[idx(i)](static_cast<Eigen::Index>(k)) = k < count ? x[k](i) : Scalar(0);
+      }
+    }
+    // A stack, as in evaluate(); piece indices are carried as Scalar (exact below 2^24) so
+    // the selects are one type.
+    std::array<Lanes, MaxPieces> val;
+    std::array<Lanes, MaxPieces> who;
+    std::size_t top = 0;
+    for (std::size_t k = 0; k < node_count_; ++k) {
+      const Op op = ops_[k];
+      if (op.kind == NodeKind::kPiece) {
+        const PieceType& p = pieces_[op.piece];
+        val[top] = p.bias + dot_lanes<0, N>(p.weight, in);
+        who[top] = Lanes::Constant(static_cast<Scalar>(op.piece));
+        ++top;
+        continue;
+      }
+      --top;
+      if (op.kind == NodeKind::kMax) {
+        take_second<true>(val[top - 1], who[top - 1], val[top], who[top]);
+      } else {
+        take_second<false>(val[top - 1], who[top - 1], val[top], who[top]);
+      }
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+      value[k] = val[0](static_cast<Eigen::Index>(k));
+      piece[k] = static_cast<std::uint16_t>(who[0](static_cast<Eigen::Index>(k)));
+    }
+    return count;
+  }
+
  private:
   static std::size_t idx(int i) { return static_cast<std::size_t>(i); }
+
+  // first = MAX (or MIN) of first and second per lane, who following; ties (and NaN) keep
+  // first, as evaluate(). Eigen's packet compare and bitwise select (SSE, NEON; a scalar
+  // fallback where Eigen does not vectorise), so no lane branches.
+  template <bool kMaxNode>
+  static void take_second(Lanes& first, Lanes& who_first, const Lanes& second,
+                          const Lanes& who_second) {
+    namespace ei = Eigen::internal;
+    using Packet = typename ei::packet_traits<Scalar>::type;
+    constexpr auto kStep = static_cast<std::size_t>(ei::packet_traits<Scalar>::size);
+    static_assert(kBlock % kStep == 0, "whole packets per block");
+    for (std::size_t k = 0; k < kBlock; k += kStep) {
+      const Packet f = ei::ploadu<Packet>(first.data() + k);
+      const Packet s = ei::ploadu<Packet>(second.data() + k);
+      const Packet take = kMaxNode ? ei::pcmp_lt(f, s) : ei::pcmp_lt(s, f);
+      ei::pstoreu(first.data() + k, ei::pselect(take, s, f));
+      ei::pstoreu(who_first.data() + k, ei::pselect(take, ei::ploadu<Packet>(who_second.data() + k),
+                                                    ei::ploadu<Packet>(who_first.data() + k)));
+    }
+  }
+
+  // sum_i w_i x_i over inputs [Start, Start + Len) on every lane, halves summed as Eigen's
+  // fixed-size dot product sums them (w_0 x_0 + (w_1 x_1 + w_2 x_2) for N = 3), so a lane's
+  // value is bit-identical to Piece::value where the compiler contracts neither into FMAs.
+  template <int Start, int Len>
+  static auto dot_lanes(const Vec& w, const std::array<Lanes, static_cast<std::size_t>(N)>& in) {
+    if constexpr (Len == 1) {
+      return w(Start) * in[static_cast<std::size_t>(Start)];
+    } else {
+      constexpr int kHalf = Len / 2;
+      return dot_lanes<Start, kHalf>(w, in) + dot_lanes<Start + kHalf, Len - kHalf>(w, in);
+    }
+  }
 
   // Value of the subtree at node n, exact if it lies in (lo, hi), else some value on the
   // same side of the window (which the ancestors then ignore). Leaf children are

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include <Eigen/Core>
 
@@ -71,9 +72,9 @@ struct TrainerStats {
 };
 
 // Trains an Aln<Scalar, N, MaxPieces>. The method (ALN.md "better training"): every pass
-// assigns each sample to its responsible piece (alpha-beta evaluation) and accumulates that
-// piece's normal equations; then each piece is refitted exactly by box-constrained least
-// squares (its weight bounds, Eqs 4.27-4.28), a k-plane / Lloyd iteration. When the error
+// assigns each sample to its responsible piece (block evaluation, Aln::evaluate_block) and
+// accumulates that piece's normal equations; then each piece is refitted exactly by box-constrained
+// least squares (its weight bounds, Eqs 4.27-4.28), a k-plane / Lloyd iteration. When the error
 // stops falling, pieces whose error exceeds epsilon are split, pieces no sample uses are
 // pruned, and the next round starts. A split (TrainerConfig::split) is either a V at the
 // piece's centroid (two tilted copies, MAX if the residuals rise towards the rim of its
@@ -164,7 +165,7 @@ class Trainer {
     std::size_t budget = std::max<std::size_t>(max_sample_visits, 1);
     while (budget > 0 && !stats_.done) {
       const std::size_t end = std::min(samples_.size(), cursor_ + budget);
-      for (std::size_t k = cursor_; k < end; ++k) visit(samples_[k]);
+      visit_range(cursor_, end);
       budget -= end - cursor_;
       stats_.sample_visits += end - cursor_;
       cursor_ = end;
@@ -286,13 +287,28 @@ class Trainer {
     }
   }
 
-  void visit(const Sample<Scalar, N>& s) {
-    const EvalResult<Scalar> e = model_->evaluate_alpha_beta(s.x);
-    const PieceType& piece = model_->piece(e.piece);
-    Accumulator& a = (*current_)[e.piece];
-    const double r = static_cast<double>(s.y) - static_cast<double>(e.value);
+  // Samples [begin, end) of the pass: the model evaluated a block of samples at a time
+  // (Aln::evaluate_block), then each sample added to its responsible piece's sums.
+  void visit_range(std::size_t begin, std::size_t end) {
+    constexpr std::size_t kBlock = Model::kBlock;
+    std::array<Vec, kBlock> x;
+    std::array<Scalar, kBlock> value;
+    std::array<std::uint16_t, kBlock> piece;
+    for (std::size_t k = begin; k < end; k += kBlock) {
+      const std::size_t n = std::min(kBlock, end - k);
+      for (std::size_t i = 0; i < n; ++i) x[i] = samples_[k + i].x;
+      model_->evaluate_block(std::span<const Vec>(x.data(), n), value, piece);
+      for (std::size_t i = 0; i < n; ++i) visit(samples_[k + i], value[i], piece[i]);
+    }
+  }
+
+  // One sample, the model's value at it and its responsible piece.
+  void visit(const Sample<Scalar, N>& s, Scalar value, std::uint16_t responsible) {
+    const PieceType& piece = model_->piece(responsible);
+    Accumulator& a = (*current_)[responsible];
+    const double r = static_cast<double>(s.y) - static_cast<double>(value);
     const double w_plain = static_cast<double>(s.weight);
-    const double w = w_plain * robust_weight(r, scale_[e.piece]);
+    const double w = w_plain * robust_weight(r, scale_[responsible]);
     const VecD x = (s.x - piece.centroid).template cast<double>();
     const double y = static_cast<double>(s.y) - static_cast<double>(piece.centroid_output);
     a.count += 1;
