@@ -418,6 +418,30 @@ TEST(AlnTrain, AnUndoneSplitRoundDoesNotEndTheTraining) {
   CHECK(g_model3b.pieces_within_bounds());
 }
 
+TEST(AlnTrain, UndoneSplitRoundsCountAgainstTheRoundCapOnlyWhenConfiguredSo) {
+  // The same noisy room: rounds are undone on the way. Without counting them, training
+  // ends with max_iterations kept rounds, having begun as many more as it undid; counting
+  // them (the default), it ends after max_iterations rounds begun.
+  const std::size_t n = fill_room(3000, 0.3, 77);
+  set_room_ranges(g_model3);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.02;
+  cfg.max_iterations = 4;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  LONGS_EQUAL(cfg.max_iterations, g_trainer3.stats().rounds);
+  LONGS_EQUAL(cfg.max_iterations, g_trainer3.stats().iterations);
+  cfg.count_undone_rounds = false;
+  g_trainer3.configure(cfg);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const aln::TrainerStats& st = g_trainer3.stats();
+  CHECK(st.failed_rounds >= 1);
+  CHECK(st.failed_rounds <= cfg.max_failed_rounds);  // the undone rounds did not end it
+  CHECK(st.rms > cfg.epsilon);                       // nor epsilon
+  LONGS_EQUAL(cfg.max_iterations, st.iterations);
+  LONGS_EQUAL(st.iterations + st.failed_rounds, st.rounds);
+}
+
 TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   const std::size_t n = fill_room(3000, 0.02, 3);
   set_room_ranges(g_model3);

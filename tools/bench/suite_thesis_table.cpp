@@ -365,7 +365,8 @@ int run_thesis_table() {
         configure_model(g_model, room);
         aln::TrainerConfig cfg;
         cfg.epsilon = kEpsilon;
-        cfg.max_iterations = env_size("BOTICELLI_THESIS_ITERATIONS", 10);
+        cfg.max_iterations = env_size("BOTICELLI_THESIS_ITERATIONS", 10);  // rounds kept
+        cfg.count_undone_rounds = false;
         cfg.max_refit_passes = env_size("BOTICELLI_THESIS_PASSES", 8);
         cfg.max_pieces = kMaxPieces;
         cfg.split_rule = run.rule;
