@@ -101,7 +101,7 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
 
 // Trains g_model. The trainer returns the model with the least loss of all it evaluated
 // (TrainerStats::robust_loss; the squared error here), so nothing is kept on the side.
-void train(const std::vector<AlnSample>& samples) {
+aln::TrainerConfig trainer_config() {
   aln::TrainerConfig cfg;
   const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
   cfg.epsilon = eps != nullptr && *eps != '\0' ? std::atof(eps) : 0.15;
@@ -110,7 +110,11 @@ void train(const std::vector<AlnSample>& samples) {
       rounds != nullptr && *rounds != '\0' ? std::strtoul(rounds, nullptr, 10) : 10;
   cfg.max_pieces = kMaxPieces;
   cfg.split = aln::SplitCandidates::kHinges;
-  g_trainer.configure(cfg);
+  return cfg;
+}
+
+void train(const std::vector<AlnSample>& samples) {
+  g_trainer.configure(trainer_config());
   (void)g_trainer.train(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model);
 }
 
@@ -268,6 +272,44 @@ void octomap_polygon(const octomap::OcTree& tree, const SyntheticRoom& room,
 }
 #endif
 
+Model g_refit;  // the refit's models
+Model g_warm;
+
+// A refit of the same place (the robot's next look from where it stands): other readings of
+// the room (another seed), fitted from one piece and from the first fit (Trainer::start_from).
+// One line per room: the fit's CPU ms, passes, pieces and RMS, cold and warm.
+void refit(const RoomSpec& spec, const SyntheticRoom& room) {
+  const std::vector<evidence::Reading> readings =
+      room.generate_camera_readings(CameraScan{}, kFeatures, 8U);
+  const std::vector<AlnSample> samples = build_samples(room, readings);
+  const aln::SampleSet<float, 3> set(samples.data(), samples.size());
+  g_trainer.configure(trainer_config());
+  configure_model(g_refit, room);
+  std::int64_t t0 = cpu_ns();
+  (void)g_trainer.train(set, g_refit);
+  const double cold_ms = ms_since(t0);
+  const aln::TrainerStats cold = g_trainer.stats();
+  g_warm = g_model;
+  t0 = cpu_ns();
+  if (g_trainer.start_from(set, g_warm)) {
+    while (!g_trainer.step(samples.size())) {
+    }
+  }
+  const double warm_ms = ms_since(t0);
+  const aln::TrainerStats& warm = g_trainer.stats();
+  JsonLine(kSuite, spec.name)
+      .text("method", "aln-refit")
+      .num("cold_train_ms", cold_ms)
+      .integer("cold_passes", static_cast<std::int64_t>(cold.passes))
+      .integer("cold_pieces", static_cast<std::int64_t>(cold.pieces))
+      .num("cold_rms", cold.rms)
+      .num("warm_train_ms", warm_ms)
+      .integer("warm_passes", static_cast<std::int64_t>(warm.passes))
+      .integer("warm_pieces", static_cast<std::int64_t>(warm.pieces))
+      .num("warm_rms", warm.rms)
+      .emit();
+}
+
 int run() {
   const char* rooms[] = {"cylinder_centre", "cylinder_offcentre_outliers", "rectangle",
                          "corridor",        "cylinder_box_view1",          "rectangle_box_case1"};
@@ -320,6 +362,7 @@ int run() {
     emit(*spec, "aln", 0.0, bytes, build_ms, extract_ms, shrink_ms,
          quality(room, p, g_map.free, g_map.navigable), g_model.piece_count(), g_guard.size(),
          parts);
+    refit(*spec, room);
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
     for (const double res : {0.1, 0.05}) {

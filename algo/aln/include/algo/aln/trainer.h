@@ -126,15 +126,7 @@ class Trainer {
   // Resets `model` to one piece (keeping its ranges and weight bounds) and prepares to train
   // it on `samples`, which must stay valid and unchanged until done. False if empty.
   bool start(SampleSet<Scalar, N> samples, Model& model) {
-    samples_ = samples;
-    model_ = &model;
-    stats_ = TrainerStats{};
-    rng_ = config_.seed * 2654435761U + 0x9E3779B9U;
-    cap_ = config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
-    if (samples.empty()) {
-      stats_.done = true;
-      return false;
-    }
+    if (!begin(samples, model)) return false;
     PieceType first{};
     VecD w0 = VecD::Zero();
     Vec centre = Vec::Zero();
@@ -145,27 +137,32 @@ class Trainer {
     }
     first.set(w0.template cast<Scalar>(), centre, Scalar(0));
     model.reset(first);
-    scale_[0] = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < N; ++i) {
-      const Range<Scalar> r = model.input_range(i);
-      span_lo_[0](i) = static_cast<double>(r.lo);
-      span_hi_[0](i) = static_cast<double>(r.hi);
-    }
-    cursor_ = 0;
-    pass_in_round_ = 0;
-    best_objective_ = 0.0;
-    stall_ = 0;
-    split_limit_ = 0;
-    last_made_ = 0;
-    failed_rounds_ = 0;
-    unevaluated_ = false;
-    checking_ = false;
-    tried_.fill(0);
-    begin_pass();
-    stats_.pieces = 1;
-    return true;
+    return begin_first_pass();
   }
 
+  // A warm start: trains `model` as it is (its tree and pieces, e.g. the last fit of a
+  // nearby pose) on `samples` instead of from one piece. Weights outside their bounds are
+  // clamped into them first; the first round refits every piece from the samples, prunes
+  // those no sample uses and splits on. False if empty or if the model has more pieces than
+  // the cap (then it is left as it was).
+  bool start_from(SampleSet<Scalar, N> samples, Model& model) {
+    const std::size_t cap =
+        config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
+    if (model.piece_count() > cap) {
+      model_ = nullptr;
+      stats_ = TrainerStats{};
+      stats_.done = true;
+      return false;
+    }
+    if (!begin(samples, model)) return false;
+    for (std::size_t p = 0; p < model.piece_count(); ++p) {
+      PieceType& piece = model.piece(p);
+      VecD w = piece.weight.template cast<double>();
+      for (int i = 0; i < N; ++i) w(i) = std::clamp(w(i), lo(i), hi(i));
+      piece.set(w.template cast<Scalar>(), piece.centroid, piece.centroid_output);
+    }
+    return begin_first_pass();
+  }
   // Advances by about max_sample_visits samples (at least one). True when training is done.
   bool step(std::size_t max_sample_visits) {
     if (stats_.done || model_ == nullptr) return true;
@@ -193,6 +190,46 @@ class Trainer {
   [[nodiscard]] const TrainerStats& stats() const { return stats_; }
 
  private:
+  // What start() and start_from() share: the samples, the model, the stats and the cap.
+  bool begin(SampleSet<Scalar, N> samples, Model& model) {
+    samples_ = samples;
+    model_ = &model;
+    stats_ = TrainerStats{};
+    rng_ = config_.seed * 2654435761U + 0x9E3779B9U;
+    cap_ = config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
+    if (samples.empty()) {
+      stats_.done = true;
+      return false;
+    }
+    return true;
+  }
+
+  // Every piece of the model as training's starting point: no residual scale yet, its split
+  // bins over the whole input box; then the first pass.
+  bool begin_first_pass() {
+    for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+      scale_[p] = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < N; ++i) {
+        const Range<Scalar> r = model_->input_range(i);
+        span_lo_[p](i) = static_cast<double>(r.lo);
+        span_hi_[p](i) = static_cast<double>(r.hi);
+      }
+    }
+    cursor_ = 0;
+    pass_in_round_ = 0;
+    best_objective_ = 0.0;
+    stall_ = 0;
+    split_limit_ = 0;
+    last_made_ = 0;
+    failed_rounds_ = 0;
+    unevaluated_ = false;
+    checking_ = false;
+    tried_.fill(0);
+    begin_pass();
+    stats_.pieces = model_->piece_count();
+    return true;
+  }
+
   // Sums of one bin of one input's split candidates, in coordinates u = x - the bin's centre.
   struct HingeBin {
     double sw = 0.0;   // sum w
