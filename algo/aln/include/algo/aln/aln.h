@@ -283,7 +283,8 @@ class Aln {
   static constexpr std::size_t kBlock = 8;
   using Lanes = Eigen::Array<Scalar, static_cast<int>(kBlock), 1>;
   // Writes value[k] and piece[k] for k < count = min(x.size(), kBlock, value.size(),
-  // piece.size()); returns count.
+  // piece.size()); returns count. Its stack holds 2 x MaxPieces x kBlock Scalars (16 KB for
+  // 256 float pieces).
   std::size_t evaluate_block(std::span<const Vec> x, std::span<Scalar> value,
                              std::span<std::uint16_t> piece) const {
     const std::size_t count =

@@ -146,9 +146,7 @@ class Trainer {
   // those no sample uses and splits on. False if empty or if the model has more pieces than
   // the cap (then it is left as it was).
   bool start_from(SampleSet<Scalar, N> samples, Model& model) {
-    const std::size_t cap =
-        config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
-    if (model.piece_count() > cap) {
+    if (model.piece_count() > piece_cap()) {
       model_ = nullptr;
       stats_ = TrainerStats{};
       stats_.done = true;
@@ -190,13 +188,18 @@ class Trainer {
   [[nodiscard]] const TrainerStats& stats() const { return stats_; }
 
  private:
+  // The piece cap of the configuration: max_pieces, or the model's capacity.
+  std::size_t piece_cap() const {
+    return config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
+  }
+
   // What start() and start_from() share: the samples, the model, the stats and the cap.
   bool begin(SampleSet<Scalar, N> samples, Model& model) {
     samples_ = samples;
     model_ = &model;
     stats_ = TrainerStats{};
     rng_ = config_.seed * 2654435761U + 0x9E3779B9U;
-    cap_ = config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
+    cap_ = piece_cap();
     if (samples.empty()) {
       stats_.done = true;
       return false;
