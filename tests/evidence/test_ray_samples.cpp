@@ -36,6 +36,45 @@ TEST(RaySamples, DefaultReadingExpandsIntoFiveSamplesPlacedAsTheThesisSays) {
   DOUBLES_EQUAL(0.0, samples[4].occupancy, 1e-9);
 }
 
+TEST(RaySamples, LineOfSightSamplesAreFreeAndEvenlySpacedBetweenTheRobotAndTheRampsFoot) {
+  params.line_of_sight_samples = 3;
+  LONGS_EQUAL(8, plausibility_samples_per_reading(params));
+  LONGS_EQUAL(8, append_plausibility_samples(reading, params, samples));
+  LONGS_EQUAL(8, samples.size());
+  // The thesis's five come first, unchanged; the ramp's foot is at r − 4δr = 1.8 m, so the
+  // three lie at 0.45, 0.9 and 1.35 m on the ray of view, each with occupancy 0.
+  DOUBLES_EQUAL(3.3, samples[0].r_m, 1e-5);
+  DOUBLES_EQUAL(0.0, samples[4].r_m, 1e-9);
+  for (std::size_t j = 1; j <= 3; ++j) {
+    const RaySample& s = samples[4 + j];
+    DOUBLES_EQUAL(0.45 * static_cast<double>(j), s.r_m, 1e-5);
+    DOUBLES_EQUAL(0.2 * static_cast<double>(s.r_m), s.h_m, 1e-5);
+    DOUBLES_EQUAL(1.0, s.alpha_rad, 1e-9);
+    DOUBLES_EQUAL(0.0, s.occupancy, 1e-9);
+  }
+  // Belief samples carry them too, before the ramp mirrored behind the point.
+  samples.clear();
+  LONGS_EQUAL(belief_samples_per_reading(params), append_belief_samples(reading, params, samples));
+  LONGS_EQUAL(11, samples.size());
+  DOUBLES_EQUAL(1.35, samples[7].r_m, 1e-5);
+}
+
+TEST(RaySamples, WithoutLowerSamplesTheLineOfSightEndsAtTheNearPlateauSample) {
+  params.samples_per_reading = 3;
+  params.line_of_sight_samples = 1;
+  LONGS_EQUAL(4, append_plausibility_samples(reading, params, samples));
+  DOUBLES_EQUAL(1.35, samples[3].r_m, 1e-5);  // half of r − δr = 2.7 m
+  DOUBLES_EQUAL(0.0, samples[3].occupancy, 1e-9);
+}
+
+TEST(RaySamples, TheStereoSizedModelIsSharperThanTheThesisAndSeesThroughItsLineOfSight) {
+  const RaySampleParams stereo = stereo_ray_sample_params();
+  CHECK(stereo.delta_r_fraction < params.delta_r_fraction);
+  LONGS_EQUAL(stereo.samples_per_reading + 2, plausibility_samples_per_reading(stereo));
+  LONGS_EQUAL(7, append_plausibility_samples(reading, stereo, samples));
+  DOUBLES_EQUAL(3.0 * (1.0 + double{kStereoDeltaRFraction}), samples[0].r_m, 1e-5);
+}
+
 TEST(RaySamples, SamplesLieOnTheRayOfViewSoHeightScalesWithDistance) {
   (void)append_plausibility_samples(reading, params, samples);
   for (const RaySample& s : samples) {
@@ -87,12 +126,19 @@ TEST(RaySamples, AFullBufferTakesNoPartOfAReading) {
   LONGS_EQUAL(5, append_plausibility_samples(reading, params, small));
   LONGS_EQUAL(0, append_plausibility_samples(reading, params, small));
   LONGS_EQUAL(5, small.size());
+  core::FixedVector<RaySample, 6> six;
+  params.line_of_sight_samples = 2;  // 7 samples: none fit in 6
+  LONGS_EQUAL(0, append_plausibility_samples(reading, params, six));
+  CHECK(six.empty());
 }
 
 TEST(RaySamples, InvalidParametersOrRangesGiveNoSamples) {
   params.samples_per_reading = 2;
   LONGS_EQUAL(0, append_plausibility_samples(reading, params, samples));
   params.samples_per_reading = 5;
+  params.line_of_sight_samples = kMaxSamplesPerReading + 1;
+  LONGS_EQUAL(0, append_plausibility_samples(reading, params, samples));
+  params.line_of_sight_samples = 0;
   LONGS_EQUAL(0, append_plausibility_samples({0.0F, 0.0F, 0.0F, 0.9F}, params, samples));
   CHECK(samples.empty());
 }

@@ -25,10 +25,8 @@ core::FixedVector<evidence::RaySample, 40000> g_ray_samples;
 // The thesis table's samples of one room (suite thesis-table: 5 per reading, seam copies,
 // no pads) with the sensor model's δr = delta_r_fraction · r.
 std::vector<aln::Sample<float, 3>> room_samples(const SyntheticRoom& room, std::size_t features,
-                                                float delta_r_fraction) {
+                                                const evidence::RaySampleParams& params) {
   const std::vector<evidence::Reading> readings = room.generate_readings(features, 2000U);
-  evidence::RaySampleParams params;
-  params.delta_r_fraction = delta_r_fraction;
   g_ray_samples.clear();
   (void)evidence::append_ray_samples(readings, params, g_ray_samples);
   (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
@@ -39,6 +37,40 @@ std::vector<aln::Sample<float, 3>> room_samples(const SyntheticRoom& room, std::
     samples[i].y = s.occupancy;
   }
   return samples;
+}
+
+std::vector<aln::Sample<float, 3>> room_samples(const SyntheticRoom& room, std::size_t features,
+                                                float delta_r_fraction) {
+  evidence::RaySampleParams params;
+  params.delta_r_fraction = delta_r_fraction;
+  return room_samples(room, features, params);
+}
+
+// Trains g_model on the room's samples with the sensor model `rays` (its pan-slope bound too).
+void fit_room(const SyntheticRoom& room, const std::vector<aln::Sample<float, 3>>& samples,
+              const evidence::RaySampleParams& rays) {
+  evidence::configure_occupancy_model(
+      g_model, static_cast<float>(-room.sensor().z),
+      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
+      static_cast<float>(room.spec().max_range_m * 1.2),
+      evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
+  aln::TrainerConfig cfg;
+  cfg.split = aln::SplitCandidates::kHinges;
+  g_trainer.configure(cfg);
+  CHECK(g_trainer.train(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model));
+}
+
+// The range [m] at which the model's occupancy at (α, h) first reaches m (bisection: the
+// model grows with r); `far` if it never does.
+float crossing_m(const Model& model, float alpha, float h, float m, float far) {
+  if (model(Model::Vec(alpha, h, far)) < m) return far;
+  float lo = 0.0F;
+  float hi = far;
+  for (int i = 0; i < 40; ++i) {
+    const float mid = 0.5F * (lo + hi);
+    (model(Model::Vec(alpha, h, mid)) < m ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 double rms_of(const Model& model, const std::vector<aln::Sample<float, 3>>& samples) {
@@ -74,4 +106,28 @@ TEST(RoomFit, TheRectangleRoomWithASharperSensorModelIsFittedToEpsilon) {
   CHECK_TEXT(rms <= 0.15, std::to_string(rms).c_str());
   DOUBLES_EQUAL(g_trainer.stats().rms, rms, 1e-3);
   CHECK(g_model.piece_count() > 2);
+}
+
+TEST(RoomFit, TheStereoSizedSensorModelPutsTheSafeCrossingNearerTheWallThanTheThesissModel) {
+  // The cylindrical room of radius 2.5 m seen from its centre: at the PTU's height the
+  // occupancy should reach m_safe = 0.6 just before the wall. The thesis's δr = 0.1 r ramp
+  // reaches 0.6 at about 0.8 r even for an exact fit; δr = 0.05 r (the stereo's accuracy) at
+  // about 0.9 r. Mean crossing over 24 pan angles, at most a wall's range error beyond it.
+  const SyntheticRoom room(*find_environment("cylinder_centre"));
+  const float wall = 2.5F;
+  double crossing[2] = {0.0, 0.0};
+  const evidence::RaySampleParams settings[2] = {evidence::RaySampleParams{},
+                                                 evidence::stereo_ray_sample_params()};
+  for (int k = 0; k < 2; ++k) {
+    const std::vector<aln::Sample<float, 3>> samples = room_samples(room, 3000, settings[k]);
+    fit_room(room, samples, settings[k]);
+    for (int i = 0; i < 24; ++i) {
+      const float alpha = 2.0F * 3.14159265F * static_cast<float>(i) / 24.0F;
+      const float r = crossing_m(g_model, alpha, 0.0F, 0.6F, 5.0F);
+      CHECK(r <= wall * (1.0F + settings[k].delta_r_fraction));
+      crossing[k] += static_cast<double>(r) / 24.0;
+    }
+  }
+  CHECK_TEXT(crossing[0] < 0.85 * double{wall}, std::to_string(crossing[0]).c_str());
+  CHECK_TEXT(crossing[1] > 0.87 * double{wall}, std::to_string(crossing[1]).c_str());
 }

@@ -27,9 +27,11 @@ constexpr float kBandEdges[] = {0.3F, 1.0F, 2.0F, 3.0F, 4.6F};
 constexpr const char* kBandNames[] = {"0.3-1", "1-2", "2-3", "3-4.5"};
 constexpr int kBands = 4;
 
-// Errors |r − r_true| / δr(r_true) (Eq 3.7) per range band of the true range.
+// Errors |r − r_true| / δr(r_true) (Eq 3.7) and |r − r_true| / r_true per range band of the
+// true range: the second is what the ray samples' δr / r is sized from (docs/evidence.md).
 struct Accuracy {
   std::vector<float> normalized[kBands];
+  std::vector<float> relative[kBands];
   std::size_t readings = 0;
 
   void add(const boticelli::test::WallPair& pair, const RigModel& rig, const CameraPose& first,
@@ -46,6 +48,7 @@ struct Accuracy {
     for (int b = 0; b < kBands; ++b) {
       if (t >= kBandEdges[b] && t < kBandEdges[b + 1]) {
         normalized[b].push_back(std::fabs(point_ptu_m.norm() - truth) / dr);
+        relative[b].push_back(std::fabs(point_ptu_m.norm() - truth) / truth);
       }
     }
   }
@@ -62,6 +65,14 @@ struct Accuracy {
       line.num(key, median);
       std::snprintf(key, sizeof key, "outliers_pct_%s_m", kBandNames[b]);
       line.num(key, v.empty() ? -1.0 : 100.0 * outliers / static_cast<double>(v.size()));
+      std::vector<float>& rel = relative[b];
+      std::sort(rel.begin(), rel.end());
+      for (const int pct : {50, 90, 95}) {
+        std::snprintf(key, sizeof key, "p%d_err_over_r_%s_m", pct, kBandNames[b]);
+        line.num(key, rel.empty() ? -1.0
+                                  : static_cast<double>(
+                                        rel[rel.size() * static_cast<std::size_t>(pct) / 100]));
+      }
     }
   }
 };

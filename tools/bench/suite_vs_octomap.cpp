@@ -65,21 +65,38 @@ mapping::ExtractionParams extraction_params(const SyntheticRoom& room) {
   return p;
 }
 
-void configure_model(Model& model, const SyntheticRoom& room) {
+// The two sensor models side by side: "aln", sized from the stereo's measured accuracy with
+// the line of sight as evidence of free (evidence::stereo_ray_sample_params), and
+// "aln-thesis", the thesis's δr = 0.1 r with the robot centre's sample only (§3.7.3).
+struct SensorSetting {
+  const char* method;
+  evidence::RaySampleParams rays;
+};
+
+std::array<SensorSetting, 2> sensor_settings() {
+  evidence::RaySampleParams stereo = evidence::stereo_ray_sample_params();
+  // δr / r of the stereo-sized model; default kStereoDeltaRFraction.
+  const char* dr = std::getenv("BOTICELLI_VS_OCTOMAP_DELTA_R_FRACTION");
+  if (dr != nullptr && *dr != '\0') stereo.delta_r_fraction = static_cast<float>(std::atof(dr));
+  const char* los = std::getenv("BOTICELLI_VS_OCTOMAP_LINE_OF_SIGHT");  // samples, default 2
+  if (los != nullptr && *los != '\0') stereo.line_of_sight_samples = std::strtoul(los, nullptr, 10);
+  return {{{"aln", stereo}, {"aln-thesis", evidence::RaySampleParams{}}}};
+}
+
+void configure_model(Model& model, const SyntheticRoom& room,
+                     const evidence::RaySampleParams& rays) {
   evidence::configure_occupancy_model(
       model, static_cast<float>(-room.sensor().z),
       static_cast<float>(room.spec().wall_height_m - room.sensor().z),
-      static_cast<float>(room.spec().max_range_m * 1.2));
+      static_cast<float>(room.spec().max_range_m * 1.2),
+      evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
 }
 
 // Ray samples (Fig 4.2b), zero pads in featureless directions and seam copies (§4.9.1).
 std::vector<AlnSample> build_samples(const SyntheticRoom& room,
-                                     const std::vector<evidence::Reading>& readings) {
+                                     const std::vector<evidence::Reading>& readings,
+                                     const evidence::RaySampleParams& params) {
   g_ray_samples.clear();
-  evidence::RaySampleParams params;
-  // δr / r of the sensor model; default the thesis's 0.1 (§3.7.3).
-  const char* dr = std::getenv("BOTICELLI_VS_OCTOMAP_DELTA_R_FRACTION");
-  if (dr != nullptr && *dr != '\0') params.delta_r_fraction = static_cast<float>(std::atof(dr));
   (void)evidence::append_ray_samples(readings, params, g_ray_samples,
                                      evidence::OccupancyBound::kPlausibility);
   evidence::PadRegion region;
@@ -280,13 +297,13 @@ Model g_warm;
 // A refit of the same place (the robot's next look from where it stands): other readings of
 // the room (another seed), fitted from one piece and from the first fit (Trainer::start_from).
 // One line per room: the fit's CPU ms, passes, pieces and RMS, cold and warm.
-void refit(const RoomSpec& spec, const SyntheticRoom& room) {
+void refit(const RoomSpec& spec, const SyntheticRoom& room, const evidence::RaySampleParams& rays) {
   const std::vector<evidence::Reading> readings =
       room.generate_camera_readings(CameraScan{}, kFeatures, 8U);
-  const std::vector<AlnSample> samples = build_samples(room, readings);
+  const std::vector<AlnSample> samples = build_samples(room, readings, rays);
   const aln::SampleSet<float, 3> set(samples.data(), samples.size());
   g_trainer.configure(trainer_config());
-  configure_model(g_refit, room);
+  configure_model(g_refit, room, rays);
   std::int64_t t0 = cpu_ns();
   (void)g_trainer.train(set, g_refit);
   const double cold_ms = ms_since(t0);
@@ -325,46 +342,52 @@ int run() {
     const std::vector<evidence::Reading> readings =
         room.generate_camera_readings(CameraScan{}, kFeatures, 7U);
 
-    // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink.
-    BuildParts parts;
-    std::int64_t t0 = cpu_ns();
-    const std::vector<AlnSample> samples = build_samples(room, readings);
-    parts.samples_ms = ms_since(t0);
-    const std::int64_t t_train = cpu_ns();
-    configure_model(g_model, room);
-    train(samples);
-    parts.train_ms = ms_since(t_train);
-    parts.samples = samples.size();
-    parts.passes = g_trainer.stats().passes;
-    const std::int64_t t_guard = cpu_ns();
-    // The feature guard: readings the fit calls free, kept where they cluster.
-    g_candidates.clear();
-    g_guard.clear();
-    const auto occupancy = [](float a, float h, float r) {
-      return static_cast<float>(g_model(Model::Vec(a, h, r)));
-    };
-    (void)mapping::collect_unexplained_features(readings, occupancy, p,
-                                                mapping::FeatureGuardParams{}, g_candidates);
-    (void)mapping::corroborated_points(g_candidates, mapping::FeatureGuardParams{}, g_guard);
-    parts.guard_ms = ms_since(t_guard);
-    const double build_ms = ms_since(t0);
-    const double extract_ms = median_ms(reps, [&] {
-      (void)g_free_range.set_model(g_model, p.safe_occupancy);
-      mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
-      do_not_optimize(g_map.navigable.rho_m(0));
-    });
-    const double shrink_ms = median_ms(reps, [&] {
-      (void)mapping::shrink_by_radius(g_map.free, p.robot_radius_m + p.clearance_margin_m,
-                                      g_scratch);
-      do_not_optimize(g_scratch.rho_m(0));
-    });
-    const std::size_t bytes = g_model.piece_count() * sizeof(Model::PieceType) +
-                              g_model.node_count() * sizeof(Model::Node) +
-                              g_guard.size() * sizeof(core::Point2);
-    emit(*spec, "aln", 0.0, bytes, build_ms, extract_ms, shrink_ms,
-         quality(room, p, g_map.free, g_map.navigable), g_model.piece_count(), g_guard.size(),
-         parts);
-    refit(*spec, room);
+    // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink; with each
+    // sensor model, the refit (warm start) with the first.
+    std::int64_t t0 = 0;
+    const std::array<SensorSetting, 2> settings = sensor_settings();
+    for (const SensorSetting& setting : settings) {
+      BuildParts parts;
+      t0 = cpu_ns();
+      const std::vector<AlnSample> samples = build_samples(room, readings, setting.rays);
+      parts.samples_ms = ms_since(t0);
+      const std::int64_t t_train = cpu_ns();
+      configure_model(g_model, room, setting.rays);
+      train(samples);
+      parts.train_ms = ms_since(t_train);
+      parts.samples = samples.size();
+      parts.passes = g_trainer.stats().passes;
+      const std::int64_t t_guard = cpu_ns();
+      // The feature guard: readings the fit calls free, kept where they cluster.
+      g_candidates.clear();
+      g_guard.clear();
+      const auto occupancy = [](float a, float h, float r) {
+        return static_cast<float>(g_model(Model::Vec(a, h, r)));
+      };
+      mapping::FeatureGuardParams guard;
+      guard.delta_r_fraction = setting.rays.delta_r_fraction;  // the readings' range error
+      (void)mapping::collect_unexplained_features(readings, occupancy, p, guard, g_candidates);
+      (void)mapping::corroborated_points(g_candidates, guard, g_guard);
+      parts.guard_ms = ms_since(t_guard);
+      const double build_ms = ms_since(t0);
+      const double extract_ms = median_ms(reps, [&] {
+        (void)g_free_range.set_model(g_model, p.safe_occupancy);
+        mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
+        do_not_optimize(g_map.navigable.rho_m(0));
+      });
+      const double shrink_ms = median_ms(reps, [&] {
+        (void)mapping::shrink_by_radius(g_map.free, p.robot_radius_m + p.clearance_margin_m,
+                                        g_scratch);
+        do_not_optimize(g_scratch.rho_m(0));
+      });
+      const std::size_t bytes = g_model.piece_count() * sizeof(Model::PieceType) +
+                                g_model.node_count() * sizeof(Model::Node) +
+                                g_guard.size() * sizeof(core::Point2);
+      emit(*spec, setting.method, 0.0, bytes, build_ms, extract_ms, shrink_ms,
+           quality(room, p, g_map.free, g_map.navigable), g_model.piece_count(), g_guard.size(),
+           parts);
+      if (&setting == &settings.front()) refit(*spec, room, setting.rays);
+    }
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
     for (const double res : {0.1, 0.05}) {

@@ -12,7 +12,8 @@ namespace {
 
 bool valid(const RaySampleParams& params) {
   return params.samples_per_reading >= 3 && params.samples_per_reading <= kMaxSamplesPerReading &&
-         params.delta_r_fraction > 0.0F && params.ramp_length_delta_r > 0.0F;
+         params.line_of_sight_samples <= kMaxSamplesPerReading && params.delta_r_fraction > 0.0F &&
+         params.ramp_length_delta_r > 0.0F;
 }
 
 // A sample on the reading's ray of view at distance s [m] (height scales with s/r).
@@ -37,20 +38,30 @@ void put_plausibility(const Reading& reading, const RaySampleParams& params, Ray
     const float m = reading.m * (1.0F - jf / (kf + 1.0F));
     (void)out.push_back(on_ray(reading, s > 0.0F ? s : 0.0F, m));
   }
-  // The robot centre is empty (Fig 4.2b).
+  // The robot centre is empty (Fig 4.2b), and so is the line of sight up to the ramp's foot.
   (void)out.push_back({reading.alpha_rad, 0.0F, 0.0F, 0.0F});
+  const std::size_t n = params.line_of_sight_samples;
+  if (n > 0) {
+    // The ramp's zero (ray_samples.h); without lower samples, the near plateau sample.
+    const float reach = k == 0 ? 1.0F : 1.0F + params.ramp_length_delta_r * (kf + 1.0F) / kf;
+    const float foot = std::max(r - reach * dr, 0.0F);
+    const float nf = static_cast<float>(n);
+    for (std::size_t j = 1; j <= n; ++j) {
+      (void)out.push_back(on_ray(reading, foot * static_cast<float>(j) / (nf + 1.0F), 0.0F));
+    }
+  }
 }
 
 }  // namespace
 
 std::size_t append_plausibility_samples(const Reading& reading, const RaySampleParams& params,
                                         RaySampleBuffer& out) {
-  if (!valid(params) || !(reading.r_m > 0.0F) ||
-      out.capacity() - out.size() < params.samples_per_reading) {
+  const std::size_t n = plausibility_samples_per_reading(params);
+  if (!valid(params) || !(reading.r_m > 0.0F) || out.capacity() - out.size() < n) {
     return 0;
   }
   put_plausibility(reading, params, out);
-  return params.samples_per_reading;
+  return n;
 }
 
 std::size_t append_belief_samples(const Reading& reading, const RaySampleParams& params,

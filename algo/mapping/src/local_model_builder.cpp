@@ -80,8 +80,9 @@ void LocalModelBuilder::start(const LocalModelParams& params,
   guard_.clear();
   stats_ = LocalModelStats{};
   map_.can_move = false;
-  evidence::configure_occupancy_model(model_, params.model_lowest_h_m, params.model_highest_h_m,
-                                      params.model_max_range_m);
+  evidence::configure_occupancy_model(
+      model_, params.model_lowest_h_m, params.model_highest_h_m, params.model_max_range_m,
+      evidence::alpha_slope_bound_per_rad(params.rays.delta_r_fraction));
   phase_ = Phase::kSamples;
 }
 

@@ -20,18 +20,30 @@ inline constexpr float kMaxAlphaSlopePerRad = 1.0F;
 inline constexpr float kMaxHeightSlopePerM = 10.0F;
 inline constexpr float kMinRangeSlopePerM = 1e-4F;
 
+// The bound on |∂F/∂α| [1/rad] for ray samples with δr / r = delta_r_fraction: the thesis's
+// 1 per rad for its 0.1 (Eq 4.28), times 0.1 / delta_r_fraction. The bound keeps the m_safe
+// surface from turning abruptly with pan: its tilt is dr/dα = −(∂F/∂α) / (∂F/∂r), and ∂F/∂r,
+// the ramp's slope before a reading, grows as 1/δr. So a sharper sensor model keeps the
+// thesis's limit on the tilt, where the thesis's bound would hold the surface at a fraction
+// of it (a wall seen at 45° needs |dr/dα| = r).
+[[nodiscard]] constexpr float alpha_slope_bound_per_rad(float delta_r_fraction) {
+  return delta_r_fraction > 0.0F ? kMaxAlphaSlopePerRad * (0.1F / delta_r_fraction)
+                                 : kMaxAlphaSlopePerRad;
+}
+
 // Sets the input box and the weight bounds of an occupancy ALN with inputs (α, h, r) and
 // output occupancy in [0, 1]. `Model` is an aln::Aln<Scalar, 3, Pieces>. Heights are
-// relative to the PTU centre [m]; `max_range_m` is the farthest r the model must cover.
+// relative to the PTU centre [m]; `max_range_m` is the farthest r the model must cover;
+// `max_alpha_slope_per_rad` bounds |∂F/∂α| (alpha_slope_bound_per_rad of the ray samples).
 template <typename Model>
-void configure_occupancy_model(Model& model, float lowest_h_m, float highest_h_m,
-                               float max_range_m) {
+void configure_occupancy_model(Model& model, float lowest_h_m, float highest_h_m, float max_range_m,
+                               float max_alpha_slope_per_rad = kMaxAlphaSlopePerRad) {
   constexpr float kTwoPi = 2.0F * std::numbers::pi_v<float>;
   model.set_input_range(0, -kSeamMarginRad, kTwoPi + kSeamMarginRad);
   model.set_input_range(1, lowest_h_m, highest_h_m);
   model.set_input_range(2, 0.0F, max_range_m);
   model.set_output_range(0.0F, 1.0F);
-  model.set_weight_bounds(0, -kMaxAlphaSlopePerRad, kMaxAlphaSlopePerRad);
+  model.set_weight_bounds(0, -max_alpha_slope_per_rad, max_alpha_slope_per_rad);
   model.set_weight_bounds(1, -kMaxHeightSlopePerM, kMaxHeightSlopePerM);
   model.set_weight_bounds(2, kMinRangeSlopePerM, std::numeric_limits<float>::infinity());
 }
@@ -44,7 +56,8 @@ void configure_occupancy_model(Model& model, const ReadingLimits& limits,
                                const RaySampleParams& rays = RaySampleParams{},
                                OccupancyBound bound = OccupancyBound::kPlausibility) {
   const ModelBox box = model_box(limits, ray_sample_reach(rays, bound));
-  configure_occupancy_model(model, box.lowest_h_m, box.highest_h_m, box.max_range_m);
+  configure_occupancy_model(model, box.lowest_h_m, box.highest_h_m, box.max_range_m,
+                            alpha_slope_bound_per_rad(rays.delta_r_fraction));
 }
 
 }  // namespace boticelli::evidence

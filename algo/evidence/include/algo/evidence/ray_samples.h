@@ -29,21 +29,47 @@ using RaySampleBuffer = core::FixedVectorBase<RaySample>;
 //     r − (1 + j·ramp_length_delta_r / k)·δr with evidence m·(1 − j/(k+1)),
 //   so occupancy falls linearly from m at r − δr to zero at about
 //   r − (1 + ramp_length_delta_r·(k+1)/k)·δr (the gradual slope of Fig 3.8b);
-//   one sample at the robot centre (α, 0, 0) with occupancy 0.
+//   one sample at the robot centre (α, 0, 0) with occupancy 0;
+//   line_of_sight_samples more with occupancy 0 on the line of sight, evenly between the
+//   robot centre and the ramp's foot (the j-th of n at j/(n+1) of the foot's distance): the
+//   camera saw the point through that space, so it is evidence of free, not only the centre
+//   (the thesis's model has none).
 // Samples between the camera and the point lie on the ray of view: a sample at distance s
 // has height h·s/r (r is the 3-D distance, h the height, so the ray is straight).
 struct RaySampleParams {
-  std::size_t samples_per_reading = 5;  // ≥ 3 and ≤ kMaxSamplesPerReading
-  float delta_r_fraction = 0.1F;        // δr / r, the thesis's sensor model (§3.7.3)
-  float ramp_length_delta_r = 2.0F;     // spread of the lower samples, in units of δr
+  std::size_t samples_per_reading = 5;    // ≥ 3 and ≤ kMaxSamplesPerReading
+  float delta_r_fraction = 0.1F;          // δr / r, the thesis's sensor model (§3.7.3)
+  float ramp_length_delta_r = 2.0F;       // spread of the lower samples, in units of δr
+  std::size_t line_of_sight_samples = 0;  // ≤ kMaxSamplesPerReading; 0 = the thesis's model
 };
 
 inline constexpr std::size_t kMaxSamplesPerReading = 16;
 
+// δr / r sized from the stereo's measured accuracy instead of the thesis's 0.1: the 90th
+// percentile of |r − r_true| / r_true is 0.029-0.045 over 0.3-3 m (0.076 at 3-4.5 m) in the
+// stereo suite's frames (docs/benchmarks.md "stereo"), so at most one reading in ten lies
+// outside r ± δr nearer than 3 m.
+inline constexpr float kStereoDeltaRFraction = 0.05F;
+
+// The sensor model sized from the stereo's accuracy, with the line of sight as evidence of
+// free (two samples on it besides the robot centre's).
+[[nodiscard]] constexpr RaySampleParams stereo_ray_sample_params() {
+  RaySampleParams p;
+  p.delta_r_fraction = kStereoDeltaRFraction;
+  p.line_of_sight_samples = 2;
+  return p;
+}
+
+// Samples per reading of the plausibility model: samples_per_reading + line_of_sight_samples.
+[[nodiscard]] constexpr std::size_t plausibility_samples_per_reading(
+    const RaySampleParams& params) {
+  return params.samples_per_reading + params.line_of_sight_samples;
+}
+
 // Plausibility samples (the thesis's default): the fit is monotone in r (Eq 4.24), so
 // nothing is said behind the point; the constraint carries m on to larger r.
-// Returns the number of samples appended: samples_per_reading, or 0 (and nothing
-// appended) if the buffer lacks room or the parameters are invalid.
+// Returns the number of samples appended: plausibility_samples_per_reading(), or 0 (and
+// nothing appended) if the buffer lacks room or the parameters are invalid.
 std::size_t append_plausibility_samples(const Reading& reading, const RaySampleParams& params,
                                         RaySampleBuffer& out);
 
@@ -56,7 +82,9 @@ std::size_t append_belief_samples(const Reading& reading, const RaySampleParams&
                                   RaySampleBuffer& out);
 
 [[nodiscard]] constexpr std::size_t belief_samples_per_reading(const RaySampleParams& params) {
-  return params.samples_per_reading < 3 ? 0 : 2 * params.samples_per_reading - 2;
+  return params.samples_per_reading < 3
+             ? 0
+             : 2 * params.samples_per_reading - 2 + params.line_of_sight_samples;
 }
 
 enum class OccupancyBound : std::uint8_t { kPlausibility, kBelief };
