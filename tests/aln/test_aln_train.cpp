@@ -517,6 +517,102 @@ TEST(AlnTrain, AWarmStartClampsTheWeightsIntoTheirBoundsAndRefusesTooManyPieces)
   CHECK_FALSE(g_trainer3.start_from(aln::SampleSet<float, 3>(), g_model3));
 }
 
+// Every k-th of the first n room samples, copied behind them in g_samples3 (from index n).
+aln::SampleSet<float, 3> every_kth_room_sample(std::size_t n, std::size_t k) {
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n; i += k) g_samples3[n + m++] = g_samples3[i];
+  return {g_samples3 + n, m};
+}
+
+double sse_over(const Model3& m, aln::SampleSet<float, 3> samples) {
+  double sse = 0.0;
+  for (const auto& s : samples) {
+    const double r = static_cast<double>(m.evaluate(s.x).value - s.y);
+    sse += r * r;
+  }
+  return sse;
+}
+
+TEST(AlnTrain, CoarseToFineSplitsOnEveryKthSampleThenRefitsOnAllWithoutSplitting) {
+  // The coarse phase is training on every 4th sample, pass for pass; the fine phase then
+  // refits that model on all samples: no more pieces, no worse a fit of them, and the stats
+  // (RMS) of the model returned, on all samples.
+  const std::size_t n = fill_room(2400, 0.03, 6);
+  const aln::SampleSet<float, 3> all(g_samples3, n);
+  const aln::SampleSet<float, 3> quarter = every_kth_room_sample(n, 4);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.03;
+  cfg.seed = 3;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.train(quarter, g_model3b));
+  const aln::TrainerStats coarse = g_trainer3.stats();
+  CHECK(g_model3b.piece_count() > 2);
+  cfg.coarse_stride = 4;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3);
+  CHECK(g_trainer3.train(all, g_model3));
+  const aln::TrainerStats& fine = g_trainer3.stats();
+  LONGS_EQUAL(coarse.passes, fine.coarse_passes);
+  LONGS_EQUAL(coarse.iterations, fine.iterations);
+  CHECK(fine.passes > fine.coarse_passes);
+  CHECK(g_model3.piece_count() <= g_model3b.piece_count());
+  CHECK(sse_over(g_model3, all) <= sse_over(g_model3b, all) * (1.0 + 1e-6));
+  DOUBLES_EQUAL(std::sqrt(sse_over(g_model3, all) / static_cast<double>(n)), fine.rms, 1e-4);
+  CHECK(g_model3.pieces_within_bounds());
+  // Sliced, the same model.
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.start(all, g_model3b));
+  std::size_t budget = 1;
+  while (!g_trainer3.step(budget)) budget = budget * 3 % 997 + 1;
+  CHECK(same_model(g_model3, g_model3b));
+}
+
+TEST(AlnTrain, TheFinePhaseRefitsButNeverSplitsHoweverBadlyTheCoarseModelFitsAllSamples) {
+  // Every 4th sample lies on a plane, the others on a V: the coarse phase sees the plane
+  // only and ends with one piece at once; the fine phase refits that piece to the V's
+  // samples (RMS far over epsilon) and still does not split.
+  aln_test::Rng rng(5);
+  const std::size_t n = 2000;
+  for (std::size_t k = 0; k < n; ++k) {
+    auto& s = g_samples2[k];
+    s.x = Eigen::Vector2d(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    s.y = k % 4 == 0 ? 0.5 : 2.0 * std::fabs(s.x(0) - 0.5);
+    s.weight = 1.0;
+  }
+  set_unit_ranges(g_model2);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.05;
+  cfg.coarse_stride = 4;
+  g_trainer2.configure(cfg);
+  CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2));
+  LONGS_EQUAL(1, g_model2.piece_count());
+  LONGS_EQUAL(0, g_trainer2.stats().iterations);
+  CHECK(g_trainer2.stats().rms > 4.0 * cfg.epsilon);
+  // One phase splits the V.
+  cfg.coarse_stride = 1;
+  g_trainer2.configure(cfg);
+  set_unit_ranges(g_model2b);
+  CHECK(g_trainer2.train(aln::SampleSet<double, 2>(g_samples2, n), g_model2b));
+  CHECK(g_model2b.piece_count() > 1);
+}
+
+TEST(AlnTrain, ACoarseStrideThatLeavesTooFewSamplesTrainsInOnePhase) {
+  const std::size_t n = fill_room(400, 0.0, 2);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.05;
+  cfg.coarse_stride = 8;  // 50 samples: fewer than the trainer fits a coarse phase on
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  LONGS_EQUAL(0, g_trainer3.stats().coarse_passes);
+  cfg.coarse_stride = 1;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  CHECK(same_model(g_model3, g_model3b));
+}
+
 TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   const std::size_t n = fill_room(3000, 0.02, 3);
   set_room_ranges(g_model3);
@@ -548,6 +644,15 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
     CHECK(g_trainer2.start_from(aln::SampleSet<double, 2>(g_samples2, m), g_model2));
     while (!done) done = g_trainer2.step(500);
   });
+  // Coarse to fine.
+  cfg.coarse_stride = 4;
+  g_trainer2.configure(cfg);
+  done = false;
+  CHECK_NO_ALLOCATION({
+    CHECK(g_trainer2.start(aln::SampleSet<double, 2>(g_samples2, m), g_model2));
+    while (!done) done = g_trainer2.step(500);
+  });
+  CHECK(g_trainer2.stats().coarse_passes > 0);
 }
 
 TEST(AlnTrain, AnEmptySampleSetIsRefused) {

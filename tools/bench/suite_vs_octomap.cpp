@@ -117,7 +117,7 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
 }
 
 // The fit's settings: the thesis's epsilon and 10 split rounds unless the knobs say otherwise,
-// hinge splits.
+// hinge splits, coarse to fine on every 4th sample (TrainerConfig::coarse_stride).
 aln::TrainerConfig trainer_config() {
   aln::TrainerConfig cfg;
   const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
@@ -127,6 +127,8 @@ aln::TrainerConfig trainer_config() {
       rounds != nullptr && *rounds != '\0' ? std::strtoul(rounds, nullptr, 10) : 10;
   cfg.max_pieces = kMaxPieces;
   cfg.split = aln::SplitCandidates::kHinges;
+  const char* stride = std::getenv("BOTICELLI_VS_OCTOMAP_COARSE_STRIDE");  // default 4
+  cfg.coarse_stride = stride != nullptr && *stride != '\0' ? std::strtoul(stride, nullptr, 10) : 4;
   return cfg;
 }
 
@@ -205,6 +207,7 @@ struct BuildParts {
   double guard_ms = 0.0;
   std::size_t samples = 0;
   std::size_t passes = 0;
+  std::size_t coarse_passes = 0;  // of them over every coarse_stride-th sample
 };
 
 void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
@@ -227,7 +230,8 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
         .num("train_ms", parts.train_ms)
         .num("guard_ms", parts.guard_ms)
         .integer("samples", static_cast<std::int64_t>(parts.samples))
-        .integer("passes", static_cast<std::int64_t>(parts.passes));
+        .integer("passes", static_cast<std::int64_t>(parts.passes))
+        .integer("coarse_passes", static_cast<std::int64_t>(parts.coarse_passes));
   }
   line.emit();
 }
@@ -357,6 +361,7 @@ int run() {
       parts.train_ms = ms_since(t_train);
       parts.samples = samples.size();
       parts.passes = g_trainer.stats().passes;
+    parts.coarse_passes = g_trainer.stats().coarse_passes;
       const std::int64_t t_guard = cpu_ns();
       // The feature guard: readings the fit calls free, kept where they cluster.
       g_candidates.clear();

@@ -60,6 +60,11 @@ struct TrainerConfig {
   SplitCandidates split = SplitCandidates::kCentroidV;
   std::uint32_t seed = 1;  // jitter of the split (V tilt; hinge draw and shift); same seed,
                            // same model
+  // Coarse to fine: with a stride k > 1 the split rounds see every k-th sample only (k times
+  // cheaper passes); then the model they end with is refitted on all samples (Lloyd passes
+  // until the loss stops falling, then pruning; no more splits). The model returned is the
+  // best of the fine passes, all of them judged on every sample. 1 (the default): one phase.
+  std::size_t coarse_stride = 1;
 };
 
 struct TrainerStats {
@@ -67,7 +72,8 @@ struct TrainerStats {
   std::size_t iterations = 0;     // split rounds counted against max_iterations
   std::size_t failed_rounds = 0;  // split rounds undone (they did not lower the error)
   std::size_t rounds = 0;         // split rounds begun (kept and undone)
-  std::size_t passes = 0;         // passes over the samples
+  std::size_t passes = 0;         // passes over the samples (coarse and fine)
+  std::size_t coarse_passes = 0;  // ... of which over every coarse_stride-th sample only
   std::uint64_t sample_visits = 0;
   double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
   double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
@@ -166,12 +172,13 @@ class Trainer {
     if (stats_.done || model_ == nullptr) return true;
     std::size_t budget = std::max<std::size_t>(max_sample_visits, 1);
     while (budget > 0 && !stats_.done) {
-      const std::size_t end = std::min(samples_.size(), cursor_ + budget);
+      const std::size_t count = visit_count();
+      const std::size_t end = std::min(count, cursor_ + budget);
       visit_range(cursor_, end);
       budget -= end - cursor_;
       stats_.sample_visits += end - cursor_;
       cursor_ = end;
-      if (cursor_ == samples_.size()) finish_pass();
+      if (cursor_ == count) finish_pass();
     }
     return stats_.done;
   }
@@ -193,10 +200,18 @@ class Trainer {
     return config_.max_pieces == 0 ? MaxPieces : std::min(config_.max_pieces, MaxPieces);
   }
 
+  // The samples a pass visits: every stride_-th (the coarse phase) or all.
+  std::size_t visit_count() const { return (samples_.size() + stride_ - 1) / stride_; }
+
   // What start() and start_from() share: the samples, the model, the stats and the cap.
   bool begin(SampleSet<Scalar, N> samples, Model& model) {
     samples_ = samples;
     model_ = &model;
+    // Coarse only where it leaves more samples than a piece needs to be fitted.
+    stride_ = config_.coarse_stride > 1 && samples.size() / config_.coarse_stride > 64
+                  ? config_.coarse_stride
+                  : 1;
+    refining_ = false;
     stats_ = TrainerStats{};
     rng_ = config_.seed * 2654435761U + 0x9E3779B9U;
     cap_ = piece_cap();
@@ -334,8 +349,9 @@ class Trainer {
     }
   }
 
-  // Samples [begin, end) of the pass: the model evaluated a block of samples at a time
-  // (Aln::evaluate_block), then each sample added to its responsible piece's sums.
+  // Visits [begin, end) of the pass (sample k·stride_ for visit k): the model evaluated a
+  // block of samples at a time (Aln::evaluate_block), then each sample added to its
+  // responsible piece's sums.
   void visit_range(std::size_t begin, std::size_t end) {
     constexpr std::size_t kBlock = Model::kBlock;
     std::array<Vec, kBlock> x;
@@ -343,9 +359,9 @@ class Trainer {
     std::array<std::uint16_t, kBlock> piece;
     for (std::size_t k = begin; k < end; k += kBlock) {
       const std::size_t n = std::min(kBlock, end - k);
-      for (std::size_t i = 0; i < n; ++i) x[i] = samples_[k + i].x;
+      for (std::size_t i = 0; i < n; ++i) x[i] = samples_[(k + i) * stride_].x;
       model_->evaluate_block(std::span<const Vec>(x.data(), n), value, piece);
-      for (std::size_t i = 0; i < n; ++i) visit(samples_[k + i], value[i], piece[i]);
+      for (std::size_t i = 0; i < n; ++i) visit(samples_[(k + i) * stride_], value[i], piece[i]);
     }
   }
 
@@ -457,6 +473,7 @@ class Trainer {
   // then either refit (one Lloyd step) or, when the loss has stopped falling, end the round.
   void finish_pass() {
     stats_.passes += 1;
+    stats_.coarse_passes += stride_ > 1 ? 1 : 0;
     if (checking_) {
       finish_check();
       return;
@@ -546,7 +563,7 @@ class Trainer {
     }
     Accumulators& acc = *current_;
     finish_stats(acc);
-    if (stats_.iterations >= config_.max_iterations || model_->piece_count() >= cap_) {
+    if (refining_ || stats_.iterations >= config_.max_iterations || model_->piece_count() >= cap_) {
       end_training();
       return;
     }
@@ -618,6 +635,13 @@ class Trainer {
   // the last evaluated model instead if pruning raised the loss. Without robust weights the
   // pruned model is returned as it is.
   void end_training() {
+    if (stride_ > 1) {
+      // The coarse phase is over: refit its model on all samples (a round with no splits).
+      stride_ = 1;
+      refining_ = true;
+      (void)begin_first_pass();
+      return;
+    }
     if (unevaluated_ && config_.robust != RobustWeighting::kNone) {
       checking_ = true;
       next_pass();
@@ -930,6 +954,8 @@ class Trainer {
   double best_loss_ = 0.0;
   bool unevaluated_ = false;
   bool checking_ = false;
+  std::size_t stride_ = 1;       // every stride_-th sample per pass (TrainerConfig::coarse_stride)
+  bool refining_ = false;        // the fine phase: refits on all samples, no splits
   std::size_t split_limit_ = 0;  // 0: no split to judge yet
   std::size_t last_made_ = 0;
   // Pieces of the current model whose split did not lower the error (not tried again), the
