@@ -361,7 +361,7 @@ int run() {
       parts.train_ms = ms_since(t_train);
       parts.samples = samples.size();
       parts.passes = g_trainer.stats().passes;
-    parts.coarse_passes = g_trainer.stats().coarse_passes;
+      parts.coarse_passes = g_trainer.stats().coarse_passes;
       const std::int64_t t_guard = cpu_ns();
       // The feature guard: readings the fit calls free, kept where they cluster.
       g_candidates.clear();
