@@ -49,11 +49,7 @@ std::vector<aln::Sample<float, 3>> room_samples(const SyntheticRoom& room, std::
 // Trains g_model on the room's samples with the sensor model `rays` (its pan-slope bound too).
 void fit_room(const SyntheticRoom& room, const std::vector<aln::Sample<float, 3>>& samples,
               const evidence::RaySampleParams& rays) {
-  evidence::configure_occupancy_model(
-      g_model, static_cast<float>(-room.sensor().z),
-      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
-      static_cast<float>(room.spec().max_range_m * 1.2),
-      evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
+  configure_room_model(g_model, room, evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
   aln::TrainerConfig cfg;
   cfg.split = aln::SplitCandidates::kHinges;
   g_trainer.configure(cfg);
@@ -92,10 +88,7 @@ TEST(RoomFit, TheRectangleRoomWithASharperSensorModelIsFittedToEpsilon) {
   // one failed round ended training); hinges placed where the residuals bend reach epsilon.
   const SyntheticRoom room(*find_environment("rectangle"));
   const std::vector<aln::Sample<float, 3>> samples = room_samples(room, 3000, 0.03F);
-  evidence::configure_occupancy_model(
-      g_model, static_cast<float>(-room.sensor().z),
-      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
-      static_cast<float>(room.spec().max_range_m * 1.2));
+  configure_room_model(g_model, room);
   aln::TrainerConfig cfg;
   cfg.epsilon = 0.15;
   cfg.max_iterations = 15;

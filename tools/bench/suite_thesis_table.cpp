@@ -151,13 +151,6 @@ std::size_t env_size(const char* name, std::size_t fallback) {
   return v != nullptr && *v != '\0' ? std::strtoul(v, nullptr, 10) : fallback;
 }
 
-void configure_model(Model& model, const SyntheticRoom& room) {
-  evidence::configure_occupancy_model(
-      model, static_cast<float>(-room.sensor().z),
-      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
-      static_cast<float>(room.spec().max_range_m * 1.2));
-}
-
 // RMS of a model over the samples: plain, or (robust runs) over the 95% smallest
 // residuals, so that a round is not preferred for fitting the outliers; and the number of
 // pieces responsible for at least one sample (the pieces the trainer would keep).
@@ -362,7 +355,7 @@ int run_thesis_table() {
         }
         std::size_t pad_count = 0;
         const std::vector<AlnSample> samples = build_samples(room, readings, run.pads, &pad_count);
-        configure_model(g_model, room);
+        configure_room_model(g_model, room);
         aln::TrainerConfig cfg;
         cfg.epsilon = kEpsilon;
         cfg.max_iterations = env_size("BOTICELLI_THESIS_ITERATIONS", 10);  // rounds kept

@@ -85,11 +85,7 @@ std::array<SensorSetting, 2> sensor_settings() {
 
 void configure_model(Model& model, const SyntheticRoom& room,
                      const evidence::RaySampleParams& rays) {
-  evidence::configure_occupancy_model(
-      model, static_cast<float>(-room.sensor().z),
-      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
-      static_cast<float>(room.spec().max_range_m * 1.2),
-      evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
+  configure_room_model(model, room, evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
 }
 
 // Ray samples (Fig 4.2b), zero pads in featureless directions and seam copies (§4.9.1).

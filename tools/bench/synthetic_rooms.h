@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "algo/evidence/occupancy_model.h"
 #include "algo/evidence/reading.h"
 
 namespace boticelli::bench {
@@ -135,5 +136,18 @@ class SyntheticRoom {
                    std::vector<evidence::Reading>& out) const;
   RoomSpec spec_;
 };
+
+// Sets `model`'s input box and weight bounds (evidence::configure_occupancy_model) for the
+// room: heights from the floor to the wall tops relative to the sensor, ranges to 1.2 times
+// the sensor's visibility, |∂F/∂α| bounded by max_alpha_slope_per_rad (the thesis's 1 per rad
+// unless the sensor model says otherwise, evidence::alpha_slope_bound_per_rad).
+template <typename Model>
+void configure_room_model(Model& model, const SyntheticRoom& room,
+                          float max_alpha_slope_per_rad = evidence::kMaxAlphaSlopePerRad) {
+  evidence::configure_occupancy_model(
+      model, static_cast<float>(-room.sensor().z),
+      static_cast<float>(room.spec().wall_height_m - room.sensor().z),
+      static_cast<float>(room.spec().max_range_m * 1.2), max_alpha_slope_per_rad);
+}
 
 }  // namespace boticelli::bench
