@@ -47,6 +47,7 @@ class Dtree {
     for (int i = 0; i < N; ++i) cells *= kGridPerAxis;
     return cells;
   }();
+  static constexpr Scalar kLastCell = static_cast<Scalar>(kGridPerAxis - 1);
   static_assert(MaxBlocks >= 1 && MaxBlocks < (1U << 30), "block capacity");
   static_assert(MaxBlockNodes < (1U << 31), "block node capacity");
   static_assert(kGridCells <= MaxBlocks, "every grid cell needs a block");
@@ -123,10 +124,10 @@ class Dtree {
     std::size_t cell = 0;
     std::size_t stride = 1;
     for (int i = 0; i < N; ++i) {
-      const Scalar u = (x(i) - cell_origin_(i)) * cell_scale_(i);
-      std::size_t c = u > Scalar(0) ? static_cast<std::size_t>(u) : 0;
-      c = c < kGridPerAxis ? c : kGridPerAxis - 1;
-      cell += c * stride;
+      Scalar u = (x(i) - cell_origin_(i)) * cell_scale_(i);
+      u = u > Scalar(0) ? u : Scalar(0);  // also NaN
+      u = u < kLastCell ? u : kLastCell;
+      cell += static_cast<std::size_t>(static_cast<int>(u)) * stride;
       stride *= kGridPerAxis;
     }
     std::int32_t c = cell_root_[cell];
