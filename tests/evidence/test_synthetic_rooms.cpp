@@ -160,3 +160,36 @@ TEST(SyntheticRooms, TheSameSeedGivesTheSameCameraReadingsAndAnotherSeedOthers) 
   }
   CHECK(differs);
 }
+
+TEST(SyntheticRooms, TheStereosRangeErrorScalesEachRangeByALaplaceDrawOfItsScale) {
+  const SyntheticRoom room(*find_environment("cylinder_centre"));  // walls 2.5 m away
+  CameraScan scan;
+  scan.range_error_b = kStereoRangeErrorB;
+  const std::vector<evidence::Reading> readings =
+      room.generate_camera_readings(scan, 4000, 5U, 0.0);
+  LONGS_EQUAL(4000, readings.size());
+  // Each reading keeps its line of sight; only its range moves: e = r / r_true − 1.
+  std::vector<double> abs_error;
+  double sum = 0.0;
+  for (const evidence::Reading& r : readings) {
+    const Vec3 p = room.world_of(r);
+    const Vec3 s = room.sensor();
+    const double r_m = static_cast<double>(r.r_m);
+    const Vec3 dir{(p.x - s.x) / r_m, (p.y - s.y) / r_m, (p.z - s.z) / r_m};
+    const double e = r_m / room.cast_from_sensor(dir).distance_m - 1.0;
+    sum += e;
+    abs_error.push_back(std::fabs(e));
+  }
+  std::sort(abs_error.begin(), abs_error.end());
+  const auto quantile = [&](double q) {
+    return abs_error[static_cast<std::size_t>(q * static_cast<double>(abs_error.size() - 1))];
+  };
+  // Laplace(b): |e| has median b ln 2 and 90th percentile b ln 10; its mean is 0.
+  DOUBLES_EQUAL(kStereoRangeErrorB * std::log(2.0), quantile(0.5), 0.1 * kStereoRangeErrorB);
+  DOUBLES_EQUAL(kStereoRangeErrorB * std::log(10.0), quantile(0.9), 0.25 * kStereoRangeErrorB);
+  DOUBLES_EQUAL(0.0, sum / static_cast<double>(readings.size()), 0.1 * kStereoRangeErrorB);
+  // Without it the ranges are exact, and the same as before the option existed.
+  for (const evidence::Reading& r : room.generate_camera_readings(CameraScan{}, 500, 5U, 0.0)) {
+    DOUBLES_EQUAL(2.5, distance_xy(room.world_of(r)), 1e-4);
+  }
+}

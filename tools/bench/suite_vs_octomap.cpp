@@ -49,6 +49,8 @@ Trainer g_trainer;
 mapping::AlnFreeRange<float, kMaxPieces> g_free_range;
 core::FixedVector<evidence::RaySample, kMaxRaySamples> g_ray_samples;
 mapping::LocalMap g_map;
+// The readings' range error of the current rows (CameraScan::range_error_b); 0: exact.
+double g_range_error_b = 0.0;
 mapping::StarPolygon g_scratch;
 core::FixedVector<mapping::GuardPoint, mapping::kMaxGuardCandidates> g_candidates;
 core::FixedVector<core::Point2, mapping::kMaxGuardPoints> g_guard;
@@ -80,6 +82,10 @@ std::array<SensorSetting, 2> sensor_settings() {
   if (dr != nullptr && *dr != '\0') stereo.delta_r_fraction = static_cast<float>(std::atof(dr));
   const char* los = std::getenv("BOTICELLI_VS_OCTOMAP_LINE_OF_SIGHT");  // samples, default 2
   if (los != nullptr && *los != '\0') stereo.line_of_sight_samples = std::strtoul(los, nullptr, 10);
+  // Length of its ramp below the plateau, in δr; default RaySampleParams' 2.
+  const char* ramp = std::getenv("BOTICELLI_VS_OCTOMAP_RAMP_DELTA_R");
+  if (ramp != nullptr && *ramp != '\0')
+    stereo.ramp_length_delta_r = static_cast<float>(std::atof(ramp));
   return {{{"aln", stereo}, {"aln-thesis", evidence::RaySampleParams{}}}};
 }
 
@@ -211,6 +217,7 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
           std::size_t pieces, std::size_t guard_points, const BuildParts& parts = {}) {
   JsonLine line(kSuite, spec.name);
   line.text("method", method)
+      .num("range_error_b", g_range_error_b)
       .num("resolution_m", resolution_m)
       .integer("pieces", static_cast<std::int64_t>(pieces))
       .integer("guard_points", static_cast<std::int64_t>(guard_points))
@@ -255,6 +262,77 @@ double median_ms(int reps, Fn fn) {
   }
   std::sort(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(n));
   return times[n / 2];
+}
+
+// The sensor model's own occupancy along a line of sight whose first surface (features with
+// evidence m) is d_m away, at distance s_m from the PTU centre: the ray samples of a reading
+// there (evidence::append_plausibility_samples), joined linearly in s; the plateau holds on
+// beyond the farthest sample.
+class SensorProfile {
+ public:
+  SensorProfile(const evidence::RaySampleParams& rays, double d_m, double m) {
+    core::FixedVector<evidence::RaySample, 2 * evidence::kMaxSamplesPerReading> samples;
+    evidence::Reading reading;
+    reading.r_m = static_cast<float>(d_m);
+    reading.m = static_cast<float>(m);
+    (void)evidence::append_plausibility_samples(reading, rays, samples);
+    for (const evidence::RaySample& q : samples) {
+      knots_[count_++] = {static_cast<double>(q.r_m), static_cast<double>(q.occupancy)};
+    }
+    std::sort(knots_.begin(), knots_.begin() + static_cast<std::ptrdiff_t>(count_));
+  }
+  [[nodiscard]] double at(double s_m) const {
+    if (count_ == 0) return 0.0;
+    if (s_m <= knots_[0].first) return knots_[0].second;
+    for (std::size_t i = 1; i < count_; ++i) {
+      if (s_m <= knots_[i].first) {
+        const auto& [s0, y0] = knots_[i - 1];
+        const auto& [s1, y1] = knots_[i];
+        return s1 > s0 ? y0 + (y1 - y0) * (s_m - s0) / (s1 - s0) : y1;
+      }
+    }
+    return knots_[count_ - 1].second;
+  }
+
+ private:
+  std::array<std::pair<double, double>, 2 * evidence::kMaxSamplesPerReading> knots_{};
+  std::size_t count_ = 0;
+};
+
+// The polygon an exact fit of the sensor model would give: the same slices, threshold and
+// shrink, with F at each point equal to the sensor model's profile (SensorProfile) along the
+// point's line of sight from the PTU centre, and 0 where that line of sight meets no
+// featured surface within range (no reading speaks there; counted free, so the figure is
+// what no fit of these samples can beat, not what one must reach). Marched in steps of
+// kExactStepM.
+void exact_fit_polygon(const SyntheticRoom& room, const mapping::ExtractionParams& p,
+                       const evidence::RaySampleParams& rays, mapping::LocalMap& out,
+                       mapping::StarPolygon& slice) {
+  constexpr double kExactStepM = 0.005;
+  const double m = room.spec().feature_m;
+  const double threshold = static_cast<double>(p.safe_occupancy);
+  for (std::size_t i = 0; i < p.height_count; ++i) {
+    const double z = static_cast<double>(mapping::slice_height_m(p, i));
+    mapping::StarPolygon& target = i == 0 ? out.free : slice;
+    target.set_vertex_count(p.vertex_count);
+    for (std::size_t k = 0; k < target.vertex_count(); ++k) {
+      const double a = static_cast<double>(target.angle_rad(k));
+      double rho = static_cast<double>(p.bounding_radius_m);
+      for (double q = kExactStepM; q < rho; q += kExactStepM) {
+        const double s = std::sqrt(q * q + z * z);
+        const Vec3 dir{q * std::cos(a) / s, q * std::sin(a) / s, z / s};
+        const SyntheticRoom::Hit hit = room.cast_from_sensor(dir);
+        if (!hit.featured || !(hit.distance_m <= room.spec().max_range_m)) continue;
+        if (SensorProfile(rays, hit.distance_m, m).at(s) >= threshold) rho = q;
+      }
+      target.set_rho_m(k, static_cast<float>(rho));
+    }
+    if (i > 0) {
+      (void)mapping::intersect_into(out.free, slice);
+    }
+  }
+  out.can_move =
+      mapping::shrink_for_robot(out.free, p.robot_radius_m, p.clearance_margin_m, out.navigable);
 }
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
@@ -338,88 +416,103 @@ int run() {
     if (spec == nullptr) continue;
     const SyntheticRoom room(*spec);
     const mapping::ExtractionParams p = extraction_params(room);
-    // As the camera sees the room: 15 pans × 2 tilts (level and 0.5 rad down).
-    const std::vector<evidence::Reading> readings =
-        room.generate_camera_readings(CameraScan{}, kFeatures, 7U);
+    for (const double b : {0.0, kStereoRangeErrorB}) {
+      g_range_error_b = b;
+      // As the camera sees the room: 15 pans × 2 tilts (level and 0.5 rad down), with exact
+      // ranges and with the stereo's range error; the same readings for ours and OctoMap.
+      CameraScan scan;
+      scan.range_error_b = g_range_error_b;
+      const std::vector<evidence::Reading> readings =
+          room.generate_camera_readings(scan, kFeatures, 7U);
 
-    // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink; with each
-    // sensor model, the refit (warm start) with the first.
-    std::int64_t t0 = 0;
-    const std::array<SensorSetting, 2> settings = sensor_settings();
-    for (const SensorSetting& setting : settings) {
-      BuildParts parts;
-      t0 = cpu_ns();
-      const std::vector<AlnSample> samples = build_samples(room, readings, setting.rays);
-      parts.samples_ms = ms_since(t0);
-      const std::int64_t t_train = cpu_ns();
-      configure_model(g_model, room, setting.rays);
-      train(samples);
-      parts.train_ms = ms_since(t_train);
-      parts.samples = samples.size();
-      parts.passes = g_trainer.stats().passes;
-      parts.coarse_passes = g_trainer.stats().coarse_passes;
-      const std::int64_t t_guard = cpu_ns();
-      // The feature guard: readings the fit calls free, kept where they cluster.
-      g_candidates.clear();
-      g_guard.clear();
-      const auto occupancy = [](float a, float h, float r) {
-        return static_cast<float>(g_model(Model::Vec(a, h, r)));
-      };
-      mapping::FeatureGuardParams guard;
-      guard.delta_r_fraction = setting.rays.delta_r_fraction;  // the readings' range error
-      (void)mapping::collect_unexplained_features(readings, occupancy, p, guard, g_candidates);
-      (void)mapping::corroborated_points(g_candidates, guard, g_guard);
-      parts.guard_ms = ms_since(t_guard);
-      const double build_ms = ms_since(t0);
-      const double extract_ms = median_ms(reps, [&] {
-        (void)g_free_range.set_model(g_model, p.safe_occupancy);
-        mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
-        do_not_optimize(g_map.navigable.rho_m(0));
-      });
-      const double shrink_ms = median_ms(reps, [&] {
-        (void)mapping::shrink_by_radius(g_map.free, p.robot_radius_m + p.clearance_margin_m,
-                                        g_scratch);
-        do_not_optimize(g_scratch.rho_m(0));
-      });
-      const std::size_t bytes = g_model.piece_count() * sizeof(Model::PieceType) +
-                                g_model.node_count() * sizeof(Model::Node) +
-                                g_guard.size() * sizeof(core::Point2);
-      emit(*spec, setting.method, 0.0, bytes, build_ms, extract_ms, shrink_ms,
-           quality(room, p, g_map.free, g_map.navigable), g_model.piece_count(), g_guard.size(),
-           parts);
-      if (&setting == &settings.front()) refit(*spec, room, setting.rays);
-    }
+      // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink; with each
+      // sensor model, the refit (warm start) with the first.
+      std::int64_t t0 = 0;
+      const std::array<SensorSetting, 2> settings = sensor_settings();
+      for (const SensorSetting& setting : settings) {
+        BuildParts parts;
+        t0 = cpu_ns();
+        const std::vector<AlnSample> samples = build_samples(room, readings, setting.rays);
+        parts.samples_ms = ms_since(t0);
+        const std::int64_t t_train = cpu_ns();
+        configure_model(g_model, room, setting.rays);
+        train(samples);
+        parts.train_ms = ms_since(t_train);
+        parts.samples = samples.size();
+        parts.passes = g_trainer.stats().passes;
+        parts.coarse_passes = g_trainer.stats().coarse_passes;
+        const std::int64_t t_guard = cpu_ns();
+        // The feature guard: readings the fit calls free, kept where they cluster.
+        g_candidates.clear();
+        g_guard.clear();
+        const auto occupancy = [](float a, float h, float r) {
+          return static_cast<float>(g_model(Model::Vec(a, h, r)));
+        };
+        mapping::FeatureGuardParams guard;
+        guard.delta_r_fraction = setting.rays.delta_r_fraction;  // the readings' range error
+        (void)mapping::collect_unexplained_features(readings, occupancy, p, guard, g_candidates);
+        (void)mapping::corroborated_points(g_candidates, guard, g_guard);
+        parts.guard_ms = ms_since(t_guard);
+        const double build_ms = ms_since(t0);
+        const double extract_ms = median_ms(reps, [&] {
+          (void)g_free_range.set_model(g_model, p.safe_occupancy);
+          mapping::extract_local_map(g_free_range, p, g_map, g_scratch, g_guard);
+          do_not_optimize(g_map.navigable.rho_m(0));
+        });
+        const double shrink_ms = median_ms(reps, [&] {
+          (void)mapping::shrink_by_radius(g_map.free, p.robot_radius_m + p.clearance_margin_m,
+                                          g_scratch);
+          do_not_optimize(g_scratch.rho_m(0));
+        });
+        const std::size_t bytes = g_model.piece_count() * sizeof(Model::PieceType) +
+                                  g_model.node_count() * sizeof(Model::Node) +
+                                  g_guard.size() * sizeof(core::Point2);
+        emit(*spec, setting.method, 0.0, bytes, build_ms, extract_ms, shrink_ms,
+             quality(room, p, g_map.free, g_map.navigable), g_model.piece_count(), g_guard.size(),
+             parts);
+        if (g_range_error_b > 0.0) continue;
+        if (&setting == &settings.front()) refit(*spec, room, setting.rays);
+        // What an exact fit of this sensor model would cover (no model, no build time).
+        static mapping::LocalMap exact_map;
+        exact_fit_polygon(room, p, setting.rays, exact_map, g_scratch);
+        char exact_method[32];
+        std::snprintf(exact_method, sizeof exact_method, "%s-exact-fit", setting.method);
+        emit(*spec, exact_method, 0.0, 0, 0.0, 0.0, 0.0,
+             quality(room, p, exact_map.free, exact_map.navigable), 0, 0);
+      }
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
-    for (const double res : {0.1, 0.05}) {
-      t0 = cpu_ns();
-      octomap::OcTree tree(res);
-      tree.setOccupancyThres(static_cast<double>(p.safe_occupancy));
-      octomap::Pointcloud cloud;
-      for (const evidence::Reading& rd : readings) {
-        const Vec3 w = room.world_of(rd);
-        cloud.push_back(static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z));
+      for (const double res : {0.1, 0.05}) {
+        t0 = cpu_ns();
+        octomap::OcTree tree(res);
+        tree.setOccupancyThres(static_cast<double>(p.safe_occupancy));
+        octomap::Pointcloud cloud;
+        for (const evidence::Reading& rd : readings) {
+          const Vec3 w = room.world_of(rd);
+          cloud.push_back(static_cast<float>(w.x), static_cast<float>(w.y),
+                          static_cast<float>(w.z));
+        }
+        const Vec3 s = room.sensor();
+        tree.insertPointCloud(cloud,
+                              octomap::point3d(static_cast<float>(s.x), static_cast<float>(s.y),
+                                               static_cast<float>(s.z)));
+        tree.updateInnerOccupancy();
+        const double oct_build_ms = ms_since(t0);
+        static mapping::LocalMap oct_map;
+        static mapping::StarPolygon oct_slice;
+        const int oct_reps = 7;
+        const double oct_extract_ms =
+            median_ms(oct_reps, [&] { octomap_polygon(tree, room, p, oct_map, oct_slice); });
+        const double oct_shrink_ms = median_ms(oct_reps, [&] {
+          (void)mapping::shrink_by_radius(oct_map.free, p.robot_radius_m + p.clearance_margin_m,
+                                          oct_slice);
+          do_not_optimize(oct_slice.rho_m(0));
+        });
+        emit(*spec, "octomap", res, tree.memoryUsage(), oct_build_ms, oct_extract_ms, oct_shrink_ms,
+             quality(room, p, oct_map.free, oct_map.navigable), 0, 0);
       }
-      const Vec3 s = room.sensor();
-      tree.insertPointCloud(cloud,
-                            octomap::point3d(static_cast<float>(s.x), static_cast<float>(s.y),
-                                             static_cast<float>(s.z)));
-      tree.updateInnerOccupancy();
-      const double oct_build_ms = ms_since(t0);
-      static mapping::LocalMap oct_map;
-      static mapping::StarPolygon oct_slice;
-      const int oct_reps = 7;
-      const double oct_extract_ms =
-          median_ms(oct_reps, [&] { octomap_polygon(tree, room, p, oct_map, oct_slice); });
-      const double oct_shrink_ms = median_ms(oct_reps, [&] {
-        (void)mapping::shrink_by_radius(oct_map.free, p.robot_radius_m + p.clearance_margin_m,
-                                        oct_slice);
-        do_not_optimize(oct_slice.rho_m(0));
-      });
-      emit(*spec, "octomap", res, tree.memoryUsage(), oct_build_ms, oct_extract_ms, oct_shrink_ms,
-           quality(room, p, oct_map.free, oct_map.navigable), 0, 0);
-    }
 #endif
+    }
   }
   return 0;
 }

@@ -306,8 +306,8 @@ Vec3 SyntheticRoom::world_of(const evidence::Reading& reading) const {
           s.y + rho * std::sin(static_cast<double>(reading.alpha_rad)), s.z + h};
 }
 
-bool SyntheticRoom::add_feature(Vec3 d, double outlier_fraction, std::mt19937& rng,
-                                std::vector<evidence::Reading>& out) const {
+bool SyntheticRoom::add_feature(Vec3 d, double outlier_fraction, double range_error_b,
+                                std::mt19937& rng, std::vector<evidence::Reading>& out) const {
   const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
   d = {d.x / len, d.y / len, d.z / len};
   const Hit hit = cast_from_sensor(d);
@@ -317,6 +317,12 @@ bool SyntheticRoom::add_feature(Vec3 d, double outlier_fraction, std::mt19937& r
   double t = hit.distance_m;
   if (std::uniform_real_distribution<double>(0.0, 1.0)(rng) < outlier_fraction) {
     t *= 0.5;  // §4.8.2: outliers appear twice as close as they are
+  }
+  if (range_error_b > 0.0) {
+    // Laplace by inversion: u uniform in (-1/2, 1/2), e = -b sgn(u) ln(1 - 2|u|).
+    const double u = std::uniform_real_distribution<double>(-0.5, 0.5)(rng);
+    const double e = range_error_b * std::copysign(-std::log1p(-2.0 * std::fabs(u)), u);
+    t *= std::max(1.0 + e, 0.05);
   }
   const Vec3 s = spec_.sensor;
   out.push_back(reading_of({s.x + d.x * t, s.y + d.y * t, s.z + d.z * t},
@@ -341,7 +347,7 @@ std::vector<evidence::Reading> SyntheticRoom::generate_readings(
     const double cy = std::sin(alpha);
     const double rho = wall_distance_xy(cx, cy);
     const double z = spec_.wall_height_m * unit(rng);
-    (void)add_feature({rho * cx, rho * cy, z - s.z}, outliers, rng, out);
+    (void)add_feature({rho * cx, rho * cy, z - s.z}, outliers, 0.0, rng, out);
   }
   return out;
 }
@@ -383,7 +389,8 @@ std::vector<evidence::Reading> SyntheticRoom::generate_camera_readings(
       const double zc = -(v - 0.5 * scan.height_px) / scan.focal_px;
       const double xt = ct - zc * st;  // forward after tilting (tilt < 0 looks down)
       const double zt = st + zc * ct;
-      if (add_feature({xt * cp - yc * sp, xt * sp + yc * cp, zt}, outliers, rng, out)) {
+      if (add_feature({xt * cp - yc * sp, xt * sp + yc * cp, zt}, outliers, scan.range_error_b, rng,
+                      out)) {
         ++found;
       }
     }

@@ -64,7 +64,16 @@ struct CameraScan {
   // mostly featureless floor yields fewer. Pixels tried per image, as a multiple of its
   // share of features, before it gives up.
   double attempts_per_feature = 20.0;
+  // The stereo's range error: each reading's range is multiplied by 1 + e, e drawn from a
+  // Laplace distribution of scale range_error_b (|e| has median b ln 2, 90th percentile
+  // b ln 10). 0: exact ranges. kStereoRangeErrorB matches the stereo suite's measurements.
+  double range_error_b = 0.0;
 };
+
+// Laplace scale of the stereo's relative range error: the stereo suite's 1-2 m band has
+// |r - r_true| / r_true at 0.009 / 0.029 / 0.039 (50th / 90th / 95th percentile,
+// docs/benchmarks.md); b = 0.013 gives 0.009 / 0.030 / 0.039.
+inline constexpr double kStereoRangeErrorB = 0.013;
 
 // Axis-aligned bounds [m].
 struct Bounds3 {
@@ -131,8 +140,9 @@ class SyntheticRoom {
   [[nodiscard]] double box_entry(const Vec3& origin, const Vec3& dir, double t_max) const;
   // Casts along direction d (any length) and, if the first surface is featured and within
   // range, appends its reading (moved to half its distance with probability
-  // outlier_fraction, one draw from rng). Returns whether it did.
-  bool add_feature(Vec3 d, double outlier_fraction, std::mt19937& rng,
+  // outlier_fraction, one draw from rng; then, if range_error_b > 0, its range scaled by
+  // 1 + e, e Laplace of that scale, one more draw). Returns whether it did.
+  bool add_feature(Vec3 d, double outlier_fraction, double range_error_b, std::mt19937& rng,
                    std::vector<evidence::Reading>& out) const;
   RoomSpec spec_;
 };
