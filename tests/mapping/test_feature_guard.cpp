@@ -339,6 +339,9 @@ TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
     guard.clear();
     (void)mapping::collect_unexplained_features(readings, wall_only, p,
                                                 mapping::FeatureGuardParams{}, candidates);
+    mapping::FeatureGuardParams see_through;
+    see_through.see_through_readings = 2;
+    (void)mapping::drop_seen_through(readings, see_through, candidates);
     (void)mapping::corroborated_points(candidates, mapping::FeatureGuardParams{}, guard);
     mapping::extract_local_map(free_range, p, map, scratch, guard);
   });
@@ -392,4 +395,52 @@ TEST(FeatureGuard, SortedCandidatesKeepTheSamePointsAsTheAllPairsSearch) {
     CHECK_EQUAL(all_pairs[i].x_m, windowed[i].x_m);
     CHECK_EQUAL(all_pairs[i].y_m, windowed[i].y_m);
   }
+}
+
+namespace {
+// A candidate at pan α, horizontal distance ρ and height h (PTU frame), as
+// collect_unexplained_features makes it.
+mapping::GuardPoint candidate_at(float alpha, float rho, float h) {
+  return {rho * std::cos(alpha), rho * std::sin(alpha), h, std::sqrt(rho * rho + h * h), 0.9F};
+}
+}  // namespace
+
+TEST(FeatureGuard, ACandidateTheCameraSawPastOnItsLineOfSightIsDroppedAndOthersStay) {
+  FixedVector<Reading, 16> readings;
+  // Behind A (pan 0, 1 m ahead, 0.3 m down): two readings 2 m out on lines of sight 5 mrad
+  // off its own (the same elevation).
+  (void)readings.push_back(at(0.005F, 2.0F, -0.6F));
+  (void)readings.push_back(at(6.2781853F, 2.0F, -0.6F));  // -0.005 rad, across the seam
+  // B (pan 1): two readings beyond it but 50 mrad to the side; two on its line of sight but
+  // within the two range errors (δr = 0.1 r each); one in front of it.
+  (void)readings.push_back(at(1.05F, 2.0F, -0.6F));
+  (void)readings.push_back(at(0.95F, 2.0F, -0.6F));
+  (void)readings.push_back(at(1.0F, 1.1F, -0.33F));
+  (void)readings.push_back(at(1.0F, 1.2F, -0.36F));
+  (void)readings.push_back(at(1.0F, 0.5F, -0.15F));
+  // C (pan 2): one reading beyond it.
+  (void)readings.push_back(at(2.0F, 2.5F, -0.75F));
+  // D (pan just below 2π): two readings beyond it just above 0, across the seam.
+  (void)readings.push_back(at(0.004F, 2.0F, 0.2F));
+  (void)readings.push_back(at(0.002F, 3.0F, 0.3F));
+  const std::array<mapping::GuardPoint, 4> all = {
+      candidate_at(0.0F, 1.0F, -0.3F), candidate_at(1.0F, 1.0F, -0.3F),
+      candidate_at(2.0F, 1.0F, -0.3F), candidate_at(6.2731853F, 1.0F, 0.1F)};
+  const auto run = [&](std::size_t through) {
+    mapping::FeatureGuardParams g;
+    g.see_through_readings = through;
+    GuardCandidatesFor<4> candidates;
+    for (const mapping::GuardPoint& c : all) (void)candidates.push_back(c);
+    const std::size_t dropped = mapping::drop_seen_through(readings, g, candidates);
+    LONGS_EQUAL(dropped, all.size() - candidates.size());
+    return candidates;
+  };
+  // Two readings needed: A and D go, B and C stay, in their order.
+  const GuardCandidatesFor<4> two = run(2);
+  LONGS_EQUAL(2, two.size());
+  DOUBLES_EQUAL(all[1].x_m, two[0].x_m, 0.0);
+  DOUBLES_EQUAL(all[2].x_m, two[1].x_m, 0.0);
+  // One reading is enough for C too; off, nothing goes.
+  LONGS_EQUAL(1, run(1).size());
+  LONGS_EQUAL(4, run(0).size());
 }

@@ -450,7 +450,14 @@ int run() {
         };
         mapping::FeatureGuardParams guard;
         guard.delta_r_fraction = setting.rays.delta_r_fraction;  // the readings' range error
+        // Candidates the camera saw through are dropped (FeatureGuardParams), two readings
+        // beyond needed: this camera's lines of sight start at the PTU centre, as the
+        // readings' do (the mission's camera is 0.21 m from it, so the mission does not).
+        const char* through = std::getenv("BOTICELLI_VS_OCTOMAP_SEE_THROUGH");  // default 2
+        guard.see_through_readings =
+            through != nullptr && *through != '\0' ? std::strtoul(through, nullptr, 10) : 2;
         (void)mapping::collect_unexplained_features(readings, occupancy, p, guard, g_candidates);
+        (void)mapping::drop_seen_through(readings, guard, g_candidates);
         (void)mapping::corroborated_points(g_candidates, guard, g_guard);
         parts.guard_ms = ms_since(t_guard);
         const double build_ms = ms_since(t0);

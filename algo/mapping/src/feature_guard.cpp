@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "algo/core/angles.h"
+
 namespace boticelli::mapping {
 
 bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuardParams& g) {
@@ -34,6 +36,42 @@ bool are_neighbours(const GuardPoint& a, const GuardPoint& b, const FeatureGuard
 bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGuardParams& g,
                          GuardPoints& out) {
   return corroborated_points(candidates, 0, candidates.size(), g, out);
+}
+
+std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
+                              const FeatureGuardParams& g, GuardCandidates& candidates) {
+  if (g.see_through_readings == 0) return 0;
+  const float cos_max = std::cos(g.see_through_angle_rad);
+  const float far_factor = (1.0F + g.delta_r_fraction) / (1.0F - g.delta_r_fraction);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const GuardPoint c = candidates[i];
+    const float r = std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m + c.h_m * c.h_m);
+    std::size_t through = 0;
+    if (r > 0.0F && g.delta_r_fraction < 1.0F) {
+      const float alpha = std::atan2(c.y_m, c.x_m);
+      const float cos_el = std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m) / r;
+      // Pan angles farther apart than this cannot be within the angle (the cone's width in
+      // pan grows as 1 / cos(elevation)).
+      const float pan_reach = g.see_through_angle_rad / std::fmax(cos_el, 0.05F);
+      for (const evidence::Reading& q : readings) {
+        if (!(q.r_m > r * far_factor)) continue;
+        if (std::fabs(std::remainder(q.alpha_rad - alpha, core::kTwoPi<float>)) > pan_reach) {
+          continue;
+        }
+        const float rho = evidence::horizontal_m(q);
+        const float cos_angle =
+            (rho * (std::cos(q.alpha_rad) * c.x_m + std::sin(q.alpha_rad) * c.y_m) +
+             q.h_m * c.h_m) /
+            (q.r_m * r);
+        if (cos_angle >= cos_max && ++through >= g.see_through_readings) break;
+      }
+    }
+    if (through < g.see_through_readings) candidates[kept++] = c;
+  }
+  const std::size_t dropped = candidates.size() - kept;
+  while (candidates.size() > kept) candidates.pop_back();
+  return dropped;
 }
 
 void sort_guard_candidates(std::span<GuardPoint> candidates) {

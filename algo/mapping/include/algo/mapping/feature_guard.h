@@ -63,6 +63,16 @@ struct FeatureGuardParams {
   // there are the floor cue's to report (its bases are exempt), and the fit keeps every
   // reading. 0 turns this off.
   float floor_delta_r_factor = 2.0F;
+  // Seen through (not in the thesis): a candidate is dropped when at least
+  // see_through_readings readings lie beyond it on lines of sight from the PTU centre within
+  // see_through_angle_rad of its own, beyond by more than both range errors
+  // (r_b (1 − δr/r) > r_a (1 + δr/r)): the camera saw past it there, so nothing stands at it.
+  // Stereo mismatches that land in front of a surface (§4.8.2's outliers) then do not
+  // corroborate each other into a phantom wall. 0 turns this off (the mission's setting: its
+  // readings' lines of sight start at the camera's optical centre, 0.21 m from the PTU
+  // centre, which Reading does not carry).
+  std::size_t see_through_readings = 0;
+  float see_through_angle_rad = 0.02F;
 };
 
 // A feature in the robot frame: x, y [m] on the floor plane, h [m] relative to the PTU centre,
@@ -128,6 +138,12 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
   }
   return lost;
 }
+
+// Removes the candidates the readings saw through (FeatureGuardParams::see_through_readings;
+// nothing if 0), keeping the others' order; returns how many went. O(candidates × readings),
+// most pairs rejected on their pan angles alone.
+std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
+                              const FeatureGuardParams& g, GuardCandidates& candidates);
 
 // Orders candidates by x, so corroborated_points looks only at those within reach along x.
 void sort_guard_candidates(std::span<GuardPoint> candidates);
