@@ -51,9 +51,11 @@ std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
     if (r > 0.0F && g.delta_r_fraction < 1.0F) {
       const float alpha = std::atan2(c.y_m, c.x_m);
       const float cos_el = std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m) / r;
-      // Pan angles farther apart than this cannot be within the angle (the cone's width in
-      // pan grows as 1 / cos(elevation)).
-      const float pan_reach = g.see_through_angle_rad / std::fmax(cos_el, 0.05F);
+      // Pan angles farther apart than this cannot be within the angle: the cone's width in
+      // pan grows as 1 / cos(elevation), and a reading inside it is at most the angle
+      // steeper (5% more for the small-angle approximation).
+      const float pan_reach =
+          1.05F * g.see_through_angle_rad / std::fmax(cos_el - g.see_through_angle_rad, 0.05F);
       for (const evidence::Reading& q : readings) {
         if (!(q.r_m > r * far_factor)) continue;
         if (std::fabs(std::remainder(q.alpha_rad - alpha, core::kTwoPi<float>)) > pan_reach) {
