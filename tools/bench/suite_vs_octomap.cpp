@@ -305,27 +305,17 @@ class SensorProfile {
 // featured surface within range (no reading speaks there; counted free, so the figure is
 // what no fit of these samples can beat, not what one must reach). Marched in steps of
 // kExactStepM.
-void exact_fit_polygon(const SyntheticRoom& room, const mapping::ExtractionParams& p,
-                       const evidence::RaySampleParams& rays, mapping::LocalMap& out,
-                       mapping::StarPolygon& slice) {
-  constexpr double kExactStepM = 0.005;
-  const double m = room.spec().feature_m;
-  const double threshold = static_cast<double>(p.safe_occupancy);
+// The free and navigable polygons from a free range per slice and pan angle
+// (rho_m(slice index, angle [rad]) [m]): the slices' polygons intersected, then the exact
+// shrink, as extract_local_map does with the ALN's.
+template <typename RhoFn>
+void polygon_from_slices(const mapping::ExtractionParams& p, mapping::LocalMap& out,
+                         mapping::StarPolygon& slice, RhoFn rho_m) {
   for (std::size_t i = 0; i < p.height_count; ++i) {
-    const double z = static_cast<double>(mapping::slice_height_m(p, i));
     mapping::StarPolygon& target = i == 0 ? out.free : slice;
     target.set_vertex_count(p.vertex_count);
     for (std::size_t k = 0; k < target.vertex_count(); ++k) {
-      const double a = static_cast<double>(target.angle_rad(k));
-      double rho = static_cast<double>(p.bounding_radius_m);
-      for (double q = kExactStepM; q < rho; q += kExactStepM) {
-        const double s = std::sqrt(q * q + z * z);
-        const Vec3 dir{q * std::cos(a) / s, q * std::sin(a) / s, z / s};
-        const SyntheticRoom::Hit hit = room.cast_from_sensor(dir);
-        if (!hit.featured || !(hit.distance_m <= room.spec().max_range_m)) continue;
-        if (SensorProfile(rays, hit.distance_m, m).at(s) >= threshold) rho = q;
-      }
-      target.set_rho_m(k, static_cast<float>(rho));
+      target.set_rho_m(k, rho_m(i, target.angle_rad(k)));
     }
     if (i > 0) {
       (void)mapping::intersect_into(out.free, slice);
@@ -335,6 +325,27 @@ void exact_fit_polygon(const SyntheticRoom& room, const mapping::ExtractionParam
       mapping::shrink_for_robot(out.free, p.robot_radius_m, p.clearance_margin_m, out.navigable);
 }
 
+void exact_fit_polygon(const SyntheticRoom& room, const mapping::ExtractionParams& p,
+                       const evidence::RaySampleParams& rays, mapping::LocalMap& out,
+                       mapping::StarPolygon& slice) {
+  constexpr double kExactStepM = 0.005;
+  const double m = room.spec().feature_m;
+  const double threshold = static_cast<double>(p.safe_occupancy);
+  polygon_from_slices(p, out, slice, [&](std::size_t i, float angle_rad) {
+    const double z = static_cast<double>(mapping::slice_height_m(p, i));
+    const auto a = static_cast<double>(angle_rad);
+    double rho = static_cast<double>(p.bounding_radius_m);
+    for (double q = kExactStepM; q < rho; q += kExactStepM) {
+      const double s = std::sqrt(q * q + z * z);
+      const Vec3 dir{q * std::cos(a) / s, q * std::sin(a) / s, z / s};
+      const SyntheticRoom::Hit hit = room.cast_from_sensor(dir);
+      if (!hit.featured || !(hit.distance_m <= room.spec().max_range_m)) continue;
+      if (SensorProfile(rays, hit.distance_m, m).at(s) >= threshold) rho = q;
+    }
+    return static_cast<float>(rho);
+  });
+}
+
 #if defined(BOTICELLI_HAVE_OCTOMAP)
 // The same slices, threshold and shrink, with the free range found by OctoMap's own ray
 // casting through the octree (unknown cells count as free: their prior 0.5 < m_safe).
@@ -342,30 +353,20 @@ void octomap_polygon(const octomap::OcTree& tree, const SyntheticRoom& room,
                      const mapping::ExtractionParams& p, mapping::LocalMap& out,
                      mapping::StarPolygon& slice) {
   const double max_range = static_cast<double>(p.bounding_radius_m);
-  for (std::size_t i = 0; i < p.height_count; ++i) {
+  polygon_from_slices(p, out, slice, [&](std::size_t i, float a) {
     const double z = room.sensor().z + static_cast<double>(mapping::slice_height_m(p, i));
-    mapping::StarPolygon& target = i == 0 ? out.free : slice;
-    target.set_vertex_count(p.vertex_count);
     const octomap::point3d origin(static_cast<float>(room.sensor().x),
                                   static_cast<float>(room.sensor().y), static_cast<float>(z));
-    for (std::size_t k = 0; k < target.vertex_count(); ++k) {
-      const float a = target.angle_rad(k);
-      const octomap::point3d dir(std::cos(a), std::sin(a), 0.0F);
-      octomap::point3d end;
-      float rho = p.bounding_radius_m;
-      if (tree.castRay(origin, dir, end, true, max_range)) {
-        rho = std::min(rho, static_cast<float>((end - origin).norm()));
-        // The hit is a cell centre; its near face is half a cell closer.
-        rho = std::max(0.0F, rho - static_cast<float>(tree.getResolution()) * 0.5F);
-      }
-      target.set_rho_m(k, rho);
+    const octomap::point3d dir(std::cos(a), std::sin(a), 0.0F);
+    octomap::point3d end;
+    float rho = p.bounding_radius_m;
+    if (tree.castRay(origin, dir, end, true, max_range)) {
+      rho = std::min(rho, static_cast<float>((end - origin).norm()));
+      // The hit is a cell centre; its near face is half a cell closer.
+      rho = std::max(0.0F, rho - static_cast<float>(tree.getResolution()) * 0.5F);
     }
-    if (i > 0) {
-      (void)mapping::intersect_into(out.free, slice);
-    }
-  }
-  out.can_move =
-      mapping::shrink_for_robot(out.free, p.robot_radius_m, p.clearance_margin_m, out.navigable);
+    return rho;
+  });
 }
 #endif
 
