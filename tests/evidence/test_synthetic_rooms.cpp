@@ -188,7 +188,7 @@ TEST(SyntheticRooms, TheStereosRangeErrorScalesEachRangeByALaplaceDrawOfItsScale
   DOUBLES_EQUAL(kStereoRangeErrorB * std::log(2.0), quantile(0.5), 0.1 * kStereoRangeErrorB);
   DOUBLES_EQUAL(kStereoRangeErrorB * std::log(10.0), quantile(0.9), 0.25 * kStereoRangeErrorB);
   DOUBLES_EQUAL(0.0, sum / static_cast<double>(readings.size()), 0.1 * kStereoRangeErrorB);
-  // Without it the ranges are exact, and the same as before the option existed.
+  // Without it the ranges are exact.
   for (const evidence::Reading& r : room.generate_camera_readings(CameraScan{}, 500, 5U, 0.0)) {
     DOUBLES_EQUAL(2.5, distance_xy(room.world_of(r)), 1e-4);
   }
