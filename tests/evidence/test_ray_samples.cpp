@@ -59,6 +59,35 @@ TEST(RaySamples, LineOfSightSamplesAreFreeAndEvenlySpacedBetweenTheRobotAndTheRa
   DOUBLES_EQUAL(1.35, samples[7].r_m, 1e-5);
 }
 
+TEST(RaySamples, LineOfSightSamplesStartAtTheReadingsViewNotAtThePtuCentre) {
+  // The point 2 m ahead at pan 0, level; seen from an optical centre 0.21 m to its side and
+  // 0.1 m down: the free samples lie on that line of sight, at j/3 of the way from the view
+  // to the ramp's foot, 4δr = 0.8 m short of the point along it.
+  Reading side{0.0F, 0.0F, 2.0F, 0.9F};
+  side.view_y_m = 0.21F;
+  side.view_z_m = -0.1F;
+  params.line_of_sight_samples = 2;
+  LONGS_EQUAL(7, append_plausibility_samples(side, params, samples));
+  const double vx = 0.0;
+  const double vy = 0.21;
+  const double vz = -0.1;
+  const double d = std::sqrt(2.0 * 2.0 + vy * vy + vz * vz);
+  for (std::size_t j = 1; j <= 2; ++j) {
+    const RaySample& s = samples[4 + j];
+    const double t = (d - 0.8) / d * static_cast<double>(j) / 3.0;
+    const double x = vx + t * (2.0 - vx);
+    const double y = vy + t * (0.0 - vy);
+    const double z = vz + t * (0.0 - vz);
+    DOUBLES_EQUAL(std::sqrt(x * x + y * y + z * z), s.r_m, 1e-5);
+    DOUBLES_EQUAL(z, s.h_m, 1e-5);
+    DOUBLES_EQUAL(std::atan2(y, x), s.alpha_rad, 1e-5);
+    DOUBLES_EQUAL(0.0, s.occupancy, 1e-9);
+  }
+  // The thesis's five are where they were: on the ray from the PTU centre.
+  DOUBLES_EQUAL(2.2, samples[0].r_m, 1e-5);
+  DOUBLES_EQUAL(0.0, samples[0].alpha_rad, 1e-9);
+}
+
 TEST(RaySamples, WithoutLowerSamplesTheLineOfSightEndsAtTheNearPlateauSample) {
   params.samples_per_reading = 3;
   params.line_of_sight_samples = 1;

@@ -444,3 +444,30 @@ TEST(FeatureGuard, ACandidateTheCameraSawPastOnItsLineOfSightIsDroppedAndOthersS
   LONGS_EQUAL(1, run(1).size());
   LONGS_EQUAL(4, run(0).size());
 }
+
+TEST(FeatureGuard, TheLinesOfSightThatSeePastACandidateStartAtTheReadingsViews) {
+  // A candidate 1 m ahead at pan 0; two readings 2 m beyond it on lines of sight from an
+  // optical centre 0.21 m to the side (pan π/2). From the PTU centre their directions are
+  // 0.14 rad off the candidate's; from their view, they pass through it.
+  const mapping::GuardPoint c = candidate_at(0.0F, 1.0F, 0.0F);
+  FixedVector<Reading, 4> readings;
+  for (const float dz : {0.0F, 0.01F}) {
+    // view v = (0, 0.21, 0); the point v + 3 (c − v).
+    const float x = 3.0F * 1.0F;
+    const float y = 0.21F + 3.0F * (0.0F - 0.21F);
+    Reading q = at(std::atan2(y, x) + 6.2831853F, std::hypot(x, y), dz);
+    q.view_y_m = 0.21F;
+    (void)readings.push_back(q);
+  }
+  mapping::FeatureGuardParams g;
+  g.see_through_readings = 2;
+  GuardCandidatesFor<2> candidates;
+  (void)candidates.push_back(c);
+  LONGS_EQUAL(1, mapping::drop_seen_through(readings, g, candidates));
+  LONGS_EQUAL(0, candidates.size());
+  // The same points seen from the PTU centre pass 0.14 rad to the side: the candidate stays.
+  for (Reading& q : readings) q.view_y_m = 0.0F;
+  (void)candidates.push_back(c);
+  LONGS_EQUAL(0, mapping::drop_seen_through(readings, g, candidates));
+  LONGS_EQUAL(1, candidates.size());
+}

@@ -68,6 +68,15 @@ TEST(Triangulation, ReadingIsTakenAboutThePtuCentre) {
   DOUBLES_EQUAL(0.5, reading.h_m, 1e-6);
   DOUBLES_EQUAL(1.5, reading.r_m, 1e-6);
   DOUBLES_EQUAL(0.8, reading.m, 1e-6);
+  // Seen from the PTU centre unless a view is given; then that is where its line of sight
+  // starts.
+  DOUBLES_EQUAL(0.0, reading.view_x_m, 0.0);
+  const auto seen = reading_from_point(Eigen::Vector3f(-1.0F, -1.0F, 0.5F), 0.8F,
+                                       Eigen::Vector3f(0.1F, -0.2F, 0.05F));
+  DOUBLES_EQUAL(0.1, seen.view_x_m, 1e-7);
+  DOUBLES_EQUAL(-0.2, seen.view_y_m, 1e-7);
+  DOUBLES_EQUAL(0.05, seen.view_z_m, 1e-7);
+  DOUBLES_EQUAL(1.5, seen.r_m, 1e-6);
 }
 
 TEST(Triangulation, OnePixelOfDisparityMovesTheRangeByLessThanEq37ButMoreThanHalfOfIt) {

@@ -44,10 +44,30 @@ void put_plausibility(const Reading& reading, const RaySampleParams& params, Ray
   if (n > 0) {
     // The ramp's zero (ray_samples.h); without lower samples, the near plateau sample.
     const float reach = k == 0 ? 1.0F : 1.0F + params.ramp_length_delta_r * (kf + 1.0F) / kf;
-    const float foot = std::max(r - reach * dr, 0.0F);
     const float nf = static_cast<float>(n);
+    if (reading.view_x_m == 0.0F && reading.view_y_m == 0.0F && reading.view_z_m == 0.0F) {
+      const float foot = std::max(r - reach * dr, 0.0F);
+      for (std::size_t j = 1; j <= n; ++j) {
+        (void)out.push_back(on_ray(reading, foot * static_cast<float>(j) / (nf + 1.0F), 0.0F));
+      }
+      return;
+    }
+    // From the view: the point p, the view v, the foot reach·δr short of p along v → p.
+    const float rho = horizontal_m(reading);
+    const float px = rho * std::cos(reading.alpha_rad);
+    const float py = rho * std::sin(reading.alpha_rad);
+    const float dx = px - reading.view_x_m;
+    const float dy = py - reading.view_y_m;
+    const float dz = reading.h_m - reading.view_z_m;
+    const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    const float foot = d > 0.0F ? std::max(d - reach * dr, 0.0F) / d : 0.0F;  // of v → p
     for (std::size_t j = 1; j <= n; ++j) {
-      (void)out.push_back(on_ray(reading, foot * static_cast<float>(j) / (nf + 1.0F), 0.0F));
+      const float t = foot * static_cast<float>(j) / (nf + 1.0F);
+      const float x = reading.view_x_m + t * dx;
+      const float y = reading.view_y_m + t * dy;
+      const float z = reading.view_z_m + t * dz;
+      (void)out.push_back(
+          {core::wrap_two_pi(std::atan2(y, x)), z, std::sqrt(x * x + y * y + z * z), 0.0F});
     }
   }
 }

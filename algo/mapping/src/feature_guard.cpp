@@ -40,33 +40,52 @@ bool corroborated_points(std::span<const GuardPoint> candidates, const FeatureGu
 
 std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
                               const FeatureGuardParams& g, GuardCandidates& candidates) {
-  if (g.see_through_readings == 0) return 0;
-  const float cos_max = std::cos(g.see_through_angle_rad);
+  if (g.see_through_readings == 0 || !(g.delta_r_fraction < 1.0F)) return 0;
+  const float angle = g.see_through_angle_rad;
+  const float cos_max = std::cos(angle);
   const float far_factor = (1.0F + g.delta_r_fraction) / (1.0F - g.delta_r_fraction);
+  // The farthest any line of sight starts from the PTU centre (the camera's lever).
+  float lever = 0.0F;
+  for (const evidence::Reading& q : readings) {
+    lever = std::fmax(lever, std::sqrt(q.view_x_m * q.view_x_m + q.view_y_m * q.view_y_m +
+                                       q.view_z_m * q.view_z_m));
+  }
   std::size_t kept = 0;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const GuardPoint c = candidates[i];
     const float r = std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m + c.h_m * c.h_m);
     std::size_t through = 0;
-    if (r > 0.0F && g.delta_r_fraction < 1.0F) {
+    if (r > lever) {
       const float alpha = std::atan2(c.y_m, c.x_m);
       const float cos_el = std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m) / r;
-      // Pan angles farther apart than this cannot be within the angle: the cone's width in
-      // pan grows as 1 / cos(elevation), and a reading inside it is at most the angle
-      // steeper (5% more for the small-angle approximation).
-      const float pan_reach =
-          1.05F * g.see_through_angle_rad / std::fmax(cos_el - g.see_through_angle_rad, 0.05F);
+      // A reading seen past the candidate lies on a line of sight within the angle of it,
+      // from a view at most `lever` away: seen from the PTU centre its direction is within
+      // angle + asin(lever / r) of the candidate's. So pans farther apart than this (the
+      // cone's width in pan grows as 1 / cos(elevation); 5% more for the small-angle
+      // approximation), or ranges too short even with the lever, are not looked at.
+      const float spread = angle + std::asin(std::fmin(lever / r, 1.0F));
+      const float pan_reach = 1.05F * spread / std::fmax(cos_el - spread, 0.05F);
+      const float near_limit = (r - lever) * far_factor - lever;
       for (const evidence::Reading& q : readings) {
-        if (!(q.r_m > r * far_factor)) continue;
+        if (!(q.r_m > near_limit)) continue;
         if (std::fabs(std::remainder(q.alpha_rad - alpha, core::kTwoPi<float>)) > pan_reach) {
           continue;
         }
+        // From q's view: u to q, w to the candidate; q beyond both range errors, within the
+        // angle.
         const float rho = evidence::horizontal_m(q);
-        const float cos_angle =
-            (rho * (std::cos(q.alpha_rad) * c.x_m + std::sin(q.alpha_rad) * c.y_m) +
-             q.h_m * c.h_m) /
-            (q.r_m * r);
-        if (cos_angle >= cos_max && ++through >= g.see_through_readings) break;
+        const float ux = rho * std::cos(q.alpha_rad) - q.view_x_m;
+        const float uy = rho * std::sin(q.alpha_rad) - q.view_y_m;
+        const float uz = q.h_m - q.view_z_m;
+        const float wx = c.x_m - q.view_x_m;
+        const float wy = c.y_m - q.view_y_m;
+        const float wz = c.h_m - q.view_z_m;
+        const float u = std::sqrt(ux * ux + uy * uy + uz * uz);
+        const float w = std::sqrt(wx * wx + wy * wy + wz * wz);
+        if (!(u > w * far_factor)) continue;
+        if (ux * wx + uy * wy + uz * wz >= cos_max * u * w && ++through >= g.see_through_readings) {
+          break;
+        }
       }
     }
     if (through < g.see_through_readings) candidates[kept++] = c;

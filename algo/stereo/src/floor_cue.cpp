@@ -454,7 +454,7 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
         ++result.boundaries;
         for (std::uint32_t i = 0; i < params_.obstacle_height_count; ++i) {
           const Eigen::Vector3f p(base.x(), base.y(), floor_h + params_.obstacle_heights_m[i]);
-          if (obstacles.push_back(reading_from_point(p, m))) {
+          if (obstacles.push_back(reading_from_point(p, m, pose.centre_m))) {
             ++result.obstacle_readings;
           } else {
             result.truncated = true;
@@ -466,7 +466,8 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
     }
     if (col.end == FloorColumn::End::kBlockedAtBottom && blocked != nullptr) {
       // Something stands on the floor somewhere nearer than the bottom row's floor point.
-      if (blocked->push_back(reading_from_point(near_point, params_.evidence_weak))) {
+      if (blocked->push_back(
+              reading_from_point(near_point, params_.evidence_weak, pose.centre_m))) {
         ++result.blocked_readings;
       } else {
         result.truncated = true;
@@ -477,7 +478,7 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
       // With free_near_m, the walk's near end goes with it, or neither is kept.
       if (free_near_m != nullptr && free_near_m->size() != free.size()) {
         result.truncated = true;  // the caller's lists are out of step: add to neither
-      } else if (free.push_back(reading_from_point(free_point, 0.0F))) {
+      } else if (free.push_back(reading_from_point(free_point, 0.0F, pose.centre_m))) {
         if (free_near_m == nullptr || free_near_m->push_back(col.near_rho_m)) {
           ++result.free_readings;
         } else {

@@ -30,10 +30,11 @@ using RaySampleBuffer = core::FixedVectorBase<RaySample>;
 //   so occupancy falls linearly from m at r − δr to zero at about
 //   r − (1 + ramp_length_delta_r·(k+1)/k)·δr (the gradual slope of Fig 3.8b);
 //   one sample at the robot centre (α, 0, 0) with occupancy 0;
-//   line_of_sight_samples more with occupancy 0 on the line of sight, evenly between the
-//   robot centre and the ramp's foot (the j-th of n at j/(n+1) of the foot's distance): the
-//   camera saw the point through that space, so it is evidence of free, not only the centre
-//   (the thesis's model has none).
+//   line_of_sight_samples more with occupancy 0 on the line of sight, evenly between where it
+//   starts (the reading's view, the camera's optical centre; the PTU centre if unset) and
+//   the ramp's foot on it, reach·δr short of the point (the j-th of n at j/(n+1) of the way):
+//   the camera saw the point through that space, so it is evidence of free, not only the
+//   centre (the thesis's model has none).
 // Samples between the camera and the point lie on the ray of view: a sample at distance s
 // has height h·s/r (r is the 3-D distance, h the height, so the ray is straight).
 struct RaySampleParams {

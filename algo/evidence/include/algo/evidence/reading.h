@@ -13,6 +13,11 @@ struct Reading {
   float h_m = 0.0F;        // height of the point relative to the PTU centre [m]
   float r_m = 0.0F;        // distance from the PTU centre to the point [m]
   float m = 0.0F;          // evidence in [0, 1] (Eq 3.8)
+  // Where its line of sight starts: the camera's optical centre when it was seen, PTU frame
+  // [m] (x along pan 0, z up). All 0: the PTU centre, the thesis's origin of every ray.
+  float view_x_m = 0.0F;
+  float view_y_m = 0.0F;
+  float view_z_m = 0.0F;
 };
 
 // ρ = √(r² − h²): the point's distance from the PTU's vertical axis [m] (0 when |h| ≥ r).

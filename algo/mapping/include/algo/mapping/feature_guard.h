@@ -64,13 +64,12 @@ struct FeatureGuardParams {
   // reading. 0 turns this off.
   float floor_delta_r_factor = 2.0F;
   // Seen through (not in the thesis): a candidate is dropped when at least
-  // see_through_readings readings lie beyond it on lines of sight from the PTU centre within
-  // see_through_angle_rad of its own, beyond by more than both range errors
-  // (r_b (1 − δr/r) > r_a (1 + δr/r)): the camera saw past it there, so nothing stands at it.
-  // Stereo mismatches that land in front of a surface (§4.8.2's outliers) then do not
-  // corroborate each other into a phantom wall. 0 turns this off (the mission's setting: its
-  // readings' lines of sight start at the camera's optical centre, 0.21 m from the PTU
-  // centre, which Reading does not carry).
+  // see_through_readings readings lie beyond it on their lines of sight (from the camera's
+  // optical centre, Reading::view_*), within see_through_angle_rad of the direction to it
+  // and beyond by more than both range errors (d_b (1 − δr/r) > d_a (1 + δr/r)): the camera
+  // saw past it there, so nothing stands at it. Stereo mismatches that land in front of a
+  // surface (§4.8.2's outliers) then do not corroborate each other into a phantom wall.
+  // 0 turns this off.
   std::size_t see_through_readings = 0;
   float see_through_angle_rad = 0.02F;
 };
@@ -141,7 +140,8 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
 
 // Removes the candidates the readings saw through (FeatureGuardParams::see_through_readings;
 // nothing if 0), keeping the others' order; returns how many went. O(candidates × readings),
-// most pairs rejected on their pan angles alone.
+// most pairs rejected on their ranges and pan angles alone. A candidate nearer the PTU centre
+// than the farthest view stays.
 std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
                               const FeatureGuardParams& g, GuardCandidates& candidates);
 

@@ -26,8 +26,10 @@ bool triangulate_fast(const CameraPose& first, const CameraPose& second,
                       Eigen::Vector3f& point_camera1_m);
 
 // A PTU-frame point as a Reading about the PTU centre (§4.5.2): α = atan2(y, x) in [0, 2π),
-// h = z, r = |p|; m is the evidence (Eq 3.8).
-evidence::Reading reading_from_point(const Eigen::Vector3f& point_ptu_m, float evidence_m);
+// h = z, r = |p|; m is the evidence (Eq 3.8); seen from view_ptu_m (the camera's optical
+// centre, PTU frame; Reading::view_*).
+evidence::Reading reading_from_point(const Eigen::Vector3f& point_ptu_m, float evidence_m,
+                                     const Eigen::Vector3f& view_ptu_m = Eigen::Vector3f::Zero());
 
 // App. A: the epipolar line i' = K·j' + B in the second frame for the feature at centred
 // pixel (i, j) of the first (i = u − c_x, j = v − c_y; pixels of `intrinsics`), from the
