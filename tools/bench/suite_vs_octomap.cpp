@@ -452,8 +452,7 @@ int run() {
         mapping::FeatureGuardParams guard;
         guard.delta_r_fraction = setting.rays.delta_r_fraction;  // the readings' range error
         // Candidates the camera saw through are dropped (FeatureGuardParams), two readings
-        // beyond needed: this camera's lines of sight start at the PTU centre, as the
-        // readings' do (the mission's camera is 0.21 m from it, so the mission does not).
+        // beyond needed (the mission does not: docs/mapping.md).
         const char* through = std::getenv("BOTICELLI_VS_OCTOMAP_SEE_THROUGH");  // default 2
         guard.see_through_readings =
             through != nullptr && *through != '\0' ? std::strtoul(through, nullptr, 10) : 2;
