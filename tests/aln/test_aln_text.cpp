@@ -291,3 +291,25 @@ TEST(AlnText, ReadingAndWritingDoNotAllocate) {
   CHECK_NO_ALLOCATION(ok = aln::read_text(g_text, n, g_g, err));
   CHECK(ok);
 }
+
+TEST(AlnText, AFormThatOverflowsSomewhereInItsInputRangesIsRejectedAndTheModelKept) {
+  // 1e307 per unit of x0 over [0, 100]: finite at the centroid, past the largest double at
+  // x0 = 100. Read as the 2-input double model.
+  const char* text =
+      "VARIABLES = 3:\nx0 : [0, 100];\nx1 : [0, 1];\nx2 : [0, 1];\nOUTPUT = x2;\n"
+      "LINEARFORMS = 2;\n0 : 1e307 (x0 - 0) + 1 (x1 - 0) - 1 (x2 - 0);\n"
+      "1 : 1 (x0 - 0) + 1 (x1 - 0) - 1 (x2 - 0);\nBLOCKS = 1;\n0 : MIN(0, 1);\n";
+  static ModelD m;
+  const std::size_t before = m.piece_count();
+  aln::TextError err;
+  CHECK_FALSE(aln::read_text(text, std::strlen(text), m, err));
+  STRCMP_CONTAINS("overflows", err.what());
+  LONGS_EQUAL(before, m.piece_count());
+  // The same form with x0 only up to 10 reads (1e308 < the largest double).
+  const char* fits =
+      "VARIABLES = 3:\nx0 : [0, 10];\nx1 : [0, 1];\nx2 : [0, 1];\nOUTPUT = x2;\n"
+      "LINEARFORMS = 2;\n0 : 1e307 (x0 - 0) + 1 (x1 - 0) - 1 (x2 - 0);\n"
+      "1 : 1 (x0 - 0) + 1 (x1 - 0) - 1 (x2 - 0);\nBLOCKS = 1;\n0 : MIN(0, 1);\n";
+  CHECK_TRUE(aln::read_text(fits, std::strlen(fits), m, err));
+  LONGS_EQUAL(2, m.piece_count());
+}

@@ -491,6 +491,18 @@ bool read_text(const char* text, std::size_t length, Aln<Scalar, N, MaxPieces>& 
       }
     }
   }
+  // Every form finite all over the input box: |bias| + sum |w_i| max(|lo_i|, |hi_i|) bounds
+  // its value there and every partial sum of evaluating it, so if that is finite no
+  // evaluation in the box overflows.
+  for (std::size_t f = 0; f < forms; ++f) {
+    Scalar bound = std::fabs(pieces[f].bias);
+    for (std::size_t v = 0; v < kVars; ++v) {
+      if (v == output) continue;
+      const Scalar reach = std::max(std::fabs(ranges[v].lo), std::fabs(ranges[v].hi));
+      bound += std::fabs(pieces[f].weight(input_of[v])) * reach;
+    }
+    if (!std::isfinite(bound)) return fail("a linear form overflows over the input ranges");
+  }
   if (!model.assign({nodes.data(), node_count}, {pieces.data(), forms})) {
     return fail("the block must use every linear form exactly once");
   }
