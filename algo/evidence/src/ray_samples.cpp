@@ -53,11 +53,9 @@ void put_plausibility(const Reading& reading, const RaySampleParams& params, Ray
       return;
     }
     // From the view: the point p, the view v, the foot reach·δr short of p along v → p.
-    const float rho = horizontal_m(reading);
-    const float px = rho * std::cos(reading.alpha_rad);
-    const float py = rho * std::sin(reading.alpha_rad);
-    const float dx = px - reading.view_x_m;
-    const float dy = py - reading.view_y_m;
+    const core::Point2 p = floor_point_m(reading);
+    const float dx = p.x_m - reading.view_x_m;
+    const float dy = p.y_m - reading.view_y_m;
     const float dz = reading.h_m - reading.view_z_m;
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float foot = d > 0.0F ? std::max(d - reach * dr, 0.0F) / d : 0.0F;  // of v → p

@@ -73,9 +73,9 @@ std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
         }
         // From q's view: u to q, w to the candidate; q beyond both range errors, within the
         // angle.
-        const float rho = evidence::horizontal_m(q);
-        const float ux = rho * std::cos(q.alpha_rad) - q.view_x_m;
-        const float uy = rho * std::sin(q.alpha_rad) - q.view_y_m;
+        const core::Point2 qp = evidence::floor_point_m(q);
+        const float ux = qp.x_m - q.view_x_m;
+        const float uy = qp.y_m - q.view_y_m;
         const float uz = q.h_m - q.view_z_m;
         const float wx = c.x_m - q.view_x_m;
         const float wy = c.y_m - q.view_y_m;
