@@ -64,8 +64,8 @@ void put_plausibility(const Reading& reading, const RaySampleParams& params, Ray
       const float x = reading.view_x_m + t * dx;
       const float y = reading.view_y_m + t * dy;
       const float z = reading.view_z_m + t * dz;
-      (void)out.push_back(
-          {core::wrap_two_pi(std::atan2(y, x)), z, std::sqrt(x * x + y * y + z * z), 0.0F});
+      const Reading free = reading_at(x, y, z, 0.0F);
+      (void)out.push_back({free.alpha_rad, free.h_m, free.r_m, 0.0F});
     }
   }
 }

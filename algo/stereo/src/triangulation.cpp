@@ -5,7 +5,6 @@
 
 #include <Eigen/Geometry>
 
-#include "algo/core/angles.h"
 
 namespace boticelli::stereo {
 
@@ -57,11 +56,8 @@ bool triangulate_fast(const CameraPose& first, const CameraPose& second,
 
 evidence::Reading reading_from_point(const Eigen::Vector3f& point_ptu_m, float evidence_m,
                                      const Eigen::Vector3f& view_ptu_m) {
-  evidence::Reading reading;
-  reading.alpha_rad = core::wrap_two_pi(std::atan2(point_ptu_m.y(), point_ptu_m.x()));
-  reading.h_m = point_ptu_m.z();
-  reading.r_m = point_ptu_m.norm();
-  reading.m = evidence_m;
+  evidence::Reading reading =
+      evidence::reading_at(point_ptu_m.x(), point_ptu_m.y(), point_ptu_m.z(), evidence_m);
   reading.view_x_m = view_ptu_m.x();
   reading.view_y_m = view_ptu_m.y();
   reading.view_z_m = view_ptu_m.z();

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "algo/core/angles.h"
 #include "algo/core/geometry.h"
 
 namespace boticelli::evidence {
@@ -19,6 +20,17 @@ struct Reading {
   float view_y_m = 0.0F;
   float view_z_m = 0.0F;
 };
+
+// The reading of the point (x, y, z) [m] in the PTU frame (§4.5.2): α = atan2(y, x) in
+// [0, 2π), h = z, r = |(x, y, z)|; evidence m, seen from the PTU centre.
+inline Reading reading_at(float x_m, float y_m, float z_m, float m) {
+  Reading r;
+  r.alpha_rad = core::wrap_two_pi(std::atan2(y_m, x_m));
+  r.h_m = z_m;
+  r.r_m = std::sqrt(x_m * x_m + (y_m * y_m + z_m * z_m));  // summed as Eigen sums a norm
+  r.m = m;
+  return r;
+}
 
 // ρ = √(r² − h²): the point's distance from the PTU's vertical axis [m] (0 when |h| ≥ r).
 inline float horizontal_m(const Reading& r) {
