@@ -5,7 +5,6 @@
 
 #include <Eigen/Geometry>
 
-
 namespace boticelli::stereo {
 
 bool triangulate_exact(const Eigen::Vector3f& c1_m, const Eigen::Vector3f& d1,
