@@ -568,6 +568,41 @@ TEST(AlnTrain, CoarseToFineSplitsOnEveryKthSampleThenRefitsOnAllWithoutSplitting
   CHECK(same_model(g_model3, g_model3b));
 }
 
+TEST(AlnTrain, TheFinePhaseStopsAfterMaxFinePassesWithTheBestModelOfThem) {
+  // The same coarse phase three times; the fine phase unbounded, capped at 2 passes (the
+  // coarse model evaluated on all samples, then one refit) and at 1 (evaluated only).
+  const std::size_t n = fill_room(2400, 0.03, 6);
+  const aln::SampleSet<float, 3> all(g_samples3, n);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.03;
+  cfg.seed = 3;
+  cfg.coarse_stride = 4;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3);
+  CHECK(g_trainer3.train(all, g_model3));
+  const aln::TrainerStats unbounded = g_trainer3.stats();
+  const std::size_t unbounded_fine = unbounded.passes - unbounded.coarse_passes;
+  CHECK(unbounded_fine > 2);
+  const double sse_unbounded = sse_over(g_model3, all);
+  cfg.max_fine_passes = 2;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.train(all, g_model3b));
+  const aln::TrainerStats two = g_trainer3.stats();
+  LONGS_EQUAL(unbounded.coarse_passes, two.coarse_passes);
+  LONGS_EQUAL(2, two.passes - two.coarse_passes);
+  const double sse_two = sse_over(g_model3b, all);
+  DOUBLES_EQUAL(std::sqrt(sse_two / static_cast<double>(n)), two.rms, 1e-4);
+  CHECK(sse_unbounded <= sse_two * (1.0 + 1e-6));  // more passes, never a worse best
+  cfg.max_fine_passes = 1;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.train(all, g_model3b));
+  LONGS_EQUAL(1, g_trainer3.stats().passes - g_trainer3.stats().coarse_passes);
+  CHECK(sse_two <= sse_over(g_model3b, all) * (1.0 + 1e-6));  // the refit was kept: better
+  CHECK(sse_two < sse_over(g_model3b, all));
+}
+
 TEST(AlnTrain, TheFinePhaseRefitsButNeverSplitsHoweverBadlyTheCoarseModelFitsAllSamples) {
   // Every 4th sample lies on a plane, the others on a V: the coarse phase sees the plane
   // only and ends with one piece at once; the fine phase refits that piece to the V's
@@ -646,6 +681,16 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   });
   // Coarse to fine.
   cfg.coarse_stride = 4;
+  g_trainer2.configure(cfg);
+  done = false;
+  CHECK_NO_ALLOCATION({
+    CHECK(g_trainer2.start(aln::SampleSet<double, 2>(g_samples2, m), g_model2));
+    while (!done) done = g_trainer2.step(500);
+  });
+  CHECK(g_trainer2.stats().coarse_passes > 0);
+  // Damped refits, two fine passes.
+  cfg.damped_refit = true;
+  cfg.max_fine_passes = 2;
   g_trainer2.configure(cfg);
   done = false;
   CHECK_NO_ALLOCATION({

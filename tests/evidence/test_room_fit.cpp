@@ -1,6 +1,7 @@
 // Tests of the occupancy fit on the thesis's simulated rooms: ray samples -> ALN trainer.
 #include <cmath>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "algo/aln/aln.h"
@@ -123,4 +124,53 @@ TEST(RoomFit, TheStereoSizedSensorModelPutsTheSafeCrossingNearerTheWallThanTheTh
   }
   CHECK_TEXT(crossing[0] < 0.85 * double{wall}, std::to_string(crossing[0]).c_str());
   CHECK_TEXT(crossing[1] > 0.87 * double{wall}, std::to_string(crossing[1]).c_str());
+}
+
+TEST(RoomFit, DampedRefitsKeepTheCorridorsSplitRoundsThatPlainRefitsUndo) {
+  // The corridor as vs-octomap fits it with the thesis's sensor model (camera readings, ray
+  // samples with pads and seam copies, hinges, coarse to fine on every 8th sample). A plain
+  // refit of the pieces after a split raised the loss (a piece's least squares ignore that
+  // moving it changes which piece is responsible where), so most rounds were undone and the
+  // fit stopped near RMS 0.2; refits damped towards the round's best model keep them.
+  const SyntheticRoom room(*find_environment("corridor"));
+  const std::vector<evidence::Reading> readings =
+      room.generate_camera_readings(CameraScan{}, 5000, 7U);
+  const evidence::RaySampleParams rays;
+  g_ray_samples.clear();
+  (void)evidence::append_ray_samples(readings, rays, g_ray_samples,
+                                     evidence::OccupancyBound::kPlausibility);
+  evidence::PadRegion region;
+  region.h_min_m = static_cast<float>(-room.sensor().z);
+  region.h_max_m = static_cast<float>(room.spec().wall_height_m - room.sensor().z);
+  region.r_max_m = static_cast<float>(room.spec().max_range_m);
+  evidence::PadRandom random{12345U};
+  (void)evidence::append_featureless_pads(readings, region, evidence::FeaturelessPadParams{},
+                                          random, g_ray_samples);
+  (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
+  std::vector<aln::Sample<float, 3>> samples(g_ray_samples.size());
+  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
+    const evidence::RaySample& s = g_ray_samples[i];
+    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
+    samples[i].y = s.occupancy;
+  }
+  aln::TrainerConfig cfg;
+  cfg.split = aln::SplitCandidates::kHinges;
+  cfg.coarse_stride = 8;
+  cfg.max_fine_passes = 2;
+  double rms[2] = {0.0, 0.0};
+  std::size_t failed[2] = {0, 0};
+  for (int damped = 0; damped < 2; ++damped) {
+    cfg.damped_refit = damped == 1;
+    configure_room_model(g_model, room, evidence::alpha_slope_bound_per_rad(rays.delta_r_fraction));
+    g_trainer.configure(cfg);
+    CHECK(g_trainer.train(aln::SampleSet<float, 3>(samples.data(), samples.size()), g_model));
+    rms[damped] = rms_of(g_model, samples);
+    failed[damped] = g_trainer.stats().failed_rounds;
+    CHECK(g_model.pieces_within_bounds());
+  }
+  const std::string text = std::to_string(rms[0]) + " " + std::to_string(failed[0]) + " / " +
+                           std::to_string(rms[1]) + " " + std::to_string(failed[1]);
+  // Plain refits (measured on x86-64: RMS 0.199, 6 rounds undone) are not checked: that they
+  // fail is the problem, not a contract. Damped: RMS 0.107, 1 round undone.
+  CHECK_TEXT(failed[1] <= 2 && rms[1] <= 0.15, text.c_str());
 }

@@ -119,7 +119,8 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
 }
 
 // The fit's settings: the thesis's epsilon and 10 split rounds unless the knobs say otherwise,
-// hinge splits, coarse to fine on every 4th sample (TrainerConfig::coarse_stride).
+// hinge splits, damped refits, coarse to fine on every 8th sample with two passes over all of
+// them (TrainerConfig::damped_refit, coarse_stride, max_fine_passes).
 aln::TrainerConfig trainer_config() {
   aln::TrainerConfig cfg;
   const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
@@ -129,8 +130,13 @@ aln::TrainerConfig trainer_config() {
       rounds != nullptr && *rounds != '\0' ? std::strtoul(rounds, nullptr, 10) : 10;
   cfg.max_pieces = kMaxPieces;
   cfg.split = aln::SplitCandidates::kHinges;
-  const char* stride = std::getenv("BOTICELLI_VS_OCTOMAP_COARSE_STRIDE");  // default 4
-  cfg.coarse_stride = stride != nullptr && *stride != '\0' ? std::strtoul(stride, nullptr, 10) : 4;
+  const char* stride = std::getenv("BOTICELLI_VS_OCTOMAP_COARSE_STRIDE");  // default 8
+  cfg.coarse_stride = stride != nullptr && *stride != '\0' ? std::strtoul(stride, nullptr, 10) : 8;
+  // Passes over all samples after the coarse phase; 0: until the loss stops falling.
+  const char* fine = std::getenv("BOTICELLI_VS_OCTOMAP_FINE_PASSES");  // default 2
+  cfg.max_fine_passes = fine != nullptr && *fine != '\0' ? std::strtoul(fine, nullptr, 10) : 2;
+  const char* damped = std::getenv("BOTICELLI_VS_OCTOMAP_DAMPED");  // 0 turns it off
+  cfg.damped_refit = damped == nullptr || *damped != '0';
   return cfg;
 }
 
@@ -210,6 +216,9 @@ struct BuildParts {
   std::size_t samples = 0;
   std::size_t passes = 0;
   std::size_t coarse_passes = 0;  // of them over every coarse_stride-th sample
+  std::size_t rounds = 0;         // split rounds kept (TrainerStats::iterations)
+  std::size_t failed_rounds = 0;  // split rounds undone
+  double rms = 0.0;               // the fit's RMS over all samples
 };
 
 void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
@@ -234,7 +243,10 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
         .num("guard_ms", parts.guard_ms)
         .integer("samples", static_cast<std::int64_t>(parts.samples))
         .integer("passes", static_cast<std::int64_t>(parts.passes))
-        .integer("coarse_passes", static_cast<std::int64_t>(parts.coarse_passes));
+        .integer("coarse_passes", static_cast<std::int64_t>(parts.coarse_passes))
+        .integer("rounds", static_cast<std::int64_t>(parts.rounds))
+        .integer("failed_rounds", static_cast<std::int64_t>(parts.failed_rounds))
+        .num("rms", parts.rms);
   }
   line.emit();
 }
@@ -442,6 +454,9 @@ int run() {
         parts.samples = samples.size();
         parts.passes = g_trainer.stats().passes;
         parts.coarse_passes = g_trainer.stats().coarse_passes;
+        parts.rounds = g_trainer.stats().iterations;
+        parts.failed_rounds = g_trainer.stats().failed_rounds;
+        parts.rms = g_trainer.stats().rms;
         const std::int64_t t_guard = cpu_ns();
         // The feature guard: readings the fit calls free, kept where they cluster.
         g_candidates.clear();

@@ -65,6 +65,13 @@ struct TrainerConfig {
   // until the loss stops falling, then pruning; no more splits). The model returned is the
   // best of the fine passes, all of them judged on every sample. 1 (the default): one phase.
   std::size_t coarse_stride = 1;
+  // Passes of the fine phase (0: max_refit_passes, and until the loss stops falling).
+  std::size_t max_fine_passes = 0;
+  // A refit that raised the loss (a piece's least squares ignore that moving it changes which
+  // piece is responsible where) is retried from the best model of the round with half the
+  // step towards the least-squares pieces, then a quarter; false: the round ends after two
+  // such passes, refitting from the worse model's sums.
+  bool damped_refit = false;
 };
 
 struct TrainerStats {
@@ -432,7 +439,7 @@ class Trainer {
   }
 
   // Least-squares refit of piece p from its sums, honouring the weight bounds exactly.
-  void refit(std::size_t p, const Accumulator& a) {
+  void refit(std::size_t p, const Accumulator& a, double step = 1.0) {
     if (a.sw <= 0.0 || a.count == 0) return;
     PieceType& piece = model_->piece(p);
     const VecD xbar = a.sx / a.sw;
@@ -453,7 +460,14 @@ class Trainer {
     VecD w = w_now;
     if (!solve_box_constrained_lsq<N>(c, g, lo_b, hi_b, w)) return;
     const Vec centroid = piece.centroid + xbar.template cast<Scalar>();
-    const Scalar cy = piece.centroid_output + static_cast<Scalar>(ybar);
+    Scalar cy = piece.centroid_output + static_cast<Scalar>(ybar);
+    if (step < 1.0) {
+      // Part of the way from the piece as it is to its least-squares fit, both taken at the
+      // new centroid (a convex combination: the weights stay within their bounds).
+      const double old_at = static_cast<double>(piece.centroid_output) + w_now.dot(xbar);
+      w = (1.0 - step) * w_now + step * w;
+      cy = static_cast<Scalar>((1.0 - step) * old_at + step * static_cast<double>(cy));
+    }
     piece.set(w.template cast<Scalar>(), centroid, cy);
   }
 
@@ -492,8 +506,21 @@ class Trainer {
     } else {
       ++stall_;
     }
-    const Accumulators& evaluated = improved ? *best_ : *current_;
-    if (stall_ >= 2 || pass_in_round_ >= config_.max_refit_passes) {
+    if (config_.damped_refit) {
+      step_ = improved ? 1.0 : 0.5 * step_;
+      if (!improved) {
+        for (std::size_t p = 0; p < pieces; ++p) {
+          model_->piece(p) = best_pieces_[p];
+          scale_[p] = best_scale_[p];
+        }
+      }
+    }
+    const Accumulators& evaluated = improved || config_.damped_refit ? *best_ : *current_;
+    const std::size_t pass_cap = refining_ && config_.max_fine_passes > 0
+                                     ? config_.max_fine_passes - 1
+                                     : config_.max_refit_passes;
+    const std::size_t stall_cap = config_.damped_refit ? 3 : 2;
+    if (stall_ >= stall_cap || pass_in_round_ >= pass_cap) {
       for (std::size_t p = 0; p < pieces; ++p) {
         model_->piece(p) = best_pieces_[p];
         scale_[p] = best_scale_[p];
@@ -504,7 +531,7 @@ class Trainer {
     }
     update_scales(evaluated);
     keep_spans(evaluated);
-    for (std::size_t p = 0; p < pieces; ++p) refit(p, evaluated[p]);
+    for (std::size_t p = 0; p < pieces; ++p) refit(p, evaluated[p], step_);
     pass_in_round_ += 1;
     next_pass();
   }
@@ -942,6 +969,7 @@ class Trainer {
   std::size_t pass_in_round_ = 0;
   double best_objective_ = 0.0;
   std::size_t stall_ = 0;
+  double step_ = 1.0;  // of the refits (TrainerConfig::damped_refit)
   // The model before the last round's splits, to undo them if they did not help.
   Model saved_model_{};
   Accumulators saved_acc_{};
