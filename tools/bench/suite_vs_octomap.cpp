@@ -35,6 +35,7 @@ namespace {
 
 constexpr const char* kSuite = "vs-octomap";
 constexpr std::size_t kMaxPieces = 256;
+constexpr std::size_t kBudgetPieces = 40;
 constexpr std::size_t kFeatures = 5000;
 constexpr std::size_t kMaxRaySamples = 200000;
 constexpr double kGridStepM = 0.02;  // ground-truth area integration
@@ -119,8 +120,8 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
 }
 
 // The fit's settings: the thesis's epsilon and 10 split rounds unless the knobs say otherwise,
-// hinge splits, damped refits, coarse to fine on every 8th sample with two passes over all of
-// them (TrainerConfig::damped_refit, coarse_stride, max_fine_passes).
+// at most 40 pieces, hinge splits, damped refits, coarse to fine on every 8th sample with two
+// passes over all of them (TrainerConfig::damped_refit, coarse_stride, max_fine_passes).
 aln::TrainerConfig trainer_config() {
   aln::TrainerConfig cfg;
   const char* eps = std::getenv("BOTICELLI_VS_OCTOMAP_EPSILON");  // default: the thesis's 0.15
@@ -128,7 +129,11 @@ aln::TrainerConfig trainer_config() {
   const char* rounds = std::getenv("BOTICELLI_VS_OCTOMAP_ROUNDS");  // split rounds, default 10
   cfg.max_iterations =
       rounds != nullptr && *rounds != '\0' ? std::strtoul(rounds, nullptr, 10) : 10;
-  cfg.max_pieces = kMaxPieces;
+  // The model's 2 KB budget: 40 pieces (and their nodes) take about 1.75 KB, which leaves
+  // room for a few guard points.
+  const char* pieces = std::getenv("BOTICELLI_VS_OCTOMAP_MAX_PIECES");  // default 40
+  cfg.max_pieces =
+      pieces != nullptr && *pieces != '\0' ? std::strtoul(pieces, nullptr, 10) : kBudgetPieces;
   cfg.split = aln::SplitCandidates::kHinges;
   const char* stride = std::getenv("BOTICELLI_VS_OCTOMAP_COARSE_STRIDE");  // default 8
   cfg.coarse_stride = stride != nullptr && *stride != '\0' ? std::strtoul(stride, nullptr, 10) : 8;
