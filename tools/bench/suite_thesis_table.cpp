@@ -361,6 +361,7 @@ int run_thesis_table() {
         cfg.max_iterations = env_size("BOTICELLI_THESIS_ITERATIONS", 10);  // rounds kept
         cfg.count_undone_rounds = false;
         cfg.max_refit_passes = env_size("BOTICELLI_THESIS_PASSES", 8);
+        cfg.damped_refit = env_size("BOTICELLI_THESIS_DAMPED", 0) != 0;
         cfg.max_pieces = kMaxPieces;
         cfg.split_rule = run.rule;
         cfg.robust = run.robust;
