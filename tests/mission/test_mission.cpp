@@ -38,7 +38,8 @@ struct MissionRun {
   std::vector<sim::TraceRow> trace;
   sim::TraceCheck check{};
   double target_error_m = -1.0;
-  bool telemetry_confirmed = false;  // a TLM line reported the target confirmed
+  bool telemetry_confirmed = false;     // a TLM line reported the target confirmed
+  boticelli::core::Pose2 final_pose{};  // the robot's true pose when the firmware returned
 };
 
 std::string slurp(const std::string& path) {
@@ -80,6 +81,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   dup2(fileno(null_in), 0);
   run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(argv.size()), argv.data(),
                                                      g_board, hooks);
+  run.final_pose = g_board.robot_pose();
   std::fflush(stdout);
   dup2(saved, 1);
   dup2(saved_in, 0);
@@ -395,28 +397,45 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   CHECK_TEXT(std::hypot(stopped.x_m - first.trace.front().x_m,
                         stopped.y_m - first.trace.front().y_m) > 0.3,
              "the first run drove somewhere");
+  // The pose the first run saved at shutdown (in the mission's frame).
+  double saved[3] = {0.0, 0.0, 0.0};
+  {
+    std::istringstream state(slurp(dir + "/mission.state"));
+    std::string line;
+    bool found = false;
+    while (std::getline(state, line)) {
+      std::istringstream words(line);
+      std::string key;
+      if (words >> key && key == "pose")
+        found = static_cast<bool>(words >> saved[0] >> saved[1] >> saved[2]);
+    }
+    CHECK_TEXT(found, "the state file holds the pose");
+  }
   const MissionRun second =
       run_mission("thesis_room", "1", 0.0F, nullptr, {"--state", dir.c_str(), "--resume"});
   check_found_safely(second);
-  // Put back where the base came to rest (the trace keeps 4 decimals, and its last row may be
-  // a frame older than the last odometry). On this run the base has stopped when the last
-  // cycle ends; where it had not (it rolled 2.4 mm on in a run of other Look settings), the
-  // pose saved at shutdown is the one that holds this.
+  // Put back where the base came to rest: the true pose when the first run's firmware
+  // returned (the trace keeps 4 decimals). Its last trace row may be a frame older: the last
+  // cycle can end mid-drive, and the base rolls on a few mm while it stops.
   const sim::TraceRow& resumed = second.trace.front();
-  DOUBLES_EQUAL(stopped.x_m, resumed.x_m, 0.0005);
-  DOUBLES_EQUAL(stopped.y_m, resumed.y_m, 0.0005);
-  DOUBLES_EQUAL(0.0, std::remainder(stopped.yaw_rad - resumed.yaw_rad, 2.0 * std::numbers::pi),
-                0.0005);
-  // The pose in the mission's frame (the trace's odometry columns) carries on too: the map
-  // and the goal saved in that frame still fit.
+  const double rest_x = first.final_pose.x_m;
+  const double rest_y = first.final_pose.y_m;
+  const double rest_yaw = first.final_pose.yaw_rad;
+  DOUBLES_EQUAL(rest_x, resumed.x_m, 0.0005);
+  DOUBLES_EQUAL(rest_y, resumed.y_m, 0.0005);
+  DOUBLES_EQUAL(0.0, std::remainder(rest_yaw - resumed.yaw_rad, 2.0 * std::numbers::pi), 0.0005);
+  CHECK(std::hypot(stopped.x_m - resumed.x_m, stopped.y_m - resumed.y_m) < 0.05);
+  // The pose in the mission's frame (the trace's odometry columns) carries on too, from the
+  // pose saved at shutdown: the map and the goal saved in that frame still fit.
   double before[3] = {0.0, 0.0, 0.0};
   double after[3] = {1.0, 1.0, 1.0};
   trace_odometry(first.trace_path, true, before);
   trace_odometry(second.trace_path, false, after);
   CHECK_TEXT(std::hypot(before[0], before[1]) > 0.3, "the first run's frame moved with the robot");
-  DOUBLES_EQUAL(before[0], after[0], 0.002);
-  DOUBLES_EQUAL(before[1], after[1], 0.002);
-  DOUBLES_EQUAL(0.0, std::remainder(before[2] - after[2], 2.0 * std::numbers::pi), 0.002);
+  CHECK(std::hypot(before[0] - saved[0], before[1] - saved[1]) < 0.05);
+  DOUBLES_EQUAL(saved[0], after[0], 0.002);
+  DOUBLES_EQUAL(saved[1], after[1], 0.002);
+  DOUBLES_EQUAL(0.0, std::remainder(saved[2] - after[2], 2.0 * std::numbers::pi), 0.002);
   // The cycle count carries on from the saved state.
   const std::size_t c = second.mission_line.find("cycles=");
   CHECK(c != std::string::npos);
