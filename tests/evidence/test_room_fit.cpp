@@ -31,13 +31,8 @@ std::vector<aln::Sample<float, 3>> room_samples(const SyntheticRoom& room, std::
   g_ray_samples.clear();
   (void)evidence::append_ray_samples(readings, params, g_ray_samples);
   (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
-  std::vector<aln::Sample<float, 3>> samples(g_ray_samples.size());
-  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
-    const evidence::RaySample& s = g_ray_samples[i];
-    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
-    samples[i].y = s.occupancy;
-  }
-  return samples;
+  return to_fit_samples(
+      std::span<const evidence::RaySample>(g_ray_samples.data(), g_ray_samples.size()));
 }
 
 std::vector<aln::Sample<float, 3>> room_samples(const SyntheticRoom& room, std::size_t features,
@@ -136,23 +131,8 @@ TEST(RoomFit, DampedRefitsKeepTheCorridorsSplitRoundsThatPlainRefitsUndo) {
   const std::vector<evidence::Reading> readings =
       room.generate_camera_readings(CameraScan{}, 5000, 7U);
   const evidence::RaySampleParams rays;
-  g_ray_samples.clear();
-  (void)evidence::append_ray_samples(readings, rays, g_ray_samples,
-                                     evidence::OccupancyBound::kPlausibility);
-  evidence::PadRegion region;
-  region.h_min_m = static_cast<float>(-room.sensor().z);
-  region.h_max_m = static_cast<float>(room.spec().wall_height_m - room.sensor().z);
-  region.r_max_m = static_cast<float>(room.spec().max_range_m);
-  evidence::PadRandom random{12345U};
-  (void)evidence::append_featureless_pads(readings, region, evidence::FeaturelessPadParams{},
-                                          random, g_ray_samples);
-  (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
-  std::vector<aln::Sample<float, 3>> samples(g_ray_samples.size());
-  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
-    const evidence::RaySample& s = g_ray_samples[i];
-    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
-    samples[i].y = s.occupancy;
-  }
+  const std::vector<aln::Sample<float, 3>> samples =
+      room_fit_samples(room, readings, rays, g_ray_samples);
   aln::TrainerConfig cfg;
   cfg.split = aln::SplitCandidates::kHinges;
   cfg.coarse_stride = 8;

@@ -253,13 +253,8 @@ std::vector<AlnSample> build_samples(const SyntheticRoom& room,
         evidence::append_featureless_pads(readings, region, pad_params, random, g_ray_samples);
   }
   (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
-  std::vector<AlnSample> samples(g_ray_samples.size());
-  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
-    const evidence::RaySample& s = g_ray_samples[i];
-    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
-    samples[i].y = s.occupancy;
-  }
-  return samples;
+  return to_fit_samples(
+      std::span<const evidence::RaySample>(g_ray_samples.data(), g_ray_samples.size()));
 }
 
 int parse_feature_list(std::size_t* out, int max) {

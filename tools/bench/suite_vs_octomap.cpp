@@ -99,24 +99,7 @@ void configure_model(Model& model, const SyntheticRoom& room,
 std::vector<AlnSample> build_samples(const SyntheticRoom& room,
                                      const std::vector<evidence::Reading>& readings,
                                      const evidence::RaySampleParams& params) {
-  g_ray_samples.clear();
-  (void)evidence::append_ray_samples(readings, params, g_ray_samples,
-                                     evidence::OccupancyBound::kPlausibility);
-  evidence::PadRegion region;
-  region.h_min_m = static_cast<float>(-room.sensor().z);
-  region.h_max_m = static_cast<float>(room.spec().wall_height_m - room.sensor().z);
-  region.r_max_m = static_cast<float>(room.spec().max_range_m);
-  evidence::PadRandom random{12345U};
-  (void)evidence::append_featureless_pads(readings, region, evidence::FeaturelessPadParams{},
-                                          random, g_ray_samples);
-  (void)evidence::append_seam_copies(g_ray_samples, evidence::kSeamMarginRad);
-  std::vector<AlnSample> samples(g_ray_samples.size());
-  for (std::size_t i = 0; i < g_ray_samples.size(); ++i) {
-    const evidence::RaySample& s = g_ray_samples[i];
-    samples[i].x = Eigen::Vector3f(s.alpha_rad, s.h_m, s.r_m);
-    samples[i].y = s.occupancy;
-  }
-  return samples;
+  return room_fit_samples(room, readings, params, g_ray_samples);
 }
 
 // The fit's settings: the thesis's epsilon and 10 split rounds unless the knobs say otherwise,

@@ -398,4 +398,31 @@ std::vector<evidence::Reading> SyntheticRoom::generate_camera_readings(
   return out;
 }
 
+std::vector<aln::Sample<float, 3>> to_fit_samples(std::span<const evidence::RaySample> samples) {
+  std::vector<aln::Sample<float, 3>> out(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    out[i].x = Eigen::Vector3f(samples[i].alpha_rad, samples[i].h_m, samples[i].r_m);
+    out[i].y = samples[i].occupancy;
+  }
+  return out;
+}
+
+std::vector<aln::Sample<float, 3>> room_fit_samples(const SyntheticRoom& room,
+                                                    std::span<const evidence::Reading> readings,
+                                                    const evidence::RaySampleParams& params,
+                                                    evidence::RaySampleBuffer& buffer) {
+  buffer.clear();
+  (void)evidence::append_ray_samples(readings, params, buffer,
+                                     evidence::OccupancyBound::kPlausibility);
+  evidence::PadRegion region;
+  region.h_min_m = static_cast<float>(-room.sensor().z);
+  region.h_max_m = static_cast<float>(room.spec().wall_height_m - room.sensor().z);
+  region.r_max_m = static_cast<float>(room.spec().max_range_m);
+  evidence::PadRandom random{12345U};
+  (void)evidence::append_featureless_pads(readings, region, evidence::FeaturelessPadParams{},
+                                          random, buffer);
+  (void)evidence::append_seam_copies(buffer, evidence::kSeamMarginRad);
+  return to_fit_samples(std::span<const evidence::RaySample>(buffer.data(), buffer.size()));
+}
+
 }  // namespace boticelli::bench

@@ -8,7 +8,9 @@
 #include <span>
 #include <vector>
 
+#include "algo/aln/samples.h"
 #include "algo/evidence/occupancy_model.h"
+#include "algo/evidence/ray_samples.h"
 #include "algo/evidence/reading.h"
 
 namespace boticelli::bench {
@@ -146,6 +148,17 @@ class SyntheticRoom {
                    std::vector<evidence::Reading>& out) const;
   RoomSpec spec_;
 };
+
+// Ray samples as the ALN's training samples: x = (α, h, r), y = the occupancy, weight 1.
+std::vector<aln::Sample<float, 3>> to_fit_samples(std::span<const evidence::RaySample> samples);
+
+// What the vs-octomap suite fits to a room's readings: their ray samples (Fig 4.2b, the
+// plausibility bound), zero pads in featureless directions over the room's heights and range
+// (§4.9.1, seeded) and seam copies, built in `buffer` (cleared first).
+std::vector<aln::Sample<float, 3>> room_fit_samples(const SyntheticRoom& room,
+                                                    std::span<const evidence::Reading> readings,
+                                                    const evidence::RaySampleParams& params,
+                                                    evidence::RaySampleBuffer& buffer);
 
 // Sets `model`'s input box and weight bounds (evidence::configure_occupancy_model) for the
 // room: heights from the floor to the wall tops relative to the sensor, ranges to 1.2 times

@@ -463,7 +463,7 @@ class Trainer {
     Scalar cy = piece.centroid_output + static_cast<Scalar>(ybar);
     if (step < 1.0) {
       // Part of the way from the piece as it is to its least-squares fit, both taken at the
-      // new centroid (a convex combination: the weights stay within their bounds).
+      // refitted centroid (a convex combination: the weights stay within their bounds).
       const double old_at = static_cast<double>(piece.centroid_output) + w_now.dot(xbar);
       w = (1.0 - step) * w_now + step * w;
       cy = static_cast<Scalar>((1.0 - step) * old_at + step * static_cast<double>(cy));
