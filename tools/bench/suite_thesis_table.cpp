@@ -299,8 +299,15 @@ double epsilon() {
   return v != nullptr && *v != '\0' ? std::strtod(v, nullptr) : kThesisEpsilon;
 }
 
+// The bound on |∂F/∂α| [1/rad]: the thesis's 1 (Eq 4.28) unless BOTICELLI_THESIS_ALPHA_SLOPE.
+float alpha_slope_bound() {
+  const char* v = std::getenv("BOTICELLI_THESIS_ALPHA_SLOPE");
+  return v != nullptr && *v != '\0' ? std::strtof(v, nullptr) : evidence::kMaxAlphaSlopePerRad;
+}
+
 int run_thesis_table() {
   const double kEpsilon = epsilon();
+  const float alpha_slope = alpha_slope_bound();
   std::size_t feature_counts[8];
   const int n_counts = parse_feature_list(feature_counts, 8);
   const char* only = std::getenv("BOTICELLI_THESIS_ROWS");  // comma list of names, optional
@@ -350,7 +357,7 @@ int run_thesis_table() {
         }
         std::size_t pad_count = 0;
         const std::vector<AlnSample> samples = build_samples(room, readings, run.pads, &pad_count);
-        configure_room_model(g_model, room);
+        configure_room_model(g_model, room, alpha_slope);
         aln::TrainerConfig cfg;
         cfg.epsilon = kEpsilon;
         cfg.max_iterations = env_size("BOTICELLI_THESIS_ITERATIONS", 10);  // rounds kept
@@ -421,7 +428,8 @@ int run_thesis_table() {
     {kSuite,
      "regression fusion (ALN) vs a 0.1 m log-odds grid on the thesis's simulated rooms "
      "(4.8.2); env BOTICELLI_THESIS_FEATURES=500,5000 BOTICELLI_THESIS_ROWS=name,... "
-     "BOTICELLI_THESIS_EPSILON=0.15 BOTICELLI_THESIS_ITERATIONS=10",
+     "BOTICELLI_THESIS_EPSILON=0.15 BOTICELLI_THESIS_ITERATIONS=10 "
+     "BOTICELLI_THESIS_ALPHA_SLOPE=1 BOTICELLI_THESIS_DAMPED=0",
      &run_thesis_table});
 
 }  // namespace
