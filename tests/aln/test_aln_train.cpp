@@ -689,7 +689,6 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   cfg.max_fine_passes = 2;
   train_wall_step(false);
   CHECK(g_trainer2.stats().coarse_passes > 0);
-  CHECK(g_trainer2.stats().passes - g_trainer2.stats().coarse_passes <= 2);
 }
 
 TEST(AlnTrain, AnEmptySampleSetIsRefused) {
