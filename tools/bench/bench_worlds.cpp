@@ -38,6 +38,18 @@ bool strip_sdf(std::string& name) {
 }
 }  // namespace
 
+bool listed(const char* list, std::string_view name) {
+  if (list == nullptr || *list == '\0') return true;
+  const std::string_view names(list);
+  std::size_t begin = 0;
+  while (begin <= names.size()) {
+    const std::size_t end = std::min(names.find(',', begin), names.size());
+    if (names.substr(begin, end - begin) == name) return true;
+    begin = end + 1;
+  }
+  return false;
+}
+
 std::vector<std::string> world_names(const std::string& dir, const char* filter_env,
                                      const char* suite) {
   std::vector<std::string> names;

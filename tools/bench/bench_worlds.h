@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace boticelli::bench {
@@ -10,6 +11,10 @@ namespace boticelli::bench {
 long env_long(const char* name, long fallback);
 // The environment variable as a number, else `fallback`.
 double env_double(const char* name, double fallback);
+
+// Whether `name` is one of the comma-separated entries of `list`; every name is when `list`
+// is null or empty (an unset filter variable).
+bool listed(const char* list, std::string_view name);
 
 // The environment variable `dir_env` if set, else `fallback` (a folder of *.sdf worlds).
 std::string worlds_dir(const char* dir_env, const char* fallback);

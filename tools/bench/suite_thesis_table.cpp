@@ -19,6 +19,7 @@
 #include "algo/evidence/ray_samples.h"
 #include "algo/fusion/evidence_grid.h"
 #include "bench.h"
+#include "bench_worlds.h"
 #include "synthetic_rooms.h"
 
 namespace boticelli::bench {
@@ -277,23 +278,6 @@ int parse_feature_list(std::size_t* out, int max) {
   return n;
 }
 
-// True if `name` is one of the comma-separated entries of `list`.
-bool listed(const char* list, const char* name) {
-  const std::size_t n = std::strlen(name);
-  for (const char* p = list; *p != '\0';) {
-    const char* end = std::strchr(p, ',');
-    const std::size_t len = end != nullptr ? static_cast<std::size_t>(end - p) : std::strlen(p);
-    if (len == n && std::strncmp(p, name, n) == 0) {
-      return true;
-    }
-    if (end == nullptr) {
-      break;
-    }
-    p = end + 1;
-  }
-  return false;
-}
-
 double epsilon() {
   const char* v = std::getenv("BOTICELLI_THESIS_EPSILON");
   return v != nullptr && *v != '\0' ? std::strtod(v, nullptr) : kThesisEpsilon;
@@ -312,7 +296,7 @@ int run_thesis_table() {
   const int n_counts = parse_feature_list(feature_counts, 8);
   const char* only = std::getenv("BOTICELLI_THESIS_ROWS");  // comma list of names, optional
   for (const RoomSpec& spec : thesis_environments()) {
-    if (only != nullptr && *only != '\0' && !listed(only, spec.name)) {
+    if (!listed(only, spec.name)) {
       continue;
     }
     const SyntheticRoom room(spec);

@@ -23,6 +23,7 @@
 #include "algo/mapping/feature_guard.h"
 #include "algo/mapping/polygon_ops.h"
 #include "bench.h"
+#include "bench_worlds.h"
 #include "synthetic_rooms.h"
 
 #if defined(BOTICELLI_HAVE_OCTOMAP)
@@ -412,9 +413,11 @@ int run() {
   const char* rooms[] = {"cylinder_centre", "cylinder_offcentre_outliers", "rectangle",
                          "corridor",        "cylinder_box_view1",          "rectangle_box_case1"};
   const int reps = 21;
+  // Rooms to run, comma-separated names (default: all six).
+  const char* only = std::getenv("BOTICELLI_VS_OCTOMAP_ROOMS");
   for (const char* name : rooms) {
     const RoomSpec* spec = find_environment(name);
-    if (spec == nullptr) continue;
+    if (spec == nullptr || !listed(only, name)) continue;
     const SyntheticRoom room(*spec);
     const mapping::ExtractionParams p = extraction_params(room);
     for (const double b : {0.0, kStereoRangeErrorB}) {
