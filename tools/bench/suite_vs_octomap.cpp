@@ -124,6 +124,9 @@ aln::TrainerConfig trainer_config() {
   // Passes over all samples after the coarse phase; 0: until the loss stops falling.
   const char* fine = std::getenv("BOTICELLI_VS_OCTOMAP_FINE_PASSES");  // default 2
   cfg.max_fine_passes = fine != nullptr && *fine != '\0' ? std::strtoul(fine, nullptr, 10) : 2;
+  const char* refits = std::getenv("BOTICELLI_VS_OCTOMAP_REFIT_PASSES");  // per round, default 8
+  if (refits != nullptr && *refits != '\0')
+    cfg.max_refit_passes = std::strtoul(refits, nullptr, 10);
   const char* damped = std::getenv("BOTICELLI_VS_OCTOMAP_DAMPED");  // 0 turns it off
   cfg.damped_refit = damped == nullptr || *damped != '0';
   return cfg;

@@ -280,10 +280,10 @@ class Aln {
   // with branch-free MIN/MAX per lane. Same values and pieces as evaluate() (ties to the first
   // child; each piece's value summed in the order Piece::value sums it). For passes over
   // many samples (training) and rays; a lone query is cheaper by evaluate_alpha_beta().
-  static constexpr std::size_t kBlock = 8;
+  static constexpr std::size_t kBlock = 16;
   using Lanes = Eigen::Array<Scalar, static_cast<int>(kBlock), 1>;
   // Writes value[k] and piece[k] for k < count = min(x.size(), kBlock, value.size(),
-  // piece.size()); returns count. Its stack holds 2 x MaxPieces x kBlock Scalars (16 KB for
+  // piece.size()); returns count. Its stack holds 2 x MaxPieces x kBlock Scalars (32 KB for
   // 256 float pieces).
   std::size_t evaluate_block(std::span<const Vec> x, std::span<Scalar> value,
                              std::span<std::uint16_t> piece) const {

@@ -98,10 +98,11 @@ struct TrainerStats {
 // stops falling, pieces whose error exceeds epsilon are split, pieces no sample uses are
 // pruned, and the next round starts. A split (TrainerConfig::split) is either a V at the
 // piece's centroid (two tilted copies, MAX if the residuals rise towards the rim of its
-// region, else MIN) or the best of many hinge candidates scored from the same pass's sums
-// (as in max-affine regression, Magnani & Boyd 2009): a hinge on each input at each of
-// kSplitBins - 1 positions across the piece's samples, on either side, as MAX(piece,
-// piece + tilt) where the residuals rise beyond the hinge or MIN where they fall. Stops at
+// region, else MIN) or the best of many hinge candidates scored from binned sums (as in
+// max-affine regression, Magnani & Boyd 2009) that one more pass over the round's model
+// gathers: a hinge on each input at each of kSplitBins - 1 positions across the piece's
+// samples in that pass, on either side, as MAX(piece, piece + tilt) where the residuals rise
+// beyond the hinge or MIN where they fall. Stops at
 // epsilon, at the piece cap or at the iteration cap; the model is always one that was
 // evaluated, with every piece inside its bounds. Models are compared by the robust loss at a fixed
 // scale (TrainerStats::robust_loss), not by the robust-weighted squared error, which a Tukey fit
@@ -249,6 +250,7 @@ class Trainer {
     failed_rounds_ = 0;
     unevaluated_ = false;
     checking_ = false;
+    binning_ = false;
     tried_.fill(0);
     begin_pass();
     stats_.pieces = model_->piece_count();
@@ -266,7 +268,7 @@ class Trainer {
 
   // Per-piece sums over the samples it is responsible for, in coordinates shifted by the
   // piece's centroid at the start of the pass (better conditioned).
-  struct Accumulator {
+  struct PieceSums {
     double sw = 0.0;  // sum of (robust) weights
     std::size_t count = 0;
     VecD sx = VecD::Zero();
@@ -288,7 +290,15 @@ class Trainer {
     VecD bin_step = VecD::Ones();
     VecD seen_lo = VecD::Constant(std::numeric_limits<double>::infinity());
     VecD seen_hi = VecD::Constant(-std::numeric_limits<double>::infinity());
+  };
+  struct Accumulator : PieceSums {
     std::array<std::array<HingeBin, kSplitBins>, static_cast<std::size_t>(N)> bins{};
+
+    // Zero sums for a pass; the bins (most of the bytes) only for a pass that fills them.
+    void reset(bool with_bins) {
+      static_cast<PieceSums&>(*this) = PieceSums{};
+      if (with_bins) bins = {};
+    }
   };
   using Accumulators = std::array<Accumulator, MaxPieces>;
 
@@ -344,7 +354,7 @@ class Trainer {
   void begin_pass() {
     Accumulators& acc = *current_;
     for (std::size_t p = 0; p < model_->piece_count(); ++p) {
-      acc[p] = Accumulator{};
+      acc[p].reset(binning_);
       for (int j = 0; j < N; ++j) {
         const double lo_j = span_lo_[p](j);
         const double span = span_hi_[p](j) - lo_j;
@@ -401,7 +411,14 @@ class Trainer {
       }
       return;
     }
-    if constexpr (kSplitBins > 0) add_to_bins(s, w, r, a);
+    for (int j = 0; j < N; ++j) {
+      const double xj = static_cast<double>(s.x(j));
+      a.seen_lo(j) = std::min(a.seen_lo(j), xj);
+      a.seen_hi(j) = std::max(a.seen_hi(j), xj);
+    }
+    if constexpr (kSplitBins > 0) {
+      if (binning_) add_to_bins(s, w, r, a);
+    }
   }
 
   // Hinge splits only where the trainer keeps their sums (SplitBins > 0).
@@ -413,8 +430,6 @@ class Trainer {
   void add_to_bins(const Sample<Scalar, N>& s, double w, double r, Accumulator& a) const {
     for (int j = 0; j < N; ++j) {
       const double xj = static_cast<double>(s.x(j));
-      a.seen_lo(j) = std::min(a.seen_lo(j), xj);
-      a.seen_hi(j) = std::max(a.seen_hi(j), xj);
       const double t = (xj - a.bin_lo(j)) / a.bin_step(j);
       const std::size_t b =
           t <= 0.0 ? 0 : std::min(static_cast<std::size_t>(t), kSplitBins - 1);  // NaN-free: t > 0
@@ -492,6 +507,11 @@ class Trainer {
       finish_check();
       return;
     }
+    if (binning_) {
+      binning_ = false;
+      split_round();
+      return;
+    }
     const std::size_t pieces = model_->piece_count();
     const double objective = loss_of(*current_);
     const bool improved = pass_in_round_ == 0 || objective < best_objective_ * (1.0 - 1e-4);
@@ -553,6 +573,7 @@ class Trainer {
   // Every round's model is judged against the one before it by the robust loss, so that
   // loss never rises from one round to the next (see end_training() for pruning).
   void finish_round() {
+    bool undone = false;
     double objective = loss_of(*current_);
     double sse = sse_of(*current_);  // for the overall-RMS split rule
     if (split_limit_ > 0 && objective >= saved_objective_ * (1.0 - 1e-4)) {
@@ -561,7 +582,8 @@ class Trainer {
       // split fails, that piece is left and the next worst tried. Training ends when every
       // candidate has been tried on this model or after max_failed_rounds such rounds.
       *model_ = saved_model_;
-      *current_ = saved_acc_;
+      std::copy_n(saved_acc_.begin(), model_->piece_count(), current_->begin());  // with bins
+      undone = true;
       scale_ = saved_scale_;
       objective = saved_objective_;
       sse = saved_sse_;
@@ -594,9 +616,29 @@ class Trainer {
       end_training();
       return;
     }
-    // Candidates for splitting.
-    const std::size_t pieces = model_->piece_count();
     std::array<std::uint8_t, MaxPieces> want{};
+    if (pieces_to_split(acc, sse, want) == 0) {
+      end_training();
+      return;
+    }
+    pending_objective_ = objective;
+    pending_sse_ = sse;
+    if (hinges() && !undone) {
+      // The hinges' sums come from one more pass over this model (the other passes skip
+      // them, a third of a pass's cost), their bins over its own samples' span.
+      keep_spans(acc);
+      binning_ = true;
+      next_pass();
+      return;
+    }
+    split_round();
+  }
+
+  // The pieces of the model whose sums are `acc` that the split rule wants split (want[p] =
+  // 1), pieces already tried excepted; `sse` is the model's robust-weighted squared error.
+  std::size_t pieces_to_split(const Accumulators& acc, double sse,
+                              std::array<std::uint8_t, MaxPieces>& want) const {
+    const std::size_t pieces = model_->piece_count();
     std::size_t wanted = 0;
     const double eps2 = config_.epsilon * config_.epsilon;
     const auto enough = [&](const Accumulator& a) {
@@ -618,16 +660,25 @@ class Trainer {
         }
       }
     }
-    if (wanted == 0) {
+    return wanted;
+  }
+
+  // Splits the worst of the wanted pieces (up to split_limit_) of the model whose sums
+  // *current_ holds (with the hinges' sums when they split), after saving it to undo them.
+  void split_round() {
+    Accumulators& acc = *current_;
+    const std::size_t pieces = model_->piece_count();
+    std::array<std::uint8_t, MaxPieces> want{};
+    if (pieces_to_split(acc, pending_sse_, want) == 0) {
       end_training();
       return;
     }
     update_scales(acc);
     saved_model_ = *model_;
-    saved_acc_ = acc;
+    std::copy_n(acc.begin(), pieces, saved_acc_.begin());
     saved_scale_ = scale_;
-    saved_objective_ = objective;
-    saved_sse_ = sse;
+    saved_objective_ = pending_objective_;
+    saved_sse_ = pending_sse_;
     // Split the worst first until the cap or the limit.
     std::size_t made = 0;
     last_split_count_ = 0;
@@ -982,6 +1033,11 @@ class Trainer {
   double best_loss_ = 0.0;
   bool unevaluated_ = false;
   bool checking_ = false;
+  // Whether this pass gathers the hinges' sums (the pass before a round's splits), and the
+  // loss and squared error of the model it evaluates, as the round judged it.
+  bool binning_ = false;
+  double pending_objective_ = 0.0;
+  double pending_sse_ = 0.0;
   std::size_t stride_ = 1;       // every stride_-th sample per pass (TrainerConfig::coarse_stride)
   bool refining_ = false;        // the fine phase: refits on all samples, no splits
   std::size_t split_limit_ = 0;  // 0: no split to judge yet
