@@ -460,6 +460,70 @@ TEST(AlnTrain, ATrainersModelDoesNotDependOnWhatItTrainedBefore) {
   CHECK(undone > 0);
 }
 
+// MIN(MAX(P, Q), R) on [0, 2] with P = 4x - 4, Q = 0.5, R = 1, and samples of it on [0, 1]
+// (Q's, 0.5) and [1.5, 2] (R's, 1): P is responsible for no sample, but it wins MAX(P, Q) on
+// [1.5, 2] where R then wins the MIN. Without P, Q wins there and the model is 0.5, not 1.
+struct PrunedPieceScene {
+  using Model1 = aln::Aln<double, 1, 8>;
+  using Vec1 = Model1::Vec;
+  std::array<aln::Sample<double, 1>, 200> samples{};
+  Model1 model;
+
+  PrunedPieceScene() {
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const double u = static_cast<double>(k % 100) / 99.0;
+      samples[k].x(0) = k < 100 ? u : 1.5 + 0.5 * u;
+      samples[k].y = k < 100 ? 0.5 : 1.0;
+    }
+    model.set_input_range(0, 0.0, 2.0);
+    using Node = Model1::Node;
+    const std::array<Node, 5> nodes = {
+        Node{aln::NodeKind::kMin, 1, 2}, Node{aln::NodeKind::kMax, 3, 4},
+        Node{aln::NodeKind::kPiece, 2, 0}, Node{aln::NodeKind::kPiece, 0, 0},
+        Node{aln::NodeKind::kPiece, 1, 0}};
+    std::array<aln::Piece<double, 1>, 3> pieces{};
+    pieces[0].set(Vec1(4.0), Vec1(1.0), 0.0);  // P
+    pieces[1].set(Vec1(0.0), Vec1(1.0), 0.5);  // Q
+    pieces[2].set(Vec1(0.0), Vec1(1.0), 1.0);  // R
+    CHECK(model.assign(nodes, pieces));
+  }
+
+  // Trains the model as it is, without refits or splits: what is left is the pruning.
+  void train(bool check_pruning, aln::Trainer<double, 1, 8>& trainer) {
+    aln::TrainerConfig cfg;
+    cfg.max_refit_passes = 0;
+    cfg.max_iterations = 0;
+    cfg.check_pruning = check_pruning;
+    trainer.configure(cfg);
+    CHECK(trainer.start_from(aln::SampleSet<double, 1>(samples.data(), samples.size()), model));
+    while (!trainer.step(64)) {
+    }
+  }
+
+  double worst_error() const {
+    double worst = 0.0;
+    for (const auto& s : samples)
+      worst = std::fmax(worst, std::fabs(model.evaluate(s.x).value - s.y));
+    return worst;
+  }
+};
+
+TEST(AlnTrain, APruningThatChangesTheModelAtSamplesIsUndoneWhenPruningsAreChecked) {
+  static aln::Trainer<double, 1, 8> trainer;
+  static PrunedPieceScene unchecked;
+  LONGS_EQUAL(3, unchecked.model.piece_count());
+  DOUBLES_EQUAL(0.0, unchecked.worst_error(), 1e-12);  // the model fits every sample
+  unchecked.train(false, trainer);
+  LONGS_EQUAL(2, unchecked.model.piece_count());  // P pruned: 0.5 where 1 was fitted
+  DOUBLES_EQUAL(0.5, unchecked.worst_error(), 1e-12);
+  static PrunedPieceScene checked;
+  checked.train(true, trainer);
+  LONGS_EQUAL(3, checked.model.piece_count());
+  DOUBLES_EQUAL(0.0, checked.worst_error(), 1e-12);
+  LONGS_EQUAL(1, trainer.stats().pruning_undone);
+  DOUBLES_EQUAL(0.0, trainer.stats().rms, 1e-12);  // the stats are the kept model's
+}
+
 // Hinge candidates lie across the span of the piece's samples in the pass before the split,
 // not across the model's input range: samples on [0, 1] of an input whose range is
 // [-10, 10], and one split round of a model no refit has moved (max_refit_passes = 0), whose

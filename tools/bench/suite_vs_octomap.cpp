@@ -127,6 +127,8 @@ aln::TrainerConfig trainer_config() {
   const char* refits = std::getenv("BOTICELLI_VS_OCTOMAP_REFIT_PASSES");  // per round, default 8
   if (refits != nullptr && *refits != '\0')
     cfg.max_refit_passes = std::strtoul(refits, nullptr, 10);
+  const char* check = std::getenv("BOTICELLI_VS_OCTOMAP_CHECK_PRUNING");  // 0 turns it off
+  cfg.check_pruning = check == nullptr || *check != '0';
   const char* damped = std::getenv("BOTICELLI_VS_OCTOMAP_DAMPED");  // 0 turns it off
   cfg.damped_refit = damped == nullptr || *damped != '0';
   return cfg;
@@ -207,10 +209,11 @@ struct BuildParts {
   double guard_ms = 0.0;
   std::size_t samples = 0;
   std::size_t passes = 0;
-  std::size_t coarse_passes = 0;  // of them over every coarse_stride-th sample
-  std::size_t rounds = 0;         // split rounds kept (TrainerStats::iterations)
-  std::size_t failed_rounds = 0;  // split rounds undone
-  double rms = 0.0;               // the fit's RMS over all samples
+  std::size_t coarse_passes = 0;   // of them over every coarse_stride-th sample
+  std::size_t rounds = 0;          // split rounds kept (TrainerStats::iterations)
+  std::size_t failed_rounds = 0;   // split rounds undone
+  std::size_t pruning_undone = 0;  // prunings undone (they raised the loss)
+  double rms = 0.0;                // the fit's RMS over all samples
 };
 
 void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
@@ -238,6 +241,7 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
         .integer("coarse_passes", static_cast<std::int64_t>(parts.coarse_passes))
         .integer("rounds", static_cast<std::int64_t>(parts.rounds))
         .integer("failed_rounds", static_cast<std::int64_t>(parts.failed_rounds))
+        .integer("pruning_undone", static_cast<std::int64_t>(parts.pruning_undone))
         .num("rms", parts.rms);
   }
   line.emit();
@@ -450,6 +454,7 @@ int run() {
         parts.coarse_passes = g_trainer.stats().coarse_passes;
         parts.rounds = g_trainer.stats().iterations;
         parts.failed_rounds = g_trainer.stats().failed_rounds;
+        parts.pruning_undone = g_trainer.stats().pruning_undone;
         parts.rms = g_trainer.stats().rms;
         const std::int64_t t_guard = cpu_ns();
         // The feature guard: readings the fit calls free, kept where they cluster.

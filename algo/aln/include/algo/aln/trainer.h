@@ -67,6 +67,14 @@ struct TrainerConfig {
   std::size_t coarse_stride = 1;
   // Passes of the fine phase (0: max_refit_passes, and until the loss stops falling).
   std::size_t max_fine_passes = 0;
+  // Whether each pruning is judged by a pass over the samples and undone if it raised the
+  // loss (a piece no sample uses can still shape the model at samples). Without it the
+  // pruned model goes on unjudged, and only robust training checks the model it ends on;
+  // in vs-octomap's corridor with every 12th sample in the coarse phase, an unjudged pruning
+  // took the coarse loss from 57 to about 780 and the rounds after it were all undone. The
+  // mission keeps it off: over seeds 1-5 on 18 worlds it found 72 of 90 targets with it on
+  // against 78 (docs/benchmarks.md).
+  bool check_pruning = false;
   // A refit that raised the loss (a piece's least squares ignore that moving it changes which
   // piece is responsible where) is retried from the best model of the round with half the
   // step towards the least-squares pieces, then a quarter; false: the round ends after two
@@ -76,11 +84,12 @@ struct TrainerConfig {
 
 struct TrainerStats {
   std::size_t pieces = 0;
-  std::size_t iterations = 0;     // split rounds counted against max_iterations
-  std::size_t failed_rounds = 0;  // split rounds undone (they did not lower the error)
-  std::size_t rounds = 0;         // split rounds begun (kept and undone)
-  std::size_t passes = 0;         // passes over the samples (coarse and fine)
-  std::size_t coarse_passes = 0;  // ... of which over every coarse_stride-th sample only
+  std::size_t iterations = 0;      // split rounds counted against max_iterations
+  std::size_t failed_rounds = 0;   // split rounds undone (they did not lower the error)
+  std::size_t pruning_undone = 0;  // prunings undone (the pruned model fitted worse)
+  std::size_t rounds = 0;          // split rounds begun (kept and undone)
+  std::size_t passes = 0;          // passes over the samples (coarse and fine)
+  std::size_t coarse_passes = 0;   // ... of which over every coarse_stride-th sample only
   std::uint64_t sample_visits = 0;
   double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
   double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
@@ -248,8 +257,8 @@ class Trainer {
     split_limit_ = 0;
     last_made_ = 0;
     failed_rounds_ = 0;
+    check_ = Check::kNone;
     unevaluated_ = false;
-    checking_ = false;
     binning_ = false;
     tried_.fill(0);
     begin_pass();
@@ -503,7 +512,7 @@ class Trainer {
   void finish_pass() {
     stats_.passes += 1;
     stats_.coarse_passes += stride_ > 1 ? 1 : 0;
-    if (checking_) {
+    if (check_ != Check::kNone) {
       finish_check();
       return;
     }
@@ -569,11 +578,11 @@ class Trainer {
     }
   }
 
-  // The current model and the sums in *current_ belong together: prune, split or stop.
-  // Every round's model is judged against the one before it by the robust loss, so that
-  // loss never rises from one round to the next (see end_training() for pruning).
+  // The current model and the sums in *current_ belong together: undo the round's splits
+  // or prune, then split or stop. Every round's model is judged against the one before it by
+  // the robust loss, so that loss never rises from one round to the next (pruning included:
+  // finish_check()).
   void finish_round() {
-    bool undone = false;
     double objective = loss_of(*current_);
     double sse = sse_of(*current_);  // for the overall-RMS split rule
     if (split_limit_ > 0 && objective >= saved_objective_ * (1.0 - 1e-4)) {
@@ -583,7 +592,6 @@ class Trainer {
       // candidate has been tried on this model or after max_failed_rounds such rounds.
       *model_ = saved_model_;
       std::copy_n(saved_acc_.begin(), model_->piece_count(), current_->begin());  // with bins
-      undone = true;
       scale_ = saved_scale_;
       objective = saved_objective_;
       sse = saved_sse_;
@@ -601,18 +609,47 @@ class Trainer {
         end_training();
         return;
       }
-    } else {
-      split_limit_ = MaxPieces;
-      tried_.fill(0);  // another model now: every piece is a candidate again
-      const std::size_t evaluated_pieces = model_->piece_count();
-      if (config_.robust != RobustWeighting::kNone) best_model_ = *model_;
-      prune(*current_);
-      unevaluated_ = model_->piece_count() != evaluated_pieces;
-      best_loss_ = objective;
+      continue_round(objective, sse, true);  // the saved sums have their hinge bins
+      return;
     }
+    split_limit_ = MaxPieces;
+    tried_.fill(0);  // another model now: every piece is a candidate again
+    const std::size_t evaluated_pieces = model_->piece_count();
+    keep_spans(*current_);
+    unpruned_model_ = *model_;
+    unpruned_scale_ = scale_;
+    unpruned_span_lo_ = span_lo_;
+    unpruned_span_hi_ = span_hi_;
+    unpruned_loss_ = objective;
+    prune(*current_);
+    const bool pruned = model_->piece_count() != evaluated_pieces;
+    if (pruned && config_.check_pruning) {
+      // Pruning a piece no sample uses can still change the model at samples: the piece may
+      // win an inner node there whose branch then loses higher up (in the coarse phase, the
+      // samples between the visited ones may also be its own). A pass over the samples
+      // judges the pruned model (gathering the hinges' sums on the way if a split may
+      // follow); finish_check() keeps the pieces if pruning raised the loss.
+      check_ = Check::kPruned;
+      binning_ = hinges() && may_split();
+      next_pass();
+      return;
+    }
+    unevaluated_ = pruned;  // judged only if training ends on it (end_training())
+    continue_round(objective, sse, false);
+  }
+
+  // Whether the round that ends may be followed by splits (else training ends).
+  bool may_split() const {
+    return !refining_ && stats_.iterations < config_.max_iterations && model_->piece_count() < cap_;
+  }
+
+  // The end of a round whose model and sums (*current_, with the hinges' bins if `binned`)
+  // belong together and whose loss and robust-weighted squared error are `objective` and
+  // `sse`: the stats, then splits, or the end of training.
+  void continue_round(double objective, double sse, bool binned) {
     Accumulators& acc = *current_;
     finish_stats(acc);
-    if (refining_ || stats_.iterations >= config_.max_iterations || model_->piece_count() >= cap_) {
+    if (!may_split()) {
       end_training();
       return;
     }
@@ -623,7 +660,7 @@ class Trainer {
     }
     pending_objective_ = objective;
     pending_sse_ = sse;
-    if (hinges() && !undone) {
+    if (hinges() && !binned) {
       // The hinges' sums come from one more pass over this model (the other passes skip
       // them, a third of a pass's cost), their bins over its own samples' span.
       keep_spans(acc);
@@ -632,6 +669,41 @@ class Trainer {
       return;
     }
     split_round();
+  }
+
+  // After a pass over a pruned model (Check::kPruned): if pruning raised the loss, the
+  // pieces are put back and the model evaluated once more (Check::kReverted); else the round
+  // goes on with the pruned model and its own sums.
+  void finish_check() {
+    const Check what = check_;
+    check_ = Check::kNone;
+    const bool binned = binning_;
+    binning_ = false;
+    const double loss = loss_of(*current_);
+    if (what == Check::kAtEnd) {
+      if (loss > unpruned_loss_ * (1.0 + 1e-9)) {
+        // The stats, from the round's sums, are those of the model before its pruning.
+        *model_ = unpruned_model_;
+        stats_.pieces = model_->piece_count();
+        stats_.pruning_undone += 1;
+      } else {
+        finish_stats(*current_);
+      }
+      stats_.done = true;
+      return;
+    }
+    if (what == Check::kPruned && loss > unpruned_loss_ * (1.0 + 1e-9)) {
+      *model_ = unpruned_model_;
+      scale_ = unpruned_scale_;
+      span_lo_ = unpruned_span_lo_;
+      span_hi_ = unpruned_span_hi_;
+      stats_.pruning_undone += 1;
+      check_ = Check::kReverted;
+      binning_ = hinges() && may_split();
+      next_pass();
+      return;
+    }
+    continue_round(loss, sse_of(*current_), binned);
   }
 
   // The pieces of the model whose sums are `acc` that the split rule wants split (want[p] =
@@ -706,12 +778,11 @@ class Trainer {
     next_pass();
   }
 
-  // Pruning a piece no sample uses can still change the model at samples: the piece may win
-  // an inner node there whose branch then loses higher up. Robust fits leave such pieces
-  // often (a Tukey piece can drift off all its samples), so when training would end on a
-  // pruned model no pass has evaluated, robust training evaluates it once more and returns
-  // the last evaluated model instead if pruning raised the loss. Without robust weights the
-  // pruned model is returned as it is.
+  // The coarse phase (if any) hands over to the fine one; else training is done. Without
+  // check_pruning, robust training that would end on a pruned model no pass has evaluated
+  // evaluates it once more and returns the model before its pruning if pruning raised the
+  // loss (robust fits leave sample-less pieces often: a Tukey piece can drift off all its
+  // samples); other training returns the pruned model as it is.
   void end_training() {
     if (stride_ > 1) {
       // The coarse phase is over: refit its model on all samples (a round with no splits).
@@ -721,22 +792,9 @@ class Trainer {
       return;
     }
     if (unevaluated_ && config_.robust != RobustWeighting::kNone) {
-      checking_ = true;
+      check_ = Check::kAtEnd;
       next_pass();
       return;
-    }
-    stats_.done = true;
-  }
-
-  void finish_check() {
-    checking_ = false;
-    unevaluated_ = false;
-    if (loss_of(*current_) > best_loss_ * (1.0 + 1e-9)) {
-      // The stats, from the round's sums, are those of the model before its pruning.
-      *model_ = best_model_;
-      stats_.pieces = model_->piece_count();
-    } else {
-      finish_stats(*current_);
     }
     stats_.done = true;
   }
@@ -1027,12 +1085,16 @@ class Trainer {
   std::array<double, MaxPieces> saved_scale_{};
   double saved_objective_ = 0.0;  // its robust loss
   double saved_sse_ = 0.0;        // its robust-weighted squared error
-  // The last round's model as evaluated, before pruning (robust training only), its loss,
-  // whether the current model was pruned since, and whether a pass is checking that.
-  Model best_model_{};
-  double best_loss_ = 0.0;
-  bool unevaluated_ = false;
-  bool checking_ = false;
+  // The last round's model as evaluated, before pruning, with its scales, spans and loss;
+  // whether a pass is judging the pruned model or evaluating the unpruned one again.
+  enum class Check : std::uint8_t { kNone, kPruned, kReverted, kAtEnd };
+  Model unpruned_model_{};
+  std::array<double, MaxPieces> unpruned_scale_{};
+  std::array<VecD, MaxPieces> unpruned_span_lo_{};
+  std::array<VecD, MaxPieces> unpruned_span_hi_{};
+  double unpruned_loss_ = 0.0;
+  bool unevaluated_ = false;  // the model was pruned since its last evaluation
+  Check check_ = Check::kNone;
   // Whether this pass gathers the hinges' sums (the pass before a round's splits), and the
   // loss and squared error of the model it evaluates, as the round judged it.
   bool binning_ = false;
