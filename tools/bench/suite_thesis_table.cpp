@@ -348,6 +348,8 @@ int run_thesis_table() {
         cfg.count_undone_rounds = false;
         cfg.max_refit_passes = env_size("BOTICELLI_THESIS_PASSES", 8);
         cfg.damped_refit = env_size("BOTICELLI_THESIS_DAMPED", 0) != 0;
+        cfg.check_pruning = env_size("BOTICELLI_THESIS_CHECK_PRUNING", 0) != 0;
+        cfg.seed = static_cast<std::uint32_t>(env_size("BOTICELLI_THESIS_SEED", 1));  // the split's
         cfg.max_pieces = kMaxPieces;
         cfg.split_rule = run.rule;
         cfg.robust = run.robust;

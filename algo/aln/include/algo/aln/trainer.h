@@ -107,11 +107,10 @@ struct TrainerStats {
 // stops falling, pieces whose error exceeds epsilon are split, pieces no sample uses are
 // pruned, and the next round starts. A split (TrainerConfig::split) is either a V at the
 // piece's centroid (two tilted copies, MAX if the residuals rise towards the rim of its
-// region, else MIN) or the best of many hinge candidates scored from binned sums (as in
-// max-affine regression, Magnani & Boyd 2009) that one more pass over the round's model
-// gathers: a hinge on each input at each of kSplitBins - 1 positions across the piece's
-// samples in that pass, on either side, as MAX(piece, piece + tilt) where the residuals rise
-// beyond the hinge or MIN where they fall. Stops at
+// region, else MIN) or the best of many hinge candidates scored from the same pass's sums
+// (as in max-affine regression, Magnani & Boyd 2009): a hinge on each input at each of
+// kSplitBins - 1 positions across the piece's samples, on either side, as MAX(piece,
+// piece + tilt) where the residuals rise beyond the hinge or MIN where they fall. Stops at
 // epsilon, at the piece cap or at the iteration cap; the model is always one that was
 // evaluated, with every piece inside its bounds. Models are compared by the robust loss at a fixed
 // scale (TrainerStats::robust_loss), not by the robust-weighted squared error, which a Tukey fit
@@ -259,7 +258,6 @@ class Trainer {
     failed_rounds_ = 0;
     check_ = Check::kNone;
     unevaluated_ = false;
-    binning_ = false;
     tried_.fill(0);
     begin_pass();
     stats_.pieces = model_->piece_count();
@@ -277,7 +275,7 @@ class Trainer {
 
   // Per-piece sums over the samples it is responsible for, in coordinates shifted by the
   // piece's centroid at the start of the pass (better conditioned).
-  struct PieceSums {
+  struct Accumulator {
     double sw = 0.0;  // sum of (robust) weights
     std::size_t count = 0;
     VecD sx = VecD::Zero();
@@ -299,15 +297,7 @@ class Trainer {
     VecD bin_step = VecD::Ones();
     VecD seen_lo = VecD::Constant(std::numeric_limits<double>::infinity());
     VecD seen_hi = VecD::Constant(-std::numeric_limits<double>::infinity());
-  };
-  struct Accumulator : PieceSums {
     std::array<std::array<HingeBin, kSplitBins>, static_cast<std::size_t>(N)> bins{};
-
-    // Zero sums for a pass; the bins (most of the bytes) only for a pass that fills them.
-    void reset(bool with_bins) {
-      static_cast<PieceSums&>(*this) = PieceSums{};
-      if (with_bins) bins = {};
-    }
   };
   using Accumulators = std::array<Accumulator, MaxPieces>;
 
@@ -363,7 +353,7 @@ class Trainer {
   void begin_pass() {
     Accumulators& acc = *current_;
     for (std::size_t p = 0; p < model_->piece_count(); ++p) {
-      acc[p].reset(binning_);
+      acc[p] = Accumulator{};
       for (int j = 0; j < N; ++j) {
         const double lo_j = span_lo_[p](j);
         const double span = span_hi_[p](j) - lo_j;
@@ -420,14 +410,7 @@ class Trainer {
       }
       return;
     }
-    for (int j = 0; j < N; ++j) {
-      const double xj = static_cast<double>(s.x(j));
-      a.seen_lo(j) = std::min(a.seen_lo(j), xj);
-      a.seen_hi(j) = std::max(a.seen_hi(j), xj);
-    }
-    if constexpr (kSplitBins > 0) {
-      if (binning_) add_to_bins(s, w, r, a);
-    }
+    if constexpr (kSplitBins > 0) add_to_bins(s, w, r, a);
   }
 
   // Hinge splits only where the trainer keeps their sums (SplitBins > 0).
@@ -439,6 +422,8 @@ class Trainer {
   void add_to_bins(const Sample<Scalar, N>& s, double w, double r, Accumulator& a) const {
     for (int j = 0; j < N; ++j) {
       const double xj = static_cast<double>(s.x(j));
+      a.seen_lo(j) = std::min(a.seen_lo(j), xj);
+      a.seen_hi(j) = std::max(a.seen_hi(j), xj);
       const double t = (xj - a.bin_lo(j)) / a.bin_step(j);
       const std::size_t b =
           t <= 0.0 ? 0 : std::min(static_cast<std::size_t>(t), kSplitBins - 1);  // NaN-free: t > 0
@@ -514,11 +499,6 @@ class Trainer {
     stats_.coarse_passes += stride_ > 1 ? 1 : 0;
     if (check_ != Check::kNone) {
       finish_check();
-      return;
-    }
-    if (binning_) {
-      binning_ = false;
-      split_round();
       return;
     }
     const std::size_t pieces = model_->piece_count();
@@ -609,13 +589,12 @@ class Trainer {
         end_training();
         return;
       }
-      continue_round(objective, sse, true);  // the saved sums have their hinge bins
+      continue_round(objective, sse);
       return;
     }
     split_limit_ = MaxPieces;
     tried_.fill(0);  // another model now: every piece is a candidate again
     const std::size_t evaluated_pieces = model_->piece_count();
-    keep_spans(*current_);
     unpruned_model_ = *model_;
     unpruned_scale_ = scale_;
     unpruned_span_lo_ = span_lo_;
@@ -627,15 +606,13 @@ class Trainer {
       // Pruning a piece no sample uses can still change the model at samples: the piece may
       // win an inner node there whose branch then loses higher up (in the coarse phase, the
       // samples between the visited ones may also be its own). A pass over the samples
-      // judges the pruned model (gathering the hinges' sums on the way if a split may
-      // follow); finish_check() keeps the pieces if pruning raised the loss.
+      // judges the pruned model; finish_check() keeps the pieces if pruning raised the loss.
       check_ = Check::kPruned;
-      binning_ = hinges() && may_split();
       next_pass();
       return;
     }
     unevaluated_ = pruned;  // judged only if training ends on it (end_training())
-    continue_round(objective, sse, false);
+    continue_round(objective, sse);
   }
 
   // Whether the round that ends may be followed by splits (else training ends).
@@ -643,32 +620,16 @@ class Trainer {
     return !refining_ && stats_.iterations < config_.max_iterations && model_->piece_count() < cap_;
   }
 
-  // The end of a round whose model and sums (*current_, with the hinges' bins if `binned`)
-  // belong together and whose loss and robust-weighted squared error are `objective` and
-  // `sse`: the stats, then splits, or the end of training.
-  void continue_round(double objective, double sse, bool binned) {
-    Accumulators& acc = *current_;
-    finish_stats(acc);
+  // The end of a round whose model and sums (*current_) belong together and whose loss and
+  // robust-weighted squared error are `objective` and `sse`: the stats, then splits, or the
+  // end of training.
+  void continue_round(double objective, double sse) {
+    finish_stats(*current_);
     if (!may_split()) {
       end_training();
       return;
     }
-    std::array<std::uint8_t, MaxPieces> want{};
-    if (pieces_to_split(acc, sse, want) == 0) {
-      end_training();
-      return;
-    }
-    pending_objective_ = objective;
-    pending_sse_ = sse;
-    if (hinges() && !binned) {
-      // The hinges' sums come from one more pass over this model (the other passes skip
-      // them, a third of a pass's cost), their bins over its own samples' span.
-      keep_spans(acc);
-      binning_ = true;
-      next_pass();
-      return;
-    }
-    split_round();
+    split_round(objective, sse);
   }
 
   // After a pass over a pruned model (Check::kPruned): if pruning raised the loss, the
@@ -677,8 +638,6 @@ class Trainer {
   void finish_check() {
     const Check what = check_;
     check_ = Check::kNone;
-    const bool binned = binning_;
-    binning_ = false;
     const double loss = loss_of(*current_);
     if (what == Check::kAtEnd) {
       if (loss > unpruned_loss_ * (1.0 + 1e-9)) {
@@ -699,11 +658,10 @@ class Trainer {
       span_hi_ = unpruned_span_hi_;
       stats_.pruning_undone += 1;
       check_ = Check::kReverted;
-      binning_ = hinges() && may_split();
       next_pass();
       return;
     }
-    continue_round(loss, sse_of(*current_), binned);
+    continue_round(loss, sse_of(*current_));
   }
 
   // The pieces of the model whose sums are `acc` that the split rule wants split (want[p] =
@@ -736,12 +694,13 @@ class Trainer {
   }
 
   // Splits the worst of the wanted pieces (up to split_limit_) of the model whose sums
-  // *current_ holds (with the hinges' sums when they split), after saving it to undo them.
-  void split_round() {
+  // *current_ holds, after saving it to undo them; `objective` and `sse` are its loss and
+  // robust-weighted squared error.
+  void split_round(double objective, double sse) {
     Accumulators& acc = *current_;
     const std::size_t pieces = model_->piece_count();
     std::array<std::uint8_t, MaxPieces> want{};
-    if (pieces_to_split(acc, pending_sse_, want) == 0) {
+    if (pieces_to_split(acc, sse, want) == 0) {
       end_training();
       return;
     }
@@ -749,8 +708,8 @@ class Trainer {
     saved_model_ = *model_;
     std::copy_n(acc.begin(), pieces, saved_acc_.begin());
     saved_scale_ = scale_;
-    saved_objective_ = pending_objective_;
-    saved_sse_ = pending_sse_;
+    saved_objective_ = objective;
+    saved_sse_ = sse;
     // Split the worst first until the cap or the limit.
     std::size_t made = 0;
     last_split_count_ = 0;
@@ -1097,9 +1056,6 @@ class Trainer {
   Check check_ = Check::kNone;
   // Whether this pass gathers the hinges' sums (the pass before a round's splits), and the
   // loss and squared error of the model it evaluates, as the round judged it.
-  bool binning_ = false;
-  double pending_objective_ = 0.0;
-  double pending_sse_ = 0.0;
   std::size_t stride_ = 1;       // every stride_-th sample per pass (TrainerConfig::coarse_stride)
   bool refining_ = false;        // the fine phase: refits on all samples, no splits
   std::size_t split_limit_ = 0;  // 0: no split to judge yet
