@@ -69,11 +69,10 @@ struct TrainerConfig {
   std::size_t max_fine_passes = 0;
   // Whether each pruning is judged by a pass over the samples and undone if it raised the
   // loss (a piece no sample uses can still shape the model at samples). Without it the
-  // pruned model goes on unjudged, and only robust training checks the model it ends on;
-  // in vs-octomap's corridor with every 12th sample in the coarse phase, an unjudged pruning
-  // took the coarse loss from 57 to about 780 and the rounds after it were all undone. The
-  // mission keeps it off: over seeds 1-5 on 18 worlds it found 72 of 90 targets with it on
-  // against 78 (docs/benchmarks.md).
+  // pruned model goes on unjudged (its stats are those of the model before the pruning),
+  // and only robust training checks the model it ends on; in vs-octomap, 5 of its 24 fits
+  // had prunings that raised the loss. The mission keeps it off: over seeds 1-5 on 18
+  // worlds it found 72 of 90 targets with it on against 78 (docs/benchmarks.md).
   bool check_pruning = false;
   // A refit that raised the loss (a piece's least squares ignore that moving it changes which
   // piece is responsible where) is retried from the best model of the round with half the
