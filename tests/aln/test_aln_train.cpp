@@ -795,6 +795,14 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   cfg.max_fine_passes = 2;
   train_wall_step(false);
   CHECK(g_trainer2.stats().coarse_passes > 0);
+  // Checked prunings in one phase, undamped: the pruning that made the first wall-step
+  // model worse is undone as soon as it is made.
+  cfg.coarse_stride = 1;
+  cfg.damped_refit = false;
+  cfg.max_fine_passes = 0;
+  cfg.check_pruning = true;
+  train_wall_step(false);
+  CHECK(g_trainer2.stats().pruning_undone > 0);
 }
 
 TEST(AlnTrain, AnEmptySampleSetIsRefused) {
