@@ -795,14 +795,13 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   cfg.max_fine_passes = 2;
   train_wall_step(false);
   CHECK(g_trainer2.stats().coarse_passes > 0);
-  // Checked prunings in one phase, undamped: the pruning that made the first wall-step
-  // model worse is undone as soon as it is made.
-  cfg.coarse_stride = 1;
-  cfg.damped_refit = false;
-  cfg.max_fine_passes = 0;
-  cfg.check_pruning = true;
-  train_wall_step(false);
-  CHECK(g_trainer2.stats().pruning_undone > 0);
+  // Checked prunings: a pruning judged, undone and the model evaluated again (the scene's
+  // pieces are set by hand, so this holds on every platform; the wall step's fits differ
+  // in the last bit between x86-64 and aarch64).
+  static aln::Trainer<double, 1, 8> trainer1;
+  static PrunedPieceScene scene;
+  CHECK_NO_ALLOCATION(scene.train(true, trainer1));
+  LONGS_EQUAL(1, trainer1.stats().pruning_undone);
 }
 
 TEST(AlnTrain, AnEmptySampleSetIsRefused) {
