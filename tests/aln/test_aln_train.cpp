@@ -510,13 +510,13 @@ struct PrunedPieceScene {
 
 TEST(AlnTrain, APruningThatChangesTheModelAtSamplesIsUndoneWhenPruningsAreChecked) {
   static aln::Trainer<double, 1, 8> trainer;
-  static PrunedPieceScene unchecked;
+  PrunedPieceScene unchecked;
   LONGS_EQUAL(3, unchecked.model.piece_count());
   DOUBLES_EQUAL(0.0, unchecked.worst_error(), 1e-12);  // the model fits every sample
   unchecked.train(false, trainer);
   LONGS_EQUAL(2, unchecked.model.piece_count());  // P pruned: 0.5 where 1 was fitted
   DOUBLES_EQUAL(0.5, unchecked.worst_error(), 1e-12);
-  static PrunedPieceScene checked;
+  PrunedPieceScene checked;
   checked.train(true, trainer);
   LONGS_EQUAL(3, checked.model.piece_count());
   DOUBLES_EQUAL(0.0, checked.worst_error(), 1e-12);
@@ -799,7 +799,7 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   // pieces are set by hand, so this holds on every platform; the wall step's fits differ
   // in the last bit between x86-64 and aarch64).
   static aln::Trainer<double, 1, 8> trainer1;
-  static PrunedPieceScene scene;
+  PrunedPieceScene scene;
   CHECK_NO_ALLOCATION(scene.train(true, trainer1));
   LONGS_EQUAL(1, trainer1.stats().pruning_undone);
 }
