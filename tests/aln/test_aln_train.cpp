@@ -34,6 +34,10 @@ double cylinder_room(double r_dm) {
   return std::fmin(u * u, 1.0);
 }
 
+// Both ways of splitting a piece, for tests that must hold with either.
+constexpr std::array<aln::SplitCandidates, 2> kBothSplits = {aln::SplitCandidates::kCentroidV,
+                                                             aln::SplitCandidates::kHinges};
+
 using Model2 = aln::Aln<double, 2, 64>;
 using Trainer2 = aln::Trainer<double, 2, 64>;
 using Model3 = aln::Aln<float, 3, 256>;
@@ -227,11 +231,9 @@ TEST(AlnTrain, FitsTheCylindricalRoomToEpsilonWithEveryPieceInsideItsBounds) {
 }
 
 TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
-  // With either split: the hinges' sums come from a pass of their own, which slices may
-  // begin and end anywhere in.
+  // With either split (the hinges keep sums of their own, which slices must not disturb).
   const std::size_t n = fill_room(2000, 0.03, 8);
-  for (const aln::SplitCandidates split :
-       {aln::SplitCandidates::kCentroidV, aln::SplitCandidates::kHinges}) {
+  for (const aln::SplitCandidates split : kBothSplits) {
     set_room_ranges(g_model3);
     set_room_ranges(g_model3b);
     aln::TrainerConfig cfg;
@@ -275,8 +277,7 @@ TEST(AlnTrain, DifferentSeedsGiveDifferentModelsOfTheSameQuality) {
   // The seed jitters the V's tilt, or picks among near-equal hinge candidates and shifts the
   // hinge a little: another seed, another model, fitted as well.
   const std::size_t n = fill_room(2000, 0.0, 12);
-  for (const aln::SplitCandidates split :
-       {aln::SplitCandidates::kCentroidV, aln::SplitCandidates::kHinges}) {
+  for (const aln::SplitCandidates split : kBothSplits) {
     set_room_ranges(g_model3);
     set_room_ranges(g_model3b);
     aln::TrainerConfig cfg;
@@ -406,8 +407,7 @@ TEST(AlnTrain, AnUndoneSplitRoundDoesNotEndTheTraining) {
   // either split (the hinges split again from the sums of the model the undone round had
   // split).
   const std::size_t n = fill_room(3000, 0.3, 77);
-  for (const aln::SplitCandidates split :
-       {aln::SplitCandidates::kCentroidV, aln::SplitCandidates::kHinges}) {
+  for (const aln::SplitCandidates split : kBothSplits) {
     set_room_ranges(g_model3);
     set_room_ranges(g_model3b);
     aln::TrainerConfig cfg;

@@ -594,11 +594,17 @@ class Trainer {
     split_limit_ = MaxPieces;
     tried_.fill(0);  // another model now: every piece is a candidate again
     const std::size_t evaluated_pieces = model_->piece_count();
-    unpruned_model_ = *model_;
-    unpruned_scale_ = scale_;
-    unpruned_span_lo_ = span_lo_;
-    unpruned_span_hi_ = span_hi_;
-    unpruned_loss_ = objective;
+    // What undoing the pruning needs: all of it when prunings are checked, the model alone
+    // for the robust check at the end (end_training()), nothing otherwise.
+    if (config_.check_pruning || config_.robust != RobustWeighting::kNone) {
+      unpruned_model_ = *model_;
+      unpruned_loss_ = objective;
+    }
+    if (config_.check_pruning) {
+      unpruned_scale_ = scale_;
+      unpruned_span_lo_ = span_lo_;
+      unpruned_span_hi_ = span_hi_;
+    }
     prune(*current_);
     const bool pruned = model_->piece_count() != evaluated_pieces;
     if (pruned && config_.check_pruning) {
