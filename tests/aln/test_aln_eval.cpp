@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 
 #include <Eigen/Core>
@@ -174,12 +175,46 @@ TEST(AlnEval, AlphaBetaWithAHintGivesTheSameValueAndCutsMoreOnARay) {
   CHECK(with_hint < without);
 }
 
-TEST(AlnEval, DtreeKeepsAboutNPlusOnePiecesPerBlock) {
+TEST(AlnEval, DtreeKeepsAboutTwoPiecesPerBlockOrNPlusOneWithTheThesisSetting) {
   aln_test::Rng rng(11);
   aln_test::random_model(g_model, 32, rng);
   CHECK(g_dtree.compile(g_model));
   CHECK(g_dtree.block_count() > 1);
+  CHECK(g_dtree.mean_block_pieces() <= 2.5);
+  CHECK(g_dtree.compile(g_model, 10, 4));
+  CHECK(g_dtree.mean_block_pieces() > 2.5);
   CHECK(g_dtree.mean_block_pieces() <= 4.5);
+}
+
+TEST(AlnEval, DtreeBlocksWithTheSameOpsShareThem) {
+  aln_test::Rng rng(19);
+  aln_test::random_model(g_model, 32, rng);
+  // Few ops for this many blocks: it compiles at full depth only because blocks share ops.
+  static aln::Dtree<float, 3, 128, 2048, 1024, 64> d;
+  CHECK(d.compile(g_model, 8));
+  LONGS_EQUAL(8, d.depth_used());
+  // Unshared, every block of p > 1 pieces would take 2p - 1 ops.
+  const double pieces = d.mean_block_pieces() * static_cast<double>(d.block_count());
+  const double unshared_at_least = 2.0 * (pieces - static_cast<double>(d.block_count()));
+  CHECK(static_cast<double>(d.node_count()) * 4.0 < unshared_at_least);
+  for (int k = 0; k < 20000; ++k) {
+    const auto x = aln_test::random_point<Model3::Vec>(rng);
+    const auto plain = g_model.evaluate(x);
+    const auto dt = d.evaluate(x);
+    if (plain.value != dt.value || plain.piece != dt.piece) FAIL("DTREE differs from plain");
+  }
+}
+
+TEST(AlnEval, DtreeGivesNaNForANaNInput) {
+  aln_test::Rng rng(19);
+  aln_test::random_model(g_model, 32, rng);
+  CHECK(g_dtree.compile(g_model));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int i = 0; i < 3; ++i) {
+    Model3::Vec x(0.5F, 0.5F, 0.5F);
+    x(i) = nan;
+    CHECK(std::isnan(g_dtree.evaluate(x).value));
+  }
 }
 
 TEST(AlnEval, DtreeWithSmallCapacityCompilesShallowerAndStaysExact) {

@@ -107,15 +107,19 @@ std::int64_t cpu_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
 }
 
+// ns per query of f(k, sink) over the queries, after a round that warms up and counts what
+// f returns (pieces evaluated) into `touched`. f has one call site, in a loop, so it is
+// inlined as in a caller's loop and the sum stays in a register.
 template <typename F>
 double ns_per_call(F&& f, std::size_t& touched) {
   constexpr int kRounds = 100;
-  touched = 0;
   double sink = 0.0;
-  for (std::size_t k = 0; k < kQueries; ++k) touched += f(k, sink);  // warm up, count
-  const std::int64_t t0 = cpu_ns();
-  for (int r = 0; r < kRounds; ++r) {
-    for (std::size_t k = 0; k < kQueries; ++k) (void)f(k, sink);
+  std::int64_t t0 = 0;
+  for (int r = -1; r < kRounds; ++r) {
+    if (r == 0) t0 = cpu_ns();
+    std::size_t t = 0;
+    for (std::size_t k = 0; k < kQueries; ++k) t += f(k, sink);
+    if (r < 0) touched = t;
   }
   const std::int64_t t1 = cpu_ns();
   boticelli::bench::do_not_optimize(sink);
@@ -207,16 +211,26 @@ void bench_model(std::size_t cap) {
   const double ray_block = block_ns(g_rays);
   const auto blocks = static_cast<std::int64_t>(g_dtree.block_count());
   const auto dtree_depth = static_cast<std::int64_t>(g_dtree.depth_used());
-  // DTREE with up to 8 pieces per block: fewer thresholds per query.
-  const bool dtree8_ok = g_dtree.compile(g_model, 10, 8);
+  const auto dtree_ops = static_cast<std::int64_t>(g_dtree.node_count());
+  // DTREE with up to N + 1 = 4 pieces per block (the thesis's) and up to 8: fewer thresholds
+  // per query, more pieces.
+  const auto dtree_with = [](std::size_t block_pieces, bool& ok, std::size_t& touched) {
+    ok = g_dtree.compile(g_model, 10, block_pieces);
+    return ns_per_call(
+        [](std::size_t k, double& sink) {
+          const auto e = g_dtree.evaluate(g_queries[k]);
+          sink += static_cast<double>(e.value);
+          return static_cast<std::size_t>(e.pieces_evaluated);
+        },
+        touched);
+  };
+  bool dtree4_ok = false;
+  std::size_t t_dt4 = 0;
+  const double dt4 = dtree_with(4, dtree4_ok, t_dt4);
+  const auto dtree4_blocks = static_cast<std::int64_t>(g_dtree.block_count());
+  bool dtree8_ok = false;
   std::size_t t_dt8 = 0;
-  const double dt8 = ns_per_call(
-      [](std::size_t k, double& sink) {
-        const auto e = g_dtree.evaluate(g_queries[k]);
-        sink += static_cast<double>(e.value);
-        return static_cast<std::size_t>(e.pieces_evaluated);
-      },
-      t_dt8);
+  const double dt8 = dtree_with(8, dtree8_ok, t_dt8);
   const auto per = [](std::size_t t) { return static_cast<double>(t) / kQueries; };
   boticelli::bench::JsonLine("aln", "eval")
       .integer("pieces_cap", static_cast<std::int64_t>(cap))
@@ -226,6 +240,7 @@ void bench_model(std::size_t cap) {
       .num("ns_plain", plain)
       .num("ns_alphabeta", ab)
       .num("ns_dtree", dt)
+      .num("ns_dtree4", dt4)
       .num("ns_dtree8", dt8)
       .num("ns_fixed", fx)
       .num("ns_alphabeta_rays", ray_ab)
@@ -235,15 +250,18 @@ void bench_model(std::size_t cap) {
       .num("touched_plain", per(t_plain))
       .num("touched_alphabeta", per(t_ab))
       .num("touched_dtree", per(t_dt))
+      .num("touched_dtree4", per(t_dt4))
       .num("touched_dtree8", per(t_dt8))
       .num("touched_fixed", per(t_fx))
       .num("touched_alphabeta_rays", per(t_ray))
       .num("touched_alphabeta_hint_rays", per(t_hint))
       .integer("dtree_blocks", blocks)
       .integer("dtree_depth", dtree_depth)
+      .integer("dtree_ops", dtree_ops)
+      .integer("dtree4_blocks", dtree4_blocks)
       .integer("dtree8_blocks", static_cast<std::int64_t>(g_dtree.block_count()))
       .num("dtree_compile_ms", compile_ms)
-      .flag("dtree_ok", dtree_ok && dtree8_ok)
+      .flag("dtree_ok", dtree_ok && dtree4_ok && dtree8_ok)
       .flag("fixed_ok", fixed_ok)
       .emit();
 }
