@@ -230,6 +230,31 @@ TEST(AlnTrain, FitsTheCylindricalRoomToEpsilonWithEveryPieceInsideItsBounds) {
   CHECK(g_model3.piece_count() < 64);
 }
 
+TEST(AlnTrain, ARoundEndsAtTheFirstRefitThatGainsLessThanTheRoundTolerance) {
+  const std::size_t n = fill_room(6000, 0.0, 5);
+  std::size_t passes[2] = {};
+  std::size_t rounds[2] = {};
+  constexpr double kTolerance[2] = {0.0, 1.0};  // 1: any refit that gains ends the round
+  for (std::size_t t = 0; t < 2; ++t) {
+    set_room_ranges(g_model3);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = 0.05;
+    cfg.max_iterations = 12;
+    cfg.round_tolerance = kTolerance[t];
+    g_trainer3.configure(cfg);
+    CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+    CHECK(g_trainer3.stats().rms <= 0.05);
+    passes[t] = g_trainer3.stats().passes;
+    rounds[t] = g_trainer3.stats().rounds;
+  }
+  // Without the tolerance a round refits until the loss stops falling; with it, after the
+  // round's first pass a refit that lowered the loss ends the round, so a round takes at most
+  // the first pass, stalled refits (at most 2 without damping) and one that gained.
+  CHECK(passes[1] < passes[0]);
+  CHECK(passes[1] <= 4 * (rounds[1] + 1));
+  CHECK(passes[0] > 4 * (rounds[0] + 1));
+}
+
 TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
   // With either split (the hinges keep sums of their own, which slices must not disturb).
   const std::size_t n = fill_room(2000, 0.03, 8);

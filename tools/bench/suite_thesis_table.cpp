@@ -349,6 +349,10 @@ int run_thesis_table() {
         cfg.max_refit_passes = env_size("BOTICELLI_THESIS_PASSES", 8);
         cfg.damped_refit = env_size("BOTICELLI_THESIS_DAMPED", 0) != 0;
         cfg.check_pruning = env_size("BOTICELLI_THESIS_CHECK_PRUNING", 0) != 0;
+        if (const char* t = std::getenv("BOTICELLI_THESIS_ROUND_TOLERANCE");
+            t != nullptr && *t != '\0') {
+          cfg.round_tolerance = std::atof(t);
+        }
         cfg.seed = static_cast<std::uint32_t>(env_size("BOTICELLI_THESIS_SEED", 1));  // the split's
         cfg.max_pieces = kMaxPieces;
         cfg.split_rule = run.rule;
