@@ -1,4 +1,5 @@
 // Tests of the star polygon, its intersection and its exact shrink against brute force.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <span>
@@ -421,4 +422,87 @@ TEST(OpenSpikes, WedgesNarrowerThanTheWindowGoAndWiderOpeningsStay) {
   StarPolygon q = before;
   boticelli::mapping::open_spikes(q, 0);
   for (std::size_t k = 0; k < 360; ++k) DOUBLES_EQUAL(before.rho_m(k), q.rho_m(k), 0.0);
+}
+
+TEST_GROUP(KeepPointsThatCut){};
+
+namespace {
+// The nearest point's distance per vertex ray, by nearest_vertex (infinity where none).
+void nearest_per_ray(std::span<const Point2> points, const StarPolygon& shape, float* out) {
+  for (std::size_t k = 0; k < shape.vertex_count(); ++k) out[k] = INFINITY;
+  for (const Point2& q : points) {
+    const std::size_t k = boticelli::mapping::nearest_vertex(shape, std::atan2(q.y_m, q.x_m));
+    out[k] = std::fmin(out[k], std::hypot(q.x_m, q.y_m));
+  }
+}
+}  // namespace
+
+TEST(KeepPointsThatCut, TheKeptPointsCutThePolygonAndGiveEachRayItsNearestPointAsAllOfThemDo) {
+  Random rng(31);
+  for (const std::size_t n : {std::size_t{90}, std::size_t{360}}) {
+    // Clusters of features on a few surfaces (many per sector), points on vertex rays and
+    // across the seam, and a scatter.
+    Point2 points[3000];
+    std::size_t count = 0;
+    StarPolygon shape(n);
+    for (int c = 0; c < 12; ++c) {
+      const float a = rng.uniform(0.0F, 6.2831853F);
+      const float d = rng.uniform(0.5F, 3.0F);
+      for (int k = 0; k < 200; ++k) {
+        const float da = rng.uniform(-0.15F, 0.15F);
+        const float dd = rng.uniform(-0.1F, 0.1F);
+        points[count++] = {(d + dd) * std::cos(a + da), (d + dd) * std::sin(a + da)};
+      }
+    }
+    for (std::size_t k = 0; k < 300; ++k) {
+      const float a = shape.angle_rad(k % n);
+      const float d = rng.uniform(0.3F, 3.0F);
+      points[count++] = {d * std::cos(a), d * std::sin(a)};
+    }
+    for (int k = 0; k < 300; ++k) {
+      const float d = rng.uniform(0.3F, 3.0F);
+      points[count++] = {d, rng.uniform(-1e-3F, 1e-3F)};  // on ray 0, either side of the seam
+    }
+    while (count < 3000) {
+      const float a = rng.uniform(0.0F, 6.2831853F);
+      const float d = rng.uniform(0.3F, 3.0F);
+      points[count++] = {d * std::cos(a), d * std::sin(a)};
+    }
+    Point2 kept[3000];
+    std::copy(points, points + count, kept);
+    const std::size_t k = boticelli::mapping::keep_points_that_cut(kept, shape);
+    CHECK(k <= 2 * n + 1);
+    CHECK(k < count / 2);
+    StarPolygon all(n);
+    StarPolygon some(n);
+    all.fill(5.0F);
+    some.fill(5.0F);
+    boticelli::mapping::exclude_points(std::span<const Point2>(points, count), all);
+    boticelli::mapping::exclude_points(std::span<const Point2>(kept, k), some);
+    for (std::size_t v = 0; v < n; ++v) CHECK_EQUAL(all.rho_m(v), some.rho_m(v));
+    float near_all[360];
+    float near_some[360];
+    nearest_per_ray(std::span<const Point2>(points, count), shape, near_all);
+    nearest_per_ray(std::span<const Point2>(kept, k), shape, near_some);
+    for (std::size_t v = 0; v < n; ++v) CHECK_EQUAL(near_all[v], near_some[v]);
+    // The kept points are some of the points, in their order.
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < k; ++i) {
+      while (at < count && (points[at].x_m != kept[i].x_m || points[at].y_m != kept[i].y_m)) ++at;
+      CHECK(at < count);
+      ++at;
+    }
+  }
+}
+
+TEST(KeepPointsThatCut, APointAtTheCentreIsKeptAndStillClosesThePolygon) {
+  StarPolygon shape(360);
+  Point2 points[3] = {{1.0F, 0.5F}, {0.0F, 0.0F}, {1.1F, 0.55F}};
+  const std::size_t k = boticelli::mapping::keep_points_that_cut(points, shape);
+  LONGS_EQUAL(2, k);  // the third is behind the first in the same sector and on the same ray
+  CHECK(points[1].x_m == 0.0F && points[1].y_m == 0.0F);
+  StarPolygon free(360);
+  free.fill(2.0F);
+  boticelli::mapping::exclude_points(std::span<const Point2>(points, k), free);
+  DOUBLES_EQUAL(0.0, free.max_rho_m(), 0.0);
 }

@@ -218,11 +218,12 @@ struct BuildParts {
   double guard_ms = 0.0;
   std::size_t samples = 0;
   std::size_t passes = 0;
-  std::size_t coarse_passes = 0;   // of them over every coarse_stride-th sample
-  std::size_t rounds = 0;          // split rounds kept (TrainerStats::iterations)
-  std::size_t failed_rounds = 0;   // split rounds undone
-  std::size_t pruning_undone = 0;  // prunings undone (they raised the loss)
-  double rms = 0.0;                // the fit's RMS over all samples
+  std::size_t coarse_passes = 0;       // of them over every coarse_stride-th sample
+  std::size_t rounds = 0;              // split rounds kept (TrainerStats::iterations)
+  std::size_t failed_rounds = 0;       // split rounds undone
+  std::size_t pruning_undone = 0;      // prunings undone (they raised the loss)
+  double rms = 0.0;                    // the fit's RMS over all samples
+  std::size_t guard_corroborated = 0;  // guard points before keep_points_that_cut
 };
 
 void emit(const RoomSpec& spec, const char* method, double resolution_m, std::size_t model_bytes,
@@ -248,6 +249,7 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
         .integer("samples", static_cast<std::int64_t>(parts.samples))
         .integer("passes", static_cast<std::int64_t>(parts.passes))
         .integer("coarse_passes", static_cast<std::int64_t>(parts.coarse_passes))
+        .integer("guard_corroborated", static_cast<std::int64_t>(parts.guard_corroborated))
         .integer("rounds", static_cast<std::int64_t>(parts.rounds))
         .integer("failed_rounds", static_cast<std::int64_t>(parts.failed_rounds))
         .integer("pruning_undone", static_cast<std::int64_t>(parts.pruning_undone))
@@ -482,6 +484,10 @@ int run() {
         (void)mapping::collect_unexplained_features(readings, occupancy, p, guard, g_candidates);
         (void)mapping::drop_seen_through(readings, guard, g_candidates);
         (void)mapping::corroborated_points(g_candidates, guard, g_guard);
+        // Only the points that can cut the polygon, as the mission's builder keeps them.
+        parts.guard_corroborated = g_guard.size();
+        g_guard.resize(
+            mapping::keep_points_that_cut(g_guard.span(), mapping::StarPolygon(p.vertex_count)));
         parts.guard_ms = ms_since(t_guard);
         const double build_ms = ms_since(t0);
         const double extract_ms = median_ms(reps, [&] {

@@ -15,14 +15,6 @@ namespace {
 
 using evidence::horizontal_m;
 
-// Vertex index whose sector (centred on the vertex ray) holds pan angle α.
-std::size_t vertex_of(const StarPolygon& p, float alpha_rad) {
-  const float a = core::wrap_two_pi(alpha_rad);
-  const auto n = p.vertex_count();
-  auto k = static_cast<std::size_t>(std::lround(a / p.angle_step_rad()));
-  return k % n;
-}
-
 // The robot's disc and its clearance margin, a little more so the shrunk polygon keeps a point:
 // free at every look (the robot stands there).
 float own_disc_m(const ExtractionParams& p) {
@@ -183,6 +175,12 @@ bool LocalModelBuilder::step() {
       if (!corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_)) {
         stats_.guard_points_full = true;
       }
+      if (!(params_.guard_disc_m > 0.0F)) {
+        // Only the points that can cut the polygon or be a vertex ray's nearest evidence
+        // (exact for points; a disc's cut depends on more than its sector's nearest point).
+        const StarPolygon shape(params_.extraction.vertex_count);
+        guard_.resize(keep_points_that_cut(guard_.span(), shape));
+      }
       guard_cursor_ = end;
       if (guard_cursor_ == candidates_.size()) {
         stats_.guard_candidates = candidates_.size();
@@ -210,7 +208,7 @@ void LocalModelBuilder::build_seen_free() {
   // The line of sight to a free floor point is free; so is the floor up to an obstacle's
   // base (less its range error) and the body band up to a feature seen inside it.
   auto see = [&](float alpha, float rho) {
-    const std::size_t k = vertex_of(seen_free_, alpha);
+    const std::size_t k = nearest_vertex(seen_free_, alpha);
     seen_free_.set_rho_m(k, std::max(seen_free_.rho_m(k), std::min(rho, p.bounding_radius_m)));
   };
   const float dr = params_.rays.delta_r_fraction;
@@ -229,7 +227,7 @@ void LocalModelBuilder::build_seen_free() {
       joined = false;
       for (std::size_t i = 0; i < free_.size(); ++i) {
         const evidence::Reading& r = free_[i];
-        const std::size_t k = vertex_of(seen_free_, r.alpha_rad);
+        const std::size_t k = nearest_vertex(seen_free_, r.alpha_rad);
         const float reach = seen_free_.rho_m(k);
         const float far = std::min(horizontal_m(r), p.bounding_radius_m);
         const float start_limit =
@@ -295,7 +293,7 @@ void LocalModelBuilder::extract() {
   // The floor cue's obstacle bases are obstacles whatever the fit says: nothing beyond a
   // base along its ray is free at the robot's lowest slice.
   for (const evidence::Reading& r : obstacles_) {
-    const std::size_t k = vertex_of(obstacle_polygon_, r.alpha_rad);
+    const std::size_t k = nearest_vertex(obstacle_polygon_, r.alpha_rad);
     const float base = std::max(horizontal_m(r) - params_.base_margin_m, 0.0F);
     obstacle_polygon_.set_rho_m(k, std::min(obstacle_polygon_.rho_m(k), base));
   }
@@ -303,7 +301,7 @@ void LocalModelBuilder::extract() {
   evidence_.set_vertex_count(p.vertex_count);
   evidence_.fill(std::numeric_limits<float>::infinity());
   auto evidence_at = [&](float alpha, float rho) {
-    const std::size_t k = vertex_of(evidence_, alpha);
+    const std::size_t k = nearest_vertex(evidence_, alpha);
     evidence_.set_rho_m(k, std::min(evidence_.rho_m(k), rho));
   };
   for (const evidence::Reading& r : obstacles_) evidence_at(r.alpha_rad, horizontal_m(r));
@@ -332,13 +330,13 @@ void LocalModelBuilder::extract() {
     scratch_.set_vertex_count(p.vertex_count);
     scratch_.fill(std::numeric_limits<float>::infinity());  // nearest walk start per ray
     for (std::size_t i = 0; i < free_near_.size(); ++i) {
-      const std::size_t k = vertex_of(scratch_, free_[i].alpha_rad);
+      const std::size_t k = nearest_vertex(scratch_, free_[i].alpha_rad);
       scratch_.set_rho_m(k, std::min(scratch_.rho_m(k), free_near_[i]));
     }
     const float own = own_disc_m(p);
     for (const evidence::Reading& r : blocked_) {
       const float near = horizontal_m(r);
-      const std::size_t k = vertex_of(obstacle_polygon_, r.alpha_rad);
+      const std::size_t k = nearest_vertex(obstacle_polygon_, r.alpha_rad);
       if (near > params_.seen_floor_start_m || scratch_.rho_m(k) < near - kBlockedTolerance_m ||
           obstacle_polygon_.rho_m(k) <= own) {
         continue;

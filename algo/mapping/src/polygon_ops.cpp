@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "segment_geometry.h"
 
@@ -589,34 +590,114 @@ float sweep_clearance_m(const StarPolygon& region, core::Point2 p) {
   return static_cast<float>(d);
 }
 
+namespace {
+// The vertices exclude_points cuts for point q, and to what: the sector [θ_k, θ_k+1] holding
+// it, both vertices cut to just below its distance d. A point on (or within rounding of)
+// one of its rays also lies in the sector beyond that ray: then vertices k − 1 .. k + 2 are
+// cut, which covers both sectors whichever of the two rays it is. at_centre: d is not > 0.
+struct PointCut {
+  bool at_centre = false;
+  float cut = 0.0F;       // a micrometre inside d, clear of float rounding
+  std::size_t first = 0;  // first vertex cut (mod n)
+  std::size_t count = 0;  // 2 or 4
+};
+
+PointCut point_cut(core::Point2 q, std::size_t n, float step) {
+  PointCut c;
+  const float d = std::hypot(q.x_m, q.y_m);
+  if (!(d > 0.0F)) {
+    c.at_centre = true;
+    return c;
+  }
+  float theta = std::atan2(q.y_m, q.x_m);
+  if (theta < 0.0F) {
+    theta += core::kTwoPi<float>;
+  }
+  auto k = static_cast<std::size_t>(theta / step);
+  k = std::min(k, n - 1);
+  c.cut = d * (1.0F - 1e-6F);
+  const float offset = theta - static_cast<float>(k) * step;
+  const bool near_ray = offset < 1e-5F || step - offset < 1e-5F;
+  c.first = near_ray ? k + n - 1 : k;
+  c.count = near_ray ? 4 : 2;
+  return c;
+}
+}  // namespace
+
+std::size_t nearest_vertex(const StarPolygon& p, float alpha_rad) {
+  const float a = core::wrap_two_pi(alpha_rad);
+  const auto n = p.vertex_count();
+  auto k = static_cast<std::size_t>(std::lround(a / p.angle_step_rad()));
+  return k % n;
+}
+
 void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
   const std::size_t n = free.vertex_count();
   const float step = free.angle_step_rad();
   for (const core::Point2& q : points) {
-    const float d = std::hypot(q.x_m, q.y_m);
-    if (!(d > 0.0F)) {
+    const PointCut c = point_cut(q, n, step);
+    if (c.at_centre) {
       free.fill(0.0F);  // an obstacle at the centre: nowhere is free
       return;
     }
-    float theta = std::atan2(q.y_m, q.x_m);
-    if (theta < 0.0F) {
-      theta += core::kTwoPi<float>;
-    }
-    // The sector [θ_k, θ_k+1] holding the point. A point on (or within rounding of) one of
-    // its rays also lies in the sector beyond that ray: then vertices k − 1 .. k + 2 are
-    // cut, which covers both sectors whichever of the two rays it is.
-    auto k = static_cast<std::size_t>(theta / step);
-    k = std::min(k, n - 1);
-    const float cut = d * (1.0F - 1e-6F);  // a micrometre inside, clear of float rounding
-    const float offset = theta - static_cast<float>(k) * step;
-    const bool near_ray = offset < 1e-5F || step - offset < 1e-5F;
-    const std::size_t first = near_ray ? k + n - 1 : k;
-    const std::size_t count = near_ray ? 4 : 2;
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t v = (first + i) % n;
-      free.set_rho_m(v, std::min(free.rho_m(v), cut));
+    for (std::size_t i = 0; i < c.count; ++i) {
+      const std::size_t v = (c.first + i) % n;
+      free.set_rho_m(v, std::min(free.rho_m(v), c.cut));
     }
   }
+}
+
+std::size_t keep_points_that_cut(std::span<core::Point2> points, const StarPolygon& shape) {
+  const std::size_t n = shape.vertex_count();
+  const float step = shape.angle_step_rad();
+  constexpr auto kNone = std::numeric_limits<std::uint32_t>::max();
+  std::array<std::uint32_t, kMaxPolygonVertices> cutter;  // per vertex: the point cutting nearest
+  std::array<float, kMaxPolygonVertices> cut;
+  std::array<std::uint32_t, kMaxPolygonVertices> nearest;  // per vertex ray: the nearest point
+  std::array<float, kMaxPolygonVertices> near;
+  cutter.fill(kNone);
+  nearest.fill(kNone);
+  cut.fill(std::numeric_limits<float>::infinity());
+  near.fill(std::numeric_limits<float>::infinity());
+  std::uint32_t centre = kNone;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto index = static_cast<std::uint32_t>(i);
+    const PointCut c = point_cut(points[i], n, step);
+    if (c.at_centre) {
+      if (centre == kNone) centre = index;
+      continue;
+    }
+    for (std::size_t j = 0; j < c.count; ++j) {
+      const std::size_t v = (c.first + j) % n;
+      if (c.cut < cut[v]) {
+        cut[v] = c.cut;
+        cutter[v] = index;
+      }
+    }
+    const core::Point2 q = points[i];
+    const std::size_t v = nearest_vertex(shape, std::atan2(q.y_m, q.x_m));
+    const float d = std::hypot(q.x_m, q.y_m);
+    if (d < near[v]) {
+      near[v] = d;
+      nearest[v] = index;
+    }
+  }
+  // The points some vertex names, in their own order.
+  std::size_t kept = 0;
+  const auto keep = [&](std::uint32_t index) { return index != kNone; };
+  std::array<std::uint32_t, 2 * kMaxPolygonVertices + 1> keepers;
+  std::size_t keeper_count = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (keep(cutter[v])) keepers[keeper_count++] = cutter[v];
+    if (keep(nearest[v])) keepers[keeper_count++] = nearest[v];
+  }
+  if (keep(centre)) keepers[keeper_count++] = centre;
+  std::sort(keepers.begin(), keepers.begin() + static_cast<std::ptrdiff_t>(keeper_count));
+  for (std::size_t k = 0; k < keeper_count; ++k) {
+    if (k > 0 && keepers[k] == keepers[k - 1]) continue;
+    points[kept++] = points[keepers[k]];  // keepers ascend, so nothing is overwritten unread
+  }
+  return kept;
 }
 
 void exclude_discs(std::span<const core::Point2> points, float radius_m, StarPolygon& free) {

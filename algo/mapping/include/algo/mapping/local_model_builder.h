@@ -97,7 +97,7 @@ struct LocalModelStats {
   std::size_t pieces = 0;
   double rms = 0.0;
   std::size_t guard_candidates = 0;
-  std::size_t guard_points = 0;
+  std::size_t guard_points = 0;      // kept: those that can cut the polygon (keep_points_that_cut)
   std::size_t guard_dropped = 0;     // unexplained readings that found the candidate list full
   bool guard_points_full = false;    // corroborated points were dropped (the list was full)
   std::size_t blocked_rays = 0;      // vertex rays closed by floor_blocked (close_blocked_rays)
