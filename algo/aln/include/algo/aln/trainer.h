@@ -300,6 +300,7 @@ class Trainer {
     // bin_step), samples outside in the end bins; and the span the samples really had.
     VecD bin_lo = VecD::Zero();
     VecD bin_step = VecD::Ones();
+    VecD bin_scale = VecD::Ones();  // 1 / bin_step
     VecD seen_lo = VecD::Constant(std::numeric_limits<double>::infinity());
     VecD seen_hi = VecD::Constant(-std::numeric_limits<double>::infinity());
     std::array<std::array<HingeBin, kSplitBins>, static_cast<std::size_t>(N)> bins{};
@@ -366,6 +367,7 @@ class Trainer {
         acc[p].bin_step(j) = kSplitBins > 0 && span > 0.0 && std::isfinite(span)
                                  ? span / static_cast<double>(kSplitBins)
                                  : 1.0;
+        acc[p].bin_scale(j) = 1.0 / acc[p].bin_step(j);
       }
     }
   }
@@ -429,7 +431,7 @@ class Trainer {
       const double xj = static_cast<double>(s.x(j));
       a.seen_lo(j) = std::min(a.seen_lo(j), xj);
       a.seen_hi(j) = std::max(a.seen_hi(j), xj);
-      const double t = (xj - a.bin_lo(j)) / a.bin_step(j);
+      const double t = (xj - a.bin_lo(j)) * a.bin_scale(j);
       const std::size_t b =
           t <= 0.0 ? 0 : std::min(static_cast<std::size_t>(t), kSplitBins - 1);  // NaN-free: t > 0
       const double u = xj - (a.bin_lo(j) + (static_cast<double>(b) + 0.5) * a.bin_step(j));
