@@ -179,6 +179,7 @@ class Dtree {
 
   [[nodiscard]] std::size_t block_count() const { return blocks_used_; }
   [[nodiscard]] std::size_t split_count() const { return splits_used_; }
+  // Ops stored over all blocks (blocks with the same ops share them).
   [[nodiscard]] std::size_t node_count() const { return pool_used_; }
   // Largest number of pieces kept in one block, and the mean over blocks.
   [[nodiscard]] std::size_t max_block_pieces() const { return block_pieces_max_; }
