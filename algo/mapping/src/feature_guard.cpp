@@ -67,10 +67,15 @@ std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
       const float pan_reach = 1.05F * spread / std::fmax(cos_el - spread, 0.05F);
       const float near_limit = (r - lever) * far_factor - lever;
       for (const evidence::Reading& q : readings) {
-        if (!(q.r_m > near_limit)) continue;
-        if (std::fabs(std::remainder(q.alpha_rad - alpha, core::kTwoPi<float>)) > pan_reach) {
-          continue;
-        }
+        // The pan difference's size folded into [0, π] without a library call or a branch:
+        // pans in [0, 2π) and (−π, π] differ by less than 3π, where it is
+        // min(|d|, |2π − |d||); others take std::remainder. One branch for both tests, which
+        // almost every reading fails.
+        const float d = std::fabs(q.alpha_rad - alpha);
+        const float pan = d <= 3.0F * core::kPi<float>
+                              ? std::min(d, std::fabs(core::kTwoPi<float> - d))
+                              : std::fabs(std::remainder(d, core::kTwoPi<float>));
+        if (!(q.r_m > near_limit) | (pan > pan_reach)) continue;
         // From q's view: u to q, w to the candidate; q beyond both range errors, within the
         // angle.
         const core::Point2 qp = evidence::floor_point_m(q);
