@@ -1,6 +1,7 @@
 // Tests of the feature guard: unexplained features, their corroboration, and the polygon kept
 // clear of them.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include "algo/mapping/extraction.h"
 #include "algo/mapping/feature_guard.h"
 #include "algo/mapping/polygon_ops.h"
+#include "polygon_fixtures.h"
 
 #include "CppUTest/TestHarness.h"
 #include "alloc_guard.h"
@@ -330,6 +332,8 @@ TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
   box_face(readings, 35);
   static FixedVector<mapping::GuardPoint, 64> candidates;
   static FixedVector<Point2, 64> guard;
+  static FixedVector<Point2, 64> thinned;
+  static std::array<std::uint32_t, 64> order;  // the readings by pan (drop_seen_through)
   static mapping::LocalMap map;
   static mapping::StarPolygon scratch;
   const mapping::ExtractionParams p = robot();
@@ -342,10 +346,15 @@ TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
     mapping::FeatureGuardParams see_through;
     see_through.see_through_readings = 2;
     (void)mapping::drop_seen_through(readings, see_through, candidates);
+    (void)mapping::drop_seen_through(readings, see_through, candidates, order);
     (void)mapping::corroborated_points(candidates, mapping::FeatureGuardParams{}, guard);
+    thinned.clear();
+    for (const Point2& q : guard) (void)thinned.push_back(q);
+    thinned.resize(mapping::keep_points_that_cut(thinned.span(), scratch));
     mapping::extract_local_map(free_range, p, map, scratch, guard);
   });
   LONGS_EQUAL(35, guard.size());
+  CHECK(thinned.size() > 0 && thinned.size() < 35);
 }
 
 // More candidates than the first wave's list held (2,048; looks on rendered frames have up to
@@ -426,13 +435,24 @@ TEST(FeatureGuard, ACandidateTheCameraSawPastOnItsLineOfSightIsDroppedAndOthersS
   const std::array<mapping::GuardPoint, 4> all = {
       candidate_at(0.0F, 1.0F, -0.3F), candidate_at(1.0F, 1.0F, -0.3F),
       candidate_at(2.0F, 1.0F, -0.3F), candidate_at(6.2731853F, 1.0F, 0.1F)};
+  // The plain scan and the one over the readings ordered by pan drop the same.
   const auto run = [&](std::size_t through) {
     mapping::FeatureGuardParams g;
     g.see_through_readings = through;
     GuardCandidatesFor<4> candidates;
-    for (const mapping::GuardPoint& c : all) (void)candidates.push_back(c);
+    GuardCandidatesFor<4> ordered;
+    for (const mapping::GuardPoint& c : all) {
+      (void)candidates.push_back(c);
+      (void)ordered.push_back(c);
+    }
     const std::size_t dropped = mapping::drop_seen_through(readings, g, candidates);
     LONGS_EQUAL(dropped, all.size() - candidates.size());
+    std::array<std::uint32_t, 16> scratch{};
+    LONGS_EQUAL(dropped, mapping::drop_seen_through(readings, g, ordered, scratch));
+    LONGS_EQUAL(candidates.size(), ordered.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      CHECK_EQUAL(candidates[i].x_m, ordered[i].x_m);
+    }
     return candidates;
   };
   // Two readings needed: A and D go, B and C stay, in their order.
@@ -443,6 +463,45 @@ TEST(FeatureGuard, ACandidateTheCameraSawPastOnItsLineOfSightIsDroppedAndOthersS
   // One reading is enough for C too; off, nothing goes.
   LONGS_EQUAL(1, run(1).size());
   LONGS_EQUAL(4, run(0).size());
+}
+
+TEST(FeatureGuard, OrderingTheReadingsByPanDropsTheSameCandidatesAsThePlainScan) {
+  // A room's readings from views on a 0.21 m lever, and candidates among and in front of
+  // them, many near the seam at pan 0 / 2π: both scans drop the same ones, in the same order.
+  static FixedVector<Reading, 4000> readings;
+  readings.clear();
+  boticelli::test::Random rng(41);
+  for (int k = 0; k < 4000; ++k) {
+    const float alpha = k % 4 == 0 ? rng.uniform(6.1F, 6.2831F) : rng.uniform(0.0F, 6.2831F);
+    Reading q = at(alpha, rng.uniform(1.0F, 4.0F), rng.uniform(-0.8F, 0.6F));
+    const float view = rng.uniform(0.0F, 6.2831853F);
+    q.view_x_m = 0.21F * std::cos(view);
+    q.view_y_m = 0.21F * std::sin(view);
+    (void)readings.push_back(q);
+  }
+  static GuardCandidatesFor<600> plain;
+  static GuardCandidatesFor<600> ordered;
+  plain.clear();
+  ordered.clear();
+  for (int k = 0; k < 600; ++k) {
+    const float alpha = k % 3 == 0 ? rng.uniform(-0.2F, 0.2F) : rng.uniform(-3.14F, 3.14F);
+    const mapping::GuardPoint c =
+        candidate_at(alpha, rng.uniform(0.3F, 3.5F), rng.uniform(-0.8F, 0.5F));
+    (void)plain.push_back(c);
+    (void)ordered.push_back(c);
+  }
+  mapping::FeatureGuardParams g;
+  g.see_through_readings = 2;
+  g.see_through_angle_rad = 0.05F;
+  static std::array<std::uint32_t, 4000> scratch;
+  const std::size_t dropped = mapping::drop_seen_through(readings, g, plain);
+  CHECK(dropped > 60 && dropped < 540);  // the test has both kinds
+  LONGS_EQUAL(dropped, mapping::drop_seen_through(readings, g, ordered, scratch));
+  LONGS_EQUAL(plain.size(), ordered.size());
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    CHECK_EQUAL(plain[i].x_m, ordered[i].x_m);
+    CHECK_EQUAL(plain[i].y_m, ordered[i].y_m);
+  }
 }
 
 TEST(FeatureGuard, TheLinesOfSightThatSeePastACandidateStartAtTheReadingsViews) {

@@ -446,6 +446,9 @@ int run() {
       scan.range_error_b = g_range_error_b;
       const std::vector<evidence::Reading> readings =
           room.generate_camera_readings(scan, kFeatures, 7U);
+      // The see-through check's pan order of the readings (drop_seen_through's scratch), as
+      // a look's fixed buffer would hold it: made before any build is timed.
+      std::vector<std::uint32_t> pan_order(readings.size());
 
       // Ours: ray samples → ALN fit → inversion → slices, intersection, exact shrink; with each
       // sensor model, the refit (warm start) with the first.
@@ -482,7 +485,7 @@ int run() {
         guard.see_through_readings =
             through != nullptr && *through != '\0' ? std::strtoul(through, nullptr, 10) : 2;
         (void)mapping::collect_unexplained_features(readings, occupancy, p, guard, g_candidates);
-        (void)mapping::drop_seen_through(readings, guard, g_candidates);
+        (void)mapping::drop_seen_through(readings, guard, g_candidates, pan_order);
         (void)mapping::corroborated_points(g_candidates, guard, g_guard);
         // Only the points that can cut the polygon, as the mission's builder keeps them.
         parts.guard_corroborated = g_guard.size();

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include "algo/core/fixed_vector.h"
@@ -144,6 +145,14 @@ std::size_t collect_unexplained_features(std::span<const evidence::Reading> read
 // than the farthest view stays.
 std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
                               const FeatureGuardParams& g, GuardCandidates& candidates);
+// The same candidates dropped, with the readings ordered by pan in `scratch` (one index per
+// reading; a counting sort into 1024 pan buckets) so that each candidate looks only at those
+// in the buckets within its pan reach: O(readings + candidates × readings in reach), about
+// 8 KB of stack. With scratch smaller than the readings, more than 2^32 readings or a pan
+// outside [0, 2π), the plain scan above.
+std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
+                              const FeatureGuardParams& g, GuardCandidates& candidates,
+                              std::span<std::uint32_t> scratch);
 
 // Orders candidates by x, so corroborated_points looks only at those within reach along x.
 void sort_guard_candidates(std::span<GuardPoint> candidates);
