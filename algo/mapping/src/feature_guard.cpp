@@ -114,8 +114,8 @@ bool sees_past(const evidence::Reading& q, const GuardPoint& c, const CandidateC
   return ux * wx + uy * wy + uz * wz >= st.cos_max * u * w;
 }
 
-// Drops the candidates `seen` counts enough readings for (seen(c, cone) counts up to
-// `enough`), keeping the others' order; returns how many went.
+// Drops the candidates for which seen(c, cone) counts g.see_through_readings readings (it may
+// stop counting there), keeping the others' order; returns how many went.
 template <typename Seen>
 std::size_t drop_where(GuardCandidates& candidates, const SeeThrough& st,
                        const FeatureGuardParams& g, const Seen& seen) {
@@ -182,7 +182,7 @@ std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
     // The buckets holding the pans within reach, widened by a milliradian (sees_past still
     // applies the reach itself, so the wider window only costs the readings at its edges).
     const float reach = cone.pan_reach + 1e-3F;
-    if (!(reach < core::kPi<float>)) {
+    if (!(reach < core::kPi<float>)) {  // also NaN
       scan(0, n);
       return through;
     }
@@ -190,6 +190,10 @@ std::size_t drop_seen_through(std::span<const evidence::Reading> readings,
     const auto first = static_cast<std::ptrdiff_t>(std::floor((a - reach) * kPerRad));
     const auto last = static_cast<std::ptrdiff_t>(std::floor((a + reach) * kPerRad));
     constexpr auto kCount = static_cast<std::ptrdiff_t>(kBuckets);
+    if (last - first + 1 >= kCount) {  // every bucket: all readings, each once
+      scan(0, n);
+      return through;
+    }
     for (std::ptrdiff_t b = first; b <= last && through < g.see_through_readings; ++b) {
       const auto wrapped = static_cast<std::size_t>((b % kCount + kCount) % kCount);
       scan(start[wrapped], start[wrapped + 1]);
