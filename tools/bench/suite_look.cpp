@@ -333,7 +333,8 @@ std::int64_t within_0_1m(const std::vector<double>& errors_m) {
 struct WorldStats {
   std::vector<double> readings, floor_obstacles, floor_free, weak_share;
   std::vector<double> range_error_m, range_error_rel;  // |r − r_true| [m] and / δr (Eq 3.7)
-  std::vector<double> safety, coverage, nav_safety, free_area, nav_area, pieces, guard_points;
+  std::vector<double> safety, coverage, nav_safety, free_area, nav_area, pieces, guard_points,
+      guard_corroborated;
   std::size_t guard_truncated = 0;
   std::vector<double> render_ms, stereo_ms, target_ms, floor_ms, think_ms;
   std::size_t target_views = 0, target_found = 0, target_far = 0, target_false = 0;
@@ -556,6 +557,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     st.think_ms.push_back(static_cast<double>(cpu_ns() - t0) * 1e-6);
     st.pieces.push_back(static_cast<double>(g_builder.stats().pieces));
     st.guard_points.push_back(static_cast<double>(g_builder.stats().guard_points));
+    st.guard_corroborated.push_back(static_cast<double>(g_builder.stats().guard_corroborated));
     st.guard_truncated +=
         g_builder.stats().guard_dropped > 0 || g_builder.stats().guard_points_full ? 1U : 0U;
     st.render_ms.push_back(render_ns * 1e-6);
@@ -605,6 +607,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .num("range_err_p99_dr", percentile(st.range_error_rel, 0.99))
       .num("pieces", mean(st.pieces))
       .num("guard_points", mean(st.guard_points))
+      .num("guard_corroborated", mean(st.guard_corroborated))
       .integer("looks_guard_truncated", static_cast<std::int64_t>(st.guard_truncated))
       .num("safety", mean(st.safety))
       .num("safety_min", min_safety)

@@ -172,9 +172,11 @@ bool LocalModelBuilder::step() {
       // A bounded slice of the candidates (sorted by x) per unit, each against its reach.
       const std::size_t end =
           std::min(candidates_.size(), guard_cursor_ + params_.guard_candidates_per_unit);
+      const std::size_t before = guard_.size();
       if (!corroborated_points(candidates_.span(), guard_cursor_, end, params_.guard, guard_)) {
         stats_.guard_points_full = true;
       }
+      stats_.guard_corroborated += guard_.size() - before;
       if (!(params_.guard_disc_m > 0.0F)) {
         // Only the points that can cut the polygon or be a vertex ray's nearest evidence
         // (exact for points; a disc's cut depends on more than its sector's nearest point).

@@ -97,11 +97,12 @@ struct LocalModelStats {
   std::size_t pieces = 0;
   double rms = 0.0;
   std::size_t guard_candidates = 0;
-  std::size_t guard_points = 0;      // kept: those that can cut the polygon (keep_points_that_cut)
-  std::size_t guard_dropped = 0;     // unexplained readings that found the candidate list full
-  bool guard_points_full = false;    // corroborated points were dropped (the list was full)
-  std::size_t blocked_rays = 0;      // vertex rays closed by floor_blocked (close_blocked_rays)
-  std::size_t blocked_by_prior = 0;  // ... of which the prior look's free polygon kept open
+  std::size_t guard_corroborated = 0;  // corroborated candidates (corroborated_points)
+  std::size_t guard_points = 0;        // of them kept: those that can cut the polygon
+  std::size_t guard_dropped = 0;       // unexplained readings that found the candidate list full
+  bool guard_points_full = false;      // corroborated points were dropped (the list was full)
+  std::size_t blocked_rays = 0;        // vertex rays closed by floor_blocked (close_blocked_rays)
+  std::size_t blocked_by_prior = 0;    // ... of which the prior look's free polygon kept open
   std::size_t units = 0;
   bool model_valid = false;  // the fit was invertible (monotone in r)
 };
