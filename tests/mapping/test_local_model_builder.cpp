@@ -394,6 +394,25 @@ TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
   UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_candidates);
 }
 
+TEST(LocalModelBuilder, TheGuardKeepsOnlyThePointsThatCanCutThePolygon) {
+  // Weak floor-cue bases one a degree on two rings, 2 m and 2.5 m away: all are corroborated
+  // guard points, but behind the near ring the far one cuts nothing and is no ray's nearest.
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    (void)look.obstacles.push_back(at(alpha, 2.0F, 0.05F, 0.5F));
+    (void)look.obstacles.push_back(at(alpha, 2.5F, 0.05F, 0.5F));
+    (void)look.free.push_back(at(alpha, 1.97F, 0.0F, 0.0F));
+  }
+  g_other.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+  UNSIGNED_LONGS_EQUAL(720, g_other.stats().guard_corroborated);
+  UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_points);
+}
+
 // A shelf (its front edge 1.5 m away, 0.45-0.55 m above the floor, below the robot's top) seen
 // by the stereo only with m = 0.5 in one sector: below m_safe, so its ray samples plateau at
 // 0.5 and the fit alone never reaches 0.6 there. The floor cue sees the floor free beneath it
