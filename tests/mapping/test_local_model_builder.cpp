@@ -2,6 +2,7 @@
 // with a plain box only the floor cue reports.
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <cstddef>
 #include <cstdio>
 #include <span>
@@ -376,39 +377,37 @@ TEST(LocalModelBuilder, StartingAndSteppingDoNotAllocate) {
   CHECK(g_other.map().can_move);
 }
 
+namespace {
+// Runs g_other on a look of only the floor cue's reports: weak bases (m = 0.5) 0.05 m above
+// the floor, one a degree on a ring at each of `rings` [m], and the floor seen free up to
+// 1.97 m.
+void run_on_base_rings(std::initializer_list<float> rings) {
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    for (const float rho : rings) (void)look.obstacles.push_back(at(alpha, rho, 0.05F, 0.5F));
+    (void)look.free.push_back(at(alpha, 1.97F, 0.0F, 0.0F));
+  }
+  g_other.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+}
+}  // namespace
+
 TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
   // Only the floor cue's reports, 0.05 m above the floor (on the floor's line of sight within
   // 2 δr, where stereo features are not candidates) and weak (m = 0.5: their ray samples
   // plateau below m_safe, so the fit never holds them): every one is a guard candidate.
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
-  for (int d = 0; d < 360; ++d) {
-    const float alpha = deg(static_cast<float>(d));
-    (void)look.obstacles.push_back(at(alpha, 2.0F, 0.05F, 0.5F));
-    (void)look.free.push_back(at(alpha, 1.97F, 0.0F, 0.0F));
-  }
-  g_other.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
-  g_other.run();
+  run_on_base_rings({2.0F});
   UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_candidates);
 }
 
 TEST(LocalModelBuilder, TheGuardKeepsOnlyThePointsThatCanCutThePolygon) {
-  // Weak floor-cue bases one a degree on two rings, 2 m and 2.5 m away: all are corroborated
-  // guard points, but behind the near ring the far one cuts nothing and is no ray's nearest.
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
-  for (int d = 0; d < 360; ++d) {
-    const float alpha = deg(static_cast<float>(d));
-    (void)look.obstacles.push_back(at(alpha, 2.0F, 0.05F, 0.5F));
-    (void)look.obstacles.push_back(at(alpha, 2.5F, 0.05F, 0.5F));
-    (void)look.free.push_back(at(alpha, 1.97F, 0.0F, 0.0F));
-  }
-  g_other.start(make_params(), look.features.span(), look.obstacles.span(), look.free.span());
-  g_other.run();
+  // Bases on two rings, 2 m and 2.5 m away: all are corroborated guard points, but behind the
+  // near ring the far one cuts nothing and is no ray's nearest.
+  run_on_base_rings({2.0F, 2.5F});
   UNSIGNED_LONGS_EQUAL(720, g_other.stats().guard_corroborated);
   UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_points);
 }
