@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <string>
 
 #include <Eigen/Core>
@@ -339,6 +340,81 @@ TEST(AlnTrain, ATrainerWithoutHingeSumsSplitsByTheVWhateverItIsConfigured) {
   CHECK(g_model3.piece_count() > 2);
   CHECK(same_model(g_model3, g_model3b));
   CHECK(sizeof(no_hinges) * 4 < sizeof(g_trainer3));
+}
+
+TEST(AlnTrain, AHingeSplitBendsWhereTheResidualsOfTheModelItsRoundEndedOnBend) {
+  // Without refits the one piece (0 everywhere) is split as it is, from the hinge sums of
+  // its residuals y, which a pass of their own gathers (the refit passes leave them out):
+  // y = 0.3 + 2 max(0, x0 - 0.5) is the candidate at the middle edge of 4 bins over [0, 1]
+  // (the edges beside it explain far less), so the split is 0.3 + 2 max(0, x0 - t), t
+  // within the seeded quarter bin of 0.5.
+  static aln::Trainer<double, 2, 64, 4> trainer;
+  aln_test::Rng rng(5);
+  for (auto& s : g_samples2) {
+    s.x = Eigen::Vector2d(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    s.y = 0.3 + 2.0 * std::fmax(0.0, s.x(0) - 0.5);
+    s.weight = 1.0;
+  }
+  for (const std::uint32_t seed : {1U, 2U, 3U}) {
+    set_unit_ranges(g_model2);
+    g_model2.set_weight_bounds(0, -5.0, 5.0);
+    g_model2.set_weight_bounds(1, -5.0, 5.0);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = 1e-3;
+    cfg.split = aln::SplitCandidates::kHinges;
+    cfg.max_iterations = 1;
+    cfg.max_refit_passes = 0;
+    cfg.seed = seed;
+    trainer.configure(cfg);
+    CHECK(trainer.train(aln::SampleSet<double, 2>(g_samples2, 2500), g_model2));
+    LONGS_EQUAL(2, g_model2.piece_count());
+    LONGS_EQUAL(1, trainer.stats().bin_passes);
+    constexpr double kQuarterBin = 0.25 / 4.0;
+    for (const double y : {0.0, 0.5, 1.0}) {
+      std::array<Eigen::Vector2d, 4> x = {Eigen::Vector2d(0.1, y), Eigen::Vector2d(0.4, y),
+                                          Eigen::Vector2d(0.8, y), Eigen::Vector2d(0.9, y)};
+      std::array<double, 4> v{};
+      std::array<std::uint16_t, 4> who{};
+      g_model2.evaluate_block(std::span<const Eigen::Vector2d>(x.data(), x.size()), v, who);
+      DOUBLES_EQUAL(0.3, v[0], 1e-9);
+      DOUBLES_EQUAL(0.3, v[1], 1e-9);
+      DOUBLES_EQUAL(1.1, v[3], 2.0 * kQuarterBin);
+      DOUBLES_EQUAL(0.2, v[3] - v[2], 1e-9);  // the slope beyond the hinge is the residuals'
+    }
+  }
+}
+
+TEST(AlnTrain, AHingeSplitOfARobustFitLeavesOutWhatTheRobustWeightsLeaveOut) {
+  // A step along x0 (1 below 0.5, 2 beyond) and 5% gross outliers (20), all at x1 > 0.75:
+  // weighted as the pass that fitted them weighs them, the outliers (Tukey weight 0) do not
+  // count and the one split divides the step along x0; counted, they would draw it to x1.
+  static aln::Trainer<double, 2, 64, 4> trainer;
+  aln_test::Rng rng(7);
+  for (auto& s : g_samples2) {
+    s.x = Eigen::Vector2d(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+    s.y = s.x(0) < 0.5 ? 1.0 : 2.0;
+    if (s.x(1) > 0.75 && rng.uniform(0.0, 1.0) < 0.2) s.y = 20.0;
+    s.weight = 1.0;
+  }
+  for (const std::uint32_t seed : {1U, 2U, 3U}) {
+    set_unit_ranges(g_model2);
+    aln::TrainerConfig cfg;
+    cfg.epsilon = 0.1;
+    cfg.robust = aln::RobustWeighting::kTukey;
+    cfg.split = aln::SplitCandidates::kHinges;
+    cfg.max_iterations = 1;
+    cfg.seed = seed;
+    trainer.configure(cfg);
+    CHECK(trainer.train(aln::SampleSet<double, 2>(g_samples2, 2500), g_model2));
+    LONGS_EQUAL(2, g_model2.piece_count());
+    std::array<Eigen::Vector2d, 4> x = {Eigen::Vector2d(0.1, 0.3), Eigen::Vector2d(0.9, 0.3),
+                                        Eigen::Vector2d(0.9, 0.1), Eigen::Vector2d(0.9, 0.9)};
+    std::array<double, 4> v{};
+    std::array<std::uint16_t, 4> who{};
+    g_model2.evaluate_block(std::span<const Eigen::Vector2d>(x.data(), x.size()), v, who);
+    CHECK(who[0] != who[1]);      // split along x0 ...
+    LONGS_EQUAL(who[2], who[3]);  // ... not along x1
+  }
 }
 
 TEST(AlnTrain, EveryPieceOfATrainedModelIsResponsibleForSomeSample) {

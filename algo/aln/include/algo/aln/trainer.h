@@ -95,6 +95,7 @@ struct TrainerStats {
   std::size_t rounds = 0;          // split rounds begun (kept and undone)
   std::size_t passes = 0;          // passes over the samples (coarse and fine)
   std::size_t coarse_passes = 0;   // ... of which over every coarse_stride-th sample only
+  std::size_t bin_passes = 0;      // ... of which gathered the hinge splits' sums alone
   std::uint64_t sample_visits = 0;
   double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
   double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
@@ -304,6 +305,7 @@ class Trainer {
     VecD seen_lo = VecD::Constant(std::numeric_limits<double>::infinity());
     VecD seen_hi = VecD::Constant(-std::numeric_limits<double>::infinity());
     std::array<std::array<HingeBin, kSplitBins>, static_cast<std::size_t>(N)> bins{};
+    bool binned = false;  // whether `bins` hold this pass's sums (gather_bins_)
   };
   using Accumulators = std::array<Accumulator, MaxPieces>;
 
@@ -358,8 +360,20 @@ class Trainer {
 
   void begin_pass() {
     Accumulators& acc = *current_;
+    if (check_ == Check::kBins) {
+      // The model the sums belong to, evaluated again for the split candidates' sums alone,
+      // in the bins its own pass placed.
+      for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+        acc[p].bins = {};
+        acc[p].binned = true;
+      }
+      return;
+    }
+    // A check pass's sums go on to the round's splits as they are (finish_check()).
+    gather_bins_ = hinges() && (check_ == Check::kPruned || check_ == Check::kReverted);
     for (std::size_t p = 0; p < model_->piece_count(); ++p) {
       acc[p] = Accumulator{};
+      acc[p].binned = gather_bins_;
       for (int j = 0; j < N; ++j) {
         const double lo_j = span_lo_[p](j);
         const double span = span_hi_[p](j) - lo_j;
@@ -384,6 +398,12 @@ class Trainer {
       const std::size_t n = std::min(kBlock, end - k);
       for (std::size_t i = 0; i < n; ++i) x[i] = samples_[(k + i) * stride_].x;
       model_->evaluate_block(std::span<const Vec>(x.data(), n), value, piece);
+      if (check_ == Check::kBins) {
+        for (std::size_t i = 0; i < n; ++i) {
+          visit_bins(samples_[(k + i) * stride_], value[i], piece[i]);
+        }
+        continue;
+      }
       for (std::size_t i = 0; i < n; ++i) visit(samples_[(k + i) * stride_], value[i], piece[i]);
     }
   }
@@ -417,7 +437,20 @@ class Trainer {
       }
       return;
     }
-    if constexpr (kSplitBins > 0) add_to_bins(s, w, r, a);
+    if constexpr (kSplitBins > 0) {
+      keep_span(s, a);
+      if (gather_bins_) add_to_bins(s, w, r, a);
+    }
+  }
+
+  // One sample of a bins-only pass (Check::kBins): its residual and weight as visit() has
+  // them, added to its piece's hinge sums only.
+  void visit_bins(const Sample<Scalar, N>& s, Scalar value, std::uint16_t responsible) {
+    if constexpr (kSplitBins > 0) {
+      const double r = static_cast<double>(s.y) - static_cast<double>(value);
+      const double w = static_cast<double>(s.weight) * robust_weight(r, scale_[responsible]);
+      add_to_bins(s, w, r, (*current_)[responsible]);
+    }
   }
 
   // Hinge splits only where the trainer keeps their sums (SplitBins > 0).
@@ -425,12 +458,19 @@ class Trainer {
     return kSplitBins > 0 && config_.split == SplitCandidates::kHinges;
   }
 
-  // A sample's share of its piece's hinge sums: its bin on each input.
-  void add_to_bins(const Sample<Scalar, N>& s, double w, double r, Accumulator& a) const {
+  // The span of a piece's samples (where the next pass puts its bins).
+  static void keep_span(const Sample<Scalar, N>& s, Accumulator& a) {
     for (int j = 0; j < N; ++j) {
       const double xj = static_cast<double>(s.x(j));
       a.seen_lo(j) = std::min(a.seen_lo(j), xj);
       a.seen_hi(j) = std::max(a.seen_hi(j), xj);
+    }
+  }
+
+  // A sample's share of its piece's hinge sums: its bin on each input.
+  void add_to_bins(const Sample<Scalar, N>& s, double w, double r, Accumulator& a) const {
+    for (int j = 0; j < N; ++j) {
+      const double xj = static_cast<double>(s.x(j));
       const double t = (xj - a.bin_lo(j)) * a.bin_scale(j);
       const std::size_t b =
           t <= 0.0 ? 0 : std::min(static_cast<std::size_t>(t), kSplitBins - 1);  // NaN-free: t > 0
@@ -603,6 +643,15 @@ class Trainer {
     }
     split_limit_ = MaxPieces;
     tried_.fill(0);  // another model now: every piece is a candidate again
+    if (needs_bins_before_pruning(*current_, sse)) {
+      gather_bins(AfterBins::kKeepRound, objective, sse);
+      return;
+    }
+    keep_round(objective, sse);
+  }
+
+  // The round's splits stand (or it had none): prune, then split or stop.
+  void keep_round(double objective, double sse) {
     const std::size_t evaluated_pieces = model_->piece_count();
     // What undoing the pruning needs: all of it when prunings are checked, the model alone
     // for the robust check at the end (end_training()), nothing otherwise.
@@ -635,6 +684,36 @@ class Trainer {
     return !refining_ && stats_.iterations < config_.max_iterations && model_->piece_count() < cap_;
   }
 
+  // Whether the round that ends will split its model by hinges from the sums `acc` (robust-
+  // weighted squared error `sse`) while they lack the hinge sums, and its pruning is not
+  // followed by a check pass, which gathers them (pruning changes the model: a pass on the
+  // pruned model would not see the samples as the round's sums did).
+  bool needs_bins_before_pruning(const Accumulators& acc, double sse) {
+    if (!hinges() || acc[0].binned || !may_split()) return false;
+    if (config_.check_pruning) {
+      for (std::size_t p = 0; p < model_->piece_count(); ++p) {
+        if (acc[p].count == 0) return false;  // pruned and checked
+      }
+    }
+    finish_stats(acc);  // the split rule's overall RMS
+    std::array<std::uint8_t, MaxPieces> want{};
+    return pieces_to_split(acc, sse, want) > 0;
+  }
+
+  // The hinge sums (add_to_bins) cost two thirds of a visit, and only the sums of the model a
+  // round ends on are split from, which is not known before the next pass: so the passes
+  // leave them out, and one more pass gathers them for that model (Check::kBins), the same
+  // sums its own pass would have given. Then `then` goes on with `objective` and `sse`.
+  enum class AfterBins : std::uint8_t { kKeepRound, kSplitRound };
+  void gather_bins(AfterBins then, double objective, double sse) {
+    after_bins_ = then;
+    bins_objective_ = objective;
+    bins_sse_ = sse;
+    check_ = Check::kBins;
+    stats_.bin_passes += 1;
+    next_pass();
+  }
+
   // The end of a round whose model and sums (*current_) belong together and whose loss and
   // robust-weighted squared error are `objective` and `sse`: the stats, then splits, or the
   // end of training.
@@ -653,6 +732,14 @@ class Trainer {
   void finish_check() {
     const Check what = check_;
     check_ = Check::kNone;
+    if (what == Check::kBins) {
+      if (after_bins_ == AfterBins::kKeepRound) {
+        keep_round(bins_objective_, bins_sse_);
+      } else {
+        split_round(bins_objective_, bins_sse_);
+      }
+      return;
+    }
     const double loss = loss_of(*current_);
     if (what == Check::kAtEnd) {
       if (loss > unpruned_loss_ * (1.0 + 1e-9)) {
@@ -717,6 +804,11 @@ class Trainer {
     std::array<std::uint8_t, MaxPieces> want{};
     if (pieces_to_split(acc, sse, want) == 0) {
       end_training();
+      return;
+    }
+    if (hinges() && !acc[0].binned) {
+      // Only where the pruning left the model as it was (needs_bins_before_pruning()).
+      gather_bins(AfterBins::kSplitRound, objective, sse);
       return;
     }
     update_scales(acc);
@@ -1061,7 +1153,8 @@ class Trainer {
   double saved_sse_ = 0.0;        // its robust-weighted squared error
   // The last round's model as evaluated, before pruning, with its scales, spans and loss;
   // whether a pass is judging the pruned model or evaluating the unpruned one again.
-  enum class Check : std::uint8_t { kNone, kPruned, kReverted, kAtEnd };
+  // A bins-only pass (gather_bins()) is one more such check.
+  enum class Check : std::uint8_t { kNone, kPruned, kReverted, kAtEnd, kBins };
   Model unpruned_model_{};
   std::array<double, MaxPieces> unpruned_scale_{};
   std::array<VecD, MaxPieces> unpruned_span_lo_{};
@@ -1069,8 +1162,12 @@ class Trainer {
   double unpruned_loss_ = 0.0;
   bool unevaluated_ = false;  // the model was pruned since its last evaluation
   Check check_ = Check::kNone;
-  // Whether this pass gathers the hinges' sums (the pass before a round's splits), and the
-  // loss and squared error of the model it evaluates, as the round judged it.
+  // Whether this pass gathers the hinge sums; after a bins-only pass, what goes on and with
+  // the loss and robust-weighted squared error of the model it evaluated.
+  bool gather_bins_ = false;
+  AfterBins after_bins_ = AfterBins::kKeepRound;
+  double bins_objective_ = 0.0;
+  double bins_sse_ = 0.0;
   std::size_t stride_ = 1;       // every stride_-th sample per pass (TrainerConfig::coarse_stride)
   bool refining_ = false;        // the fine phase: refits on all samples, no splits
   std::size_t split_limit_ = 0;  // 0: no split to judge yet
