@@ -216,7 +216,8 @@ BestRound train_keeping_best(const std::vector<AlnSample>& samples, bool trimmed
     (void)g_trainer.step(samples.size());
     if (g_trainer.stats().iterations != round || g_trainer.done()) {
       // The round ended on the model evaluated in this pass, or (if the last refit made
-      // it worse) on the one of the pass before.
+      // it worse) on the one of the pass before; with hinge splits this pass is the one
+      // that gathered the hinge sums, which evaluated the model the round ended on.
       consider(g_snapshot, round);
       consider(g_snapshot_previous, round);
     }
