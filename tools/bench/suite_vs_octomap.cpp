@@ -219,6 +219,7 @@ struct BuildParts {
   std::size_t samples = 0;
   std::size_t passes = 0;
   std::size_t coarse_passes = 0;       // of them over every coarse_stride-th sample
+  std::size_t bin_passes = 0;          // of them for the hinge sums alone
   std::size_t rounds = 0;              // split rounds kept (TrainerStats::iterations)
   std::size_t failed_rounds = 0;       // split rounds undone
   std::size_t pruning_undone = 0;      // prunings undone (they raised the loss)
@@ -249,6 +250,7 @@ void emit(const RoomSpec& spec, const char* method, double resolution_m, std::si
         .integer("samples", static_cast<std::int64_t>(parts.samples))
         .integer("passes", static_cast<std::int64_t>(parts.passes))
         .integer("coarse_passes", static_cast<std::int64_t>(parts.coarse_passes))
+        .integer("bin_passes", static_cast<std::int64_t>(parts.bin_passes))
         .integer("guard_corroborated", static_cast<std::int64_t>(parts.guard_corroborated))
         .integer("rounds", static_cast<std::int64_t>(parts.rounds))
         .integer("failed_rounds", static_cast<std::int64_t>(parts.failed_rounds))
@@ -466,6 +468,7 @@ int run() {
         parts.samples = samples.size();
         parts.passes = g_trainer.stats().passes;
         parts.coarse_passes = g_trainer.stats().coarse_passes;
+        parts.bin_passes = g_trainer.stats().bin_passes;
         parts.rounds = g_trainer.stats().iterations;
         parts.failed_rounds = g_trainer.stats().failed_rounds;
         parts.pruning_undone = g_trainer.stats().pruning_undone;
