@@ -34,7 +34,7 @@ boticelli::boards::sim::SimBoard g_board;
 struct MissionRun {
   int exit_code = -1;
   std::string mission_line;
-  std::string trace_path;
+  std::string trace_text;  // the trace file as written (the file and its folder are removed)
   std::vector<sim::TraceRow> trace;
   sim::TraceCheck check{};
   double target_error_m = -1.0;
@@ -57,7 +57,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   char dir_template[] = "/tmp/boticelli-mission-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
   MissionRun run;
-  run.trace_path = dir + "/trace.csv";
+  const std::string trace_path = dir + "/trace.csv";
   const std::string out = dir + "/stdout.txt";
   // A shipped world by name, or this test's own worlds by their path.
   const std::string path = world[0] == '/'
@@ -67,8 +67,8 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   g_board.settings().physics.base.odometry_noise = odometry_noise;
   // The console on stdio, stdin at end of file and stdout (telemetry, the MISSION line) into
   // a file.
-  std::vector<const char*> argv = {"boticelli", "--world",     path.c_str(),           "--seed",
-                                   seed,        "--trace",     run.trace_path.c_str(), "--console",
+  std::vector<const char*> argv = {"boticelli", "--world",     path.c_str(),       "--seed",
+                                   seed,        "--trace",     trace_path.c_str(), "--console",
                                    "stdio",     "--max-cycles"};
   argv.push_back("45");
   for (const char* arg : extra) argv.push_back(arg);
@@ -96,19 +96,21 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   const std::size_t e = run.mission_line.find("target_error_m=");
   if (e != std::string::npos) run.target_error_m = std::atof(run.mission_line.c_str() + e + 15);
   std::string error;
-  if (sim::read_trace(run.trace_path.c_str(), run.trace, error)) {
+  run.trace_text = slurp(trace_path);
+  if (sim::read_trace(trace_path.c_str(), run.trace, error)) {
     const auto& c = g_board.config();
     run.check = sim::check_trace(g_board.world(), run.trace, c.robot_radius_m, c.robot_height_m);
   } else {
     run.mission_line += " trace: " + error;
   }
   std::remove(out.c_str());
+  std::remove(trace_path.c_str());
+  rmdir(dir.c_str());
   return run;
 }
 
 // The odometry columns (the mission frame's pose) of a trace's first or last row.
-void trace_odometry(const std::string& trace_path, bool last, double odo[3]) {
-  const std::string text = slurp(trace_path);
+void trace_odometry(const std::string& text, bool last, double odo[3]) {
   const std::size_t first_row = text.find('\n') + 1;
   const std::size_t line = last ? text.rfind('\n', text.size() - 2) + 1 : first_row;
   std::stringstream fields(text.substr(line, text.find('\n', line) - line));
@@ -156,7 +158,7 @@ double odometry_drift_m(const MissionRun& r) {
   const sim::TraceRow& first = r.trace.front();
   const sim::TraceRow& last = r.trace.back();
   double odo[3] = {0.0, 0.0, 0.0};
-  trace_odometry(r.trace_path, true, odo);
+  trace_odometry(r.trace_text, true, odo);
   const boticelli::core::Point2 odo_world =
       boticelli::core::to_world({static_cast<float>(first.x_m), static_cast<float>(first.y_m),
                                  static_cast<float>(first.yaw_rad)},
@@ -171,7 +173,6 @@ TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose
   const MissionRun clean = run_mission("thesis_room", "2", 0.0F);
   check_found_safely(clean);
   const double clean_drift = odometry_drift_m(clean);
-  std::remove(clean.trace_path.c_str());
   const MissionRun r = run_mission("thesis_room", "2", 0.02F);
   check_found_safely(r);
   // The trace's pose is the simulator's true one (where the robot stopped), not odometry,
@@ -186,7 +187,6 @@ TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose
                                  std::to_string(clean_drift) + " m without noise)";
   CHECK_TEXT(clean_drift < 0.0005, drift_text.c_str());
   CHECK_TEXT(drift > 0.001 && drift > 20.0 * clean_drift, drift_text.c_str());
-  std::remove(r.trace_path.c_str());
 }
 
 // With seeds 1 and 3 below: five seeds.
@@ -194,7 +194,6 @@ TEST(MissionSeeds, FindsItForThreeMoreSeeds) {
   for (const char* seed : {"2", "4", "5"}) {
     const MissionRun r = run_mission("thesis_room", seed);
     check_found_safely(r);
-    std::remove(r.trace_path.c_str());
   }
 }
 
@@ -257,16 +256,13 @@ TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothing) {
     std::remove((dir + name).c_str());
   }
   CHECK_TEXT(rmdir(dir.c_str()) == 0, "nothing else in the snapshot folder");
-  std::remove(r.trace_path.c_str());
 }
 
 TEST(MissionThesisRoom, TheSameSeedGivesTheSameTraceBitForBit) {
   const MissionRun a = run_mission("thesis_room", "3");
   const MissionRun b = run_mission("thesis_room", "3");
   check_found_safely(a);
-  CHECK(slurp(a.trace_path) == slurp(b.trace_path));
-  std::remove(a.trace_path.c_str());
-  std::remove(b.trace_path.c_str());
+  CHECK(a.trace_text == b.trace_text);
 }
 
 TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {
@@ -279,7 +275,6 @@ TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnythin
     UNSIGNED_LONGS_EQUAL_TEXT(0, r.check.collisions, what.c_str());
     CHECK_TEXT(r.check.rows > 100, what.c_str());
     CHECK_TEXT(r.target_error_m >= 0.0 && r.target_error_m <= 0.3, what.c_str());
-    std::remove(r.trace_path.c_str());
   }
 }
 
@@ -315,7 +310,6 @@ TEST(MissionRooms, WithNothingLeftToExploreTheRobotTurnsRoundAndLooksOnceMoreBef
   // The last look is within 0.5 m of the last turn's place.
   const sim::TraceRow& turn = looks[turns.back()];
   CHECK(std::hypot(looks.back().x_m - turn.x_m, looks.back().y_m - turn.y_m) < 0.5);
-  std::remove(r.trace_path.c_str());
 }
 
 // Presses the e-stop the first time the base drives forward, holds it 3 s of simulated time,
@@ -380,7 +374,6 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsWithinAFrameAndTheMissionCarriesOn
   CHECK(held);
   CHECK(drove_after);
   check_found_safely(r);
-  std::remove(r.trace_path.c_str());
 }
 
 // Stopped after three cycles and started again with --resume: the robot is put back where it
@@ -429,8 +422,8 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   // pose saved at shutdown: the map and the goal saved in that frame still fit.
   double before[3] = {0.0, 0.0, 0.0};
   double after[3] = {1.0, 1.0, 1.0};
-  trace_odometry(first.trace_path, true, before);
-  trace_odometry(second.trace_path, false, after);
+  trace_odometry(first.trace_text, true, before);
+  trace_odometry(second.trace_text, false, after);
   CHECK_TEXT(std::hypot(before[0], before[1]) > 0.3, "the first run's frame moved with the robot");
   CHECK(std::hypot(before[0] - saved[0], before[1] - saved[1]) < 0.05);
   DOUBLES_EQUAL(saved[0], after[0], 0.002);
@@ -440,8 +433,6 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   const std::size_t c = second.mission_line.find("cycles=");
   CHECK(c != std::string::npos);
   CHECK_TEXT(std::atoi(second.mission_line.c_str() + c + 7) > 3, second.mission_line.c_str());
-  std::remove(first.trace_path.c_str());
-  std::remove(second.trace_path.c_str());
   std::remove((dir + "/mission.state").c_str());
   rmdir(dir.c_str());
 }
