@@ -350,7 +350,7 @@ TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
     (void)mapping::corroborated_points(candidates, mapping::FeatureGuardParams{}, guard);
     thinned.clear();
     for (const Point2& q : guard) (void)thinned.push_back(q);
-    thinned.resize(mapping::keep_points_that_cut(thinned.span(), scratch));
+    thinned.resize(mapping::keep_points_that_cut(thinned.span(), scratch.vertex_count()));
     mapping::extract_local_map(free_range, p, map, scratch, guard);
   });
   LONGS_EQUAL(35, guard.size());

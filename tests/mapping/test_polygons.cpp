@@ -470,7 +470,7 @@ TEST(KeepPointsThatCut, TheKeptPointsCutThePolygonAndGiveEachRayItsNearestPointA
     }
     Point2 kept[3000];
     std::copy(points, points + count, kept);
-    const std::size_t k = boticelli::mapping::keep_points_that_cut(kept, shape);
+    const std::size_t k = boticelli::mapping::keep_points_that_cut(kept, shape.vertex_count());
     CHECK(k <= 2 * n + 1);
     CHECK(k < count / 2);
     StarPolygon all(n);
@@ -498,7 +498,7 @@ TEST(KeepPointsThatCut, TheKeptPointsCutThePolygonAndGiveEachRayItsNearestPointA
 TEST(KeepPointsThatCut, APointAtTheCentreIsKeptAndStillClosesThePolygon) {
   StarPolygon shape(360);
   Point2 points[3] = {{1.0F, 0.5F}, {0.0F, 0.0F}, {1.1F, 0.55F}};
-  const std::size_t k = boticelli::mapping::keep_points_that_cut(points, shape);
+  const std::size_t k = boticelli::mapping::keep_points_that_cut(points, shape.vertex_count());
   LONGS_EQUAL(2, k);  // the third is behind the first in the same sector and on the same ray
   CHECK(points[1].x_m == 0.0F && points[1].y_m == 0.0F);
   StarPolygon free(360);

@@ -492,8 +492,7 @@ int run() {
         (void)mapping::corroborated_points(g_candidates, guard, g_guard);
         // Only the points that can cut the polygon, as the mission's builder keeps them.
         parts.guard_corroborated = g_guard.size();
-        g_guard.resize(
-            mapping::keep_points_that_cut(g_guard.span(), mapping::StarPolygon(p.vertex_count)));
+        g_guard.resize(mapping::keep_points_that_cut(g_guard.span(), p.vertex_count));
         parts.guard_ms = ms_since(t_guard);
         const double build_ms = ms_since(t0);
         const double extract_ms = median_ms(reps, [&] {

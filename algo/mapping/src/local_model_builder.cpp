@@ -180,8 +180,7 @@ bool LocalModelBuilder::step() {
       if (!(params_.guard_disc_m > 0.0F)) {
         // Only the points that can cut the polygon or be a vertex ray's nearest evidence
         // (exact for points; a disc's cut depends on more than its sector's nearest point).
-        const StarPolygon shape(params_.extraction.vertex_count);
-        guard_.resize(keep_points_that_cut(guard_.span(), shape));
+        guard_.resize(keep_points_that_cut(guard_.span(), params_.extraction.vertex_count));
       }
       guard_cursor_ = end;
       if (guard_cursor_ == candidates_.size()) {

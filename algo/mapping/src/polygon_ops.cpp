@@ -625,9 +625,14 @@ PointCut point_cut(core::Point2 q, std::size_t n, float step) {
 }  // namespace
 
 std::size_t nearest_vertex(const StarPolygon& p, float alpha_rad) {
+  return nearest_vertex(p.vertex_count(), alpha_rad);
+}
+
+std::size_t nearest_vertex(std::size_t vertex_count, float alpha_rad) {
+  const std::size_t n = std::clamp<std::size_t>(vertex_count, 3, kMaxPolygonVertices);
+  const float step = core::kTwoPi<float> / static_cast<float>(n);  // StarPolygon::angle_step_rad
   const float a = core::wrap_two_pi(alpha_rad);
-  const auto n = p.vertex_count();
-  auto k = static_cast<std::size_t>(std::lround(a / p.angle_step_rad()));
+  auto k = static_cast<std::size_t>(std::lround(a / step));
   return k % n;
 }
 
@@ -647,9 +652,9 @@ void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
   }
 }
 
-std::size_t keep_points_that_cut(std::span<core::Point2> points, const StarPolygon& shape) {
-  const std::size_t n = shape.vertex_count();
-  const float step = shape.angle_step_rad();
+std::size_t keep_points_that_cut(std::span<core::Point2> points, std::size_t vertex_count) {
+  const std::size_t n = std::clamp<std::size_t>(vertex_count, 3, kMaxPolygonVertices);
+  const float step = core::kTwoPi<float> / static_cast<float>(n);  // StarPolygon::angle_step_rad
   constexpr auto kNone = std::numeric_limits<std::uint32_t>::max();
   std::array<std::uint32_t, kMaxPolygonVertices> cutter;  // per vertex: the point cutting nearest
   std::array<float, kMaxPolygonVertices> cut;
@@ -675,7 +680,7 @@ std::size_t keep_points_that_cut(std::span<core::Point2> points, const StarPolyg
       }
     }
     const core::Point2 q = points[i];
-    const std::size_t v = nearest_vertex(shape, std::atan2(q.y_m, q.x_m));
+    const std::size_t v = nearest_vertex(n, std::atan2(q.y_m, q.x_m));
     const float d = std::hypot(q.x_m, q.y_m);
     if (d < near[v]) {
       near[v] = d;

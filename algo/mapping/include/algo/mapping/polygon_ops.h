@@ -39,18 +39,20 @@ bool shrink_by_radius(const StarPolygon& free_region, float radius_m, StarPolygo
 // vertex ray cuts both sectors beside that ray. Points at the centre close the polygon.
 void exclude_points(std::span<const core::Point2> points, StarPolygon& free);
 
-// The vertex whose ray is nearest the pan angle alpha_rad (any value): round(α / step) mod n.
+// The vertex whose ray is nearest the pan angle alpha_rad (any value): round(α / step) mod n,
+// for a polygon of p's vertex count or of vertex_count (clamped as StarPolygon clamps it).
 [[nodiscard]] std::size_t nearest_vertex(const StarPolygon& p, float alpha_rad);
+[[nodiscard]] std::size_t nearest_vertex(std::size_t vertex_count, float alpha_rad);
 
-// Moves to the front of `points` (robot frame), in their order, the ones a polygon with
-// shape's vertex count needs: per vertex, the first point that exclude_points cuts it nearest
-// for, and per vertex ray the first point nearest the centre of those whose nearest vertex
-// (nearest_vertex) it is; and the first point at the centre, if any. Returns how many. So
-// exclude_points over the kept points cuts any polygon of that vertex count exactly as over
-// all of them, and every vertex ray keeps its nearest point: a guard list keeps at most
-// 2n + 1 points however many features corroborate a surface. Allocation-free (about 17 KB of
+// Moves to the front of `points` (robot frame), in their order, the ones a polygon of
+// vertex_count vertices (clamped as StarPolygon clamps it) needs: per vertex, the first point that
+// exclude_points cuts it nearest for, and per vertex ray the first point nearest the centre of
+// those whose nearest vertex (nearest_vertex) it is; and the first point at the centre, if any.
+// Returns how many. So exclude_points over the kept points cuts any polygon of that vertex count
+// exactly as over all of them, and every vertex ray keeps its nearest point: a guard list keeps at
+// most 2n + 1 points however many features corroborate a surface. Allocation-free (about 17 KB of
 // stack).
-std::size_t keep_points_that_cut(std::span<core::Point2> points, const StarPolygon& shape);
+std::size_t keep_points_that_cut(std::span<core::Point2> points, std::size_t vertex_count);
 
 // Pulls the polygon in front of a disc of radius_m around each point (robot frame): both
 // vertices of every sector the disc reaches into are cut to the disc's nearest distance
