@@ -896,6 +896,10 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   cfg.max_fine_passes = 2;
   train_wall_step(false);
   CHECK(g_trainer2.stats().coarse_passes > 0);
+  // Hinge splits, their sums gathered in passes of their own.
+  cfg.split = aln::SplitCandidates::kHinges;
+  train_wall_step(false);
+  CHECK(g_trainer2.stats().bin_passes > 0);
   // Checked prunings: a pruning judged, undone and the model evaluated again (the scene's
   // pieces are set by hand, so this holds on every platform; the wall step's fits differ
   // in the last bit between x86-64 and aarch64).
