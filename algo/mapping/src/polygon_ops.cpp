@@ -622,16 +622,6 @@ PointCut point_cut(core::Point2 q, std::size_t n, float step) {
   c.count = near_ray ? 4 : 2;
   return c;
 }
-// A polygon's vertex count as StarPolygon clamps it, and its angle step [rad].
-struct Fan {
-  std::size_t n;
-  float step_rad;
-};
-Fan fan_of(std::size_t vertex_count) {
-  const std::size_t n = std::clamp<std::size_t>(vertex_count, 3, kMaxPolygonVertices);
-  return {n, core::kTwoPi<float> / static_cast<float>(n)};  // StarPolygon::angle_step_rad
-}
-
 }  // namespace
 
 std::size_t nearest_vertex(const StarPolygon& p, float alpha_rad) {
@@ -639,10 +629,10 @@ std::size_t nearest_vertex(const StarPolygon& p, float alpha_rad) {
 }
 
 std::size_t nearest_vertex(std::size_t vertex_count, float alpha_rad) {
-  const Fan fan = fan_of(vertex_count);
+  const std::size_t n = StarPolygon::clamped_vertex_count(vertex_count);
   const float a = core::wrap_two_pi(alpha_rad);
-  auto k = static_cast<std::size_t>(std::lround(a / fan.step_rad));
-  return k % fan.n;
+  auto k = static_cast<std::size_t>(std::lround(a / StarPolygon::angle_step_rad(n)));
+  return k % n;
 }
 
 void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
@@ -662,9 +652,8 @@ void exclude_points(std::span<const core::Point2> points, StarPolygon& free) {
 }
 
 std::size_t keep_points_that_cut(std::span<core::Point2> points, std::size_t vertex_count) {
-  const Fan fan = fan_of(vertex_count);
-  const std::size_t n = fan.n;
-  const float step = fan.step_rad;
+  const std::size_t n = StarPolygon::clamped_vertex_count(vertex_count);
+  const float step = StarPolygon::angle_step_rad(n);
   constexpr auto kNone = std::numeric_limits<std::uint32_t>::max();
   std::array<std::uint32_t, kMaxPolygonVertices> cutter;  // per vertex: the point cutting nearest
   std::array<float, kMaxPolygonVertices> cut;

@@ -6,7 +6,7 @@
 namespace boticelli::mapping {
 
 void StarPolygon::set_vertex_count(std::size_t vertex_count) {
-  count_ = std::clamp<std::size_t>(vertex_count, 3, kMaxPolygonVertices);
+  count_ = clamped_vertex_count(vertex_count);
   fill(0.0F);
 }
 

@@ -2,6 +2,7 @@
 // (§5.4.2).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -28,8 +29,15 @@ class StarPolygon {
   void set_vertex_count(std::size_t vertex_count);
   [[nodiscard]] std::size_t vertex_count() const { return count_; }
 
-  [[nodiscard]] float angle_step_rad() const {
-    return core::kTwoPi<float> / static_cast<float>(count_);
+  [[nodiscard]] float angle_step_rad() const { return angle_step_rad(count_); }
+  // The vertex count set_vertex_count() makes of vertex_count, and the angle between the
+  // vertex rays of a polygon with vertex_count vertices [rad]: for code that needs a
+  // polygon's fan but not its 2.9 KB of ρ.
+  [[nodiscard]] static std::size_t clamped_vertex_count(std::size_t vertex_count) {
+    return std::clamp<std::size_t>(vertex_count, 3, kMaxPolygonVertices);
+  }
+  [[nodiscard]] static float angle_step_rad(std::size_t vertex_count) {
+    return core::kTwoPi<float> / static_cast<float>(vertex_count);
   }
   [[nodiscard]] float angle_rad(std::size_t k) const {
     return static_cast<float>(k) * angle_step_rad();
