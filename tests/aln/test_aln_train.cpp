@@ -168,6 +168,17 @@ double share_within(const Model& m, const Sample* samples, std::size_t n, double
   return static_cast<double>(fitted) / static_cast<double>(n);
 }
 
+// Values and responsible pieces of a 2-input model at four points (one block evaluation).
+struct Lanes4 {
+  std::array<double, 4> value{};
+  std::array<std::uint16_t, 4> piece{};
+};
+Lanes4 evaluate_four(const Model2& m, const std::array<Eigen::Vector2d, 4>& x) {
+  Lanes4 out;
+  m.evaluate_block(std::span<const Eigen::Vector2d>(x.data(), x.size()), out.value, out.piece);
+  return out;
+}
+
 }  // namespace
 
 TEST_GROUP(AlnTrain){};
@@ -371,11 +382,9 @@ TEST(AlnTrain, AHingeSplitBendsWhereTheResidualsOfTheModelItsRoundEndedOnBend) {
     LONGS_EQUAL(1, trainer.stats().bin_passes);
     constexpr double kQuarterBin = 0.25 / 4.0;
     for (const double y : {0.0, 0.5, 1.0}) {
-      std::array<Eigen::Vector2d, 4> x = {Eigen::Vector2d(0.1, y), Eigen::Vector2d(0.4, y),
-                                          Eigen::Vector2d(0.8, y), Eigen::Vector2d(0.9, y)};
-      std::array<double, 4> v{};
-      std::array<std::uint16_t, 4> who{};
-      g_model2.evaluate_block(std::span<const Eigen::Vector2d>(x.data(), x.size()), v, who);
+      const Lanes4 at = evaluate_four(g_model2, {Eigen::Vector2d(0.1, y), Eigen::Vector2d(0.4, y),
+                                                 Eigen::Vector2d(0.8, y), Eigen::Vector2d(0.9, y)});
+      const std::array<double, 4>& v = at.value;
       DOUBLES_EQUAL(0.3, v[0], 1e-9);
       DOUBLES_EQUAL(0.3, v[1], 1e-9);
       DOUBLES_EQUAL(1.1, v[3], 2.0 * kQuarterBin);
@@ -407,11 +416,10 @@ TEST(AlnTrain, AHingeSplitOfARobustFitLeavesOutWhatTheRobustWeightsLeaveOut) {
     trainer.configure(cfg);
     CHECK(trainer.train(aln::SampleSet<double, 2>(g_samples2, 2500), g_model2));
     LONGS_EQUAL(2, g_model2.piece_count());
-    std::array<Eigen::Vector2d, 4> x = {Eigen::Vector2d(0.1, 0.3), Eigen::Vector2d(0.9, 0.3),
-                                        Eigen::Vector2d(0.9, 0.1), Eigen::Vector2d(0.9, 0.9)};
-    std::array<double, 4> v{};
-    std::array<std::uint16_t, 4> who{};
-    g_model2.evaluate_block(std::span<const Eigen::Vector2d>(x.data(), x.size()), v, who);
+    const Lanes4 at =
+        evaluate_four(g_model2, {Eigen::Vector2d(0.1, 0.3), Eigen::Vector2d(0.9, 0.3),
+                                 Eigen::Vector2d(0.9, 0.1), Eigen::Vector2d(0.9, 0.9)});
+    const std::array<std::uint16_t, 4>& who = at.piece;
     CHECK(who[0] != who[1]);      // split along x0 ...
     LONGS_EQUAL(who[2], who[3]);  // ... not along x1
   }
