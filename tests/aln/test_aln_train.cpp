@@ -297,6 +297,73 @@ TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
   }
 }
 
+TEST(AlnTrain, ARestartTrainsAfreshWithTheNextSeedAndTheLeastLossOfAllStartsIsReturned) {
+  // Two split rounds cannot reach this epsilon, so every start ends above it: with two
+  // restarts the trainer trains seeds 5, 6 and 7 from one piece, as three trainings would,
+  // and returns the model of the least loss, whichever start it came from.
+  static std::array<Model3, 3> alone;
+  const std::size_t n = fill_room(2000, 0.0, 12);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.001;
+  cfg.max_iterations = 2;
+  cfg.split = aln::SplitCandidates::kHinges;
+  std::array<aln::TrainerStats, 3> stats;
+  std::size_t best = 0;
+  for (std::size_t k = 0; k < alone.size(); ++k) {
+    set_room_ranges(alone[k]);
+    cfg.seed = 5 + static_cast<std::uint32_t>(k);
+    g_trainer3.configure(cfg);
+    CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), alone[k]));
+    stats[k] = g_trainer3.stats();
+    CHECK(stats[k].robust_rms > cfg.epsilon);
+    if (stats[k].robust_loss < stats[best].robust_loss) best = k;
+  }
+  // The starts differ, and the best is neither the first nor the last.
+  LONGS_EQUAL(1, best);
+  CHECK(stats[0].robust_loss != stats[1].robust_loss);
+  CHECK(stats[2].robust_loss != stats[1].robust_loss);
+  cfg.seed = 5;
+  cfg.restarts = 2;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const aln::TrainerStats with = g_trainer3.stats();
+  LONGS_EQUAL(2, with.restarts);
+  CHECK(same_model(alone[best], g_model3));
+  CHECK(with.robust_loss == stats[best].robust_loss);
+  CHECK(with.rms == stats[best].rms);
+  LONGS_EQUAL(stats[best].pieces, with.pieces);
+  LONGS_EQUAL(stats[0].passes + stats[1].passes + stats[2].passes, with.passes);
+  LONGS_EQUAL(stats[0].sample_visits + stats[1].sample_visits + stats[2].sample_visits,
+              with.sample_visits);
+  // In uneven slices, the same.
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.start(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  std::size_t budget = 1;
+  while (!g_trainer3.step(budget)) budget = budget * 3 % 997 + 1;
+  CHECK(same_model(g_model3, g_model3b));
+  LONGS_EQUAL(with.passes, g_trainer3.stats().passes);
+}
+
+TEST(AlnTrain, NoRestartIsMadeOnceAStartReachesEpsilon) {
+  const std::size_t n = fill_room(2000, 0.0, 12);
+  aln::TrainerConfig cfg;
+  cfg.epsilon = 0.03;
+  cfg.seed = 5;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
+  const aln::TrainerStats alone = g_trainer3.stats();
+  CHECK(alone.robust_rms <= cfg.epsilon);
+  cfg.restarts = 3;
+  g_trainer3.configure(cfg);
+  set_room_ranges(g_model3b);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
+  LONGS_EQUAL(0, g_trainer3.stats().restarts);
+  LONGS_EQUAL(alone.passes, g_trainer3.stats().passes);
+  CHECK(same_model(g_model3, g_model3b));
+}
+
 TEST(AlnTrain, TheSameSeedGivesTheSameModel) {
   const std::size_t n = fill_room(2000, 0.0, 12);
   set_room_ranges(g_model3);
@@ -908,6 +975,12 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   cfg.split = aln::SplitCandidates::kHinges;
   train_wall_step(false);
   CHECK(g_trainer2.stats().bin_passes > 0);
+  // Restarts: every start ends above this epsilon, so two more starts from one piece.
+  cfg.epsilon = 1e-4;
+  cfg.max_iterations = 2;
+  cfg.restarts = 2;
+  train_wall_step(false);
+  LONGS_EQUAL(2, g_trainer2.stats().restarts);
   // Checked prunings: a pruning judged, undone and the model evaluated again (the scene's
   // pieces are set by hand, so this holds on every platform; the wall step's fits differ
   // in the last bit between x86-64 and aarch64).

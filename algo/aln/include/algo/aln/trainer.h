@@ -85,6 +85,12 @@ struct TrainerConfig {
   // same mean coverage); the mission keeps 0: over seeds 1-5 on 18 worlds it found 78 of 90
   // targets with 0.01 in 1,296 cycles, against 78 in 1,207 (docs/benchmarks.md).
   double round_tolerance = 0.0;
+  // Fresh starts where they pay: a training that ends above epsilon (its robust RMS) begins
+  // again from one piece with the next seed (seed + 1, seed + 2, ...), up to this many
+  // times, and the model with the least loss of all the starts is returned. A start that
+  // reaches epsilon ends training. 0 (the default, and the mission's): one start. A warm
+  // start (start_from) restarts from one piece too.
+  std::size_t restarts = 0;
 };
 
 struct TrainerStats {
@@ -97,6 +103,9 @@ struct TrainerStats {
   std::size_t coarse_passes = 0;   // ... of which over every coarse_stride-th sample only
   std::size_t bin_passes = 0;      // ... of which gathered the hinge splits' sums alone
   std::uint64_t sample_visits = 0;
+  // Fresh starts made (TrainerConfig::restarts). The counts above (passes, visits) are of all
+  // the starts; the rest of the stats are those of the start whose model was returned.
+  std::size_t restarts = 0;
   double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
   double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
   // What training minimises and judges every model by: sum w rho(r / s) s^2 at the fixed
@@ -155,16 +164,7 @@ class Trainer {
   // it on `samples`, which must stay valid and unchanged until done. False if empty.
   bool start(SampleSet<Scalar, N> samples, Model& model) {
     if (!begin(samples, model)) return false;
-    PieceType first{};
-    VecD w0 = VecD::Zero();
-    Vec centre = Vec::Zero();
-    for (int i = 0; i < N; ++i) {
-      w0(i) = std::clamp(0.0, lo(i), hi(i));
-      const Range<Scalar> r = model.input_range(i);
-      centre(i) = (r.lo + r.hi) / Scalar(2);
-    }
-    first.set(w0.template cast<Scalar>(), centre, Scalar(0));
-    model.reset(first);
+    reset_to_one_piece();
     return begin_first_pass();
   }
 
@@ -230,18 +230,42 @@ class Trainer {
     samples_ = samples;
     model_ = &model;
     // Coarse only where it leaves more samples than a piece needs to be fitted.
-    stride_ = config_.coarse_stride > 1 && samples.size() / config_.coarse_stride > 64
-                  ? config_.coarse_stride
-                  : 1;
+    stride_ = first_stride();
     refining_ = false;
     stats_ = TrainerStats{};
-    rng_ = config_.seed * 2654435761U + 0x9E3779B9U;
+    start_index_ = 0;
+    have_best_start_ = false;
+    rng_ = seed_state(config_.seed);
     cap_ = piece_cap();
     if (samples.empty()) {
       stats_.done = true;
       return false;
     }
     return true;
+  }
+
+  // Coarse only where it leaves more samples than a piece needs to be fitted.
+  std::size_t first_stride() const {
+    return config_.coarse_stride > 1 && samples_.size() / config_.coarse_stride > 64
+               ? config_.coarse_stride
+               : 1;
+  }
+
+  static std::uint32_t seed_state(std::uint32_t seed) { return seed * 2654435761U + 0x9E3779B9U; }
+
+  // The model as one piece (keeping its ranges and weight bounds): zero slopes where the
+  // bounds allow, through output 0 at the middle of the input box.
+  void reset_to_one_piece() {
+    PieceType first{};
+    VecD w0 = VecD::Zero();
+    Vec centre = Vec::Zero();
+    for (int i = 0; i < N; ++i) {
+      w0(i) = std::clamp(0.0, lo(i), hi(i));
+      const Range<Scalar> r = model_->input_range(i);
+      centre(i) = (r.lo + r.hi) / Scalar(2);
+    }
+    first.set(w0.template cast<Scalar>(), centre, Scalar(0));
+    model_->reset(first);
   }
 
   // Every piece of the model as training's starting point: no residual scale yet, its split
@@ -750,7 +774,7 @@ class Trainer {
       } else {
         finish_stats(*current_);
       }
-      stats_.done = true;
+      finish_start();
       return;
     }
     if (what == Check::kPruned && loss > unpruned_loss_ * (1.0 + 1e-9)) {
@@ -862,7 +886,48 @@ class Trainer {
       next_pass();
       return;
     }
+    finish_start();
+  }
+
+  // This start's training is over (its model and stats final): it is kept if it is the best
+  // start so far (the least loss), and training starts afresh from one piece with the next
+  // seed if this start ended above epsilon and restarts are left; else the best start's
+  // model and stats are returned, with the passes and visits of all the starts.
+  void finish_start() {
+    if (config_.restarts == 0) {
+      stats_.done = true;
+      return;
+    }
+    if (!have_best_start_ || stats_.robust_loss < best_start_stats_.robust_loss) {
+      best_start_model_ = *model_;
+      best_start_stats_ = stats_;
+      have_best_start_ = true;
+    }
+    const TrainerStats effort = stats_;
+    if (start_index_ < config_.restarts && stats_.robust_rms > config_.epsilon) {
+      ++start_index_;
+      stats_ = TrainerStats{};
+      keep_effort(effort);
+      rng_ = seed_state(config_.seed + static_cast<std::uint32_t>(start_index_));
+      stride_ = first_stride();
+      refining_ = false;
+      reset_to_one_piece();
+      (void)begin_first_pass();
+      return;
+    }
+    *model_ = best_start_model_;
+    stats_ = best_start_stats_;
+    keep_effort(effort);
     stats_.done = true;
+  }
+
+  // The counts of all the starts so far (`effort` holds them) in stats_.
+  void keep_effort(const TrainerStats& effort) {
+    stats_.passes = effort.passes;
+    stats_.coarse_passes = effort.coarse_passes;
+    stats_.bin_passes = effort.bin_passes;
+    stats_.sample_visits = effort.sample_visits;
+    stats_.restarts = start_index_;
   }
 
   void finish_stats(const Accumulators& acc) {
@@ -1179,6 +1244,11 @@ class Trainer {
   std::size_t last_split_count_ = 0;
   std::size_t failed_rounds_ = 0;
   std::uint32_t rng_ = 1;
+  // Restarts: the starts made after the first, and the best start's model and stats so far.
+  std::size_t start_index_ = 0;
+  bool have_best_start_ = false;
+  Model best_start_model_{};
+  TrainerStats best_start_stats_{};
   Accumulators acc_a_{};
   Accumulators acc_b_{};
   Accumulators tmp_acc_{};
