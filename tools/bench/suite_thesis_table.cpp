@@ -350,7 +350,7 @@ int run_thesis_table() {
         cfg.max_refit_passes = env_size("BOTICELLI_THESIS_PASSES", 8);
         cfg.damped_refit = env_size("BOTICELLI_THESIS_DAMPED", 0) != 0;
         cfg.check_pruning = env_size("BOTICELLI_THESIS_CHECK_PRUNING", 0) != 0;
-        cfg.restarts = env_size("BOTICELLI_THESIS_RESTARTS", 0);  // fresh starts above epsilon
+        cfg.restarts = env_size("BOTICELLI_THESIS_RESTARTS", 2);  // fresh starts above epsilon
         if (const char* t = std::getenv("BOTICELLI_THESIS_ROUND_TOLERANCE");
             t != nullptr && *t != '\0') {
           cfg.round_tolerance = std::atof(t);
@@ -422,7 +422,7 @@ int run_thesis_table() {
      "regression fusion (ALN) vs a 0.1 m log-odds grid on the thesis's simulated rooms "
      "(4.8.2); env BOTICELLI_THESIS_FEATURES=500,5000 BOTICELLI_THESIS_ROWS=name,... "
      "BOTICELLI_THESIS_EPSILON=0.15 BOTICELLI_THESIS_ITERATIONS=10 "
-     "BOTICELLI_THESIS_ALPHA_SLOPE=1 BOTICELLI_THESIS_DAMPED=0 BOTICELLI_THESIS_RESTARTS=0",
+     "BOTICELLI_THESIS_ALPHA_SLOPE=1 BOTICELLI_THESIS_DAMPED=0 BOTICELLI_THESIS_RESTARTS=2",
      &run_thesis_table});
 
 }  // namespace
