@@ -126,7 +126,8 @@ struct TrainerStats {
 // (as in max-affine regression, Magnani & Boyd 2009): a hinge on each input at each of
 // kSplitBins - 1 positions across the piece's samples, on either side, as MAX(piece,
 // piece + tilt) where the residuals rise beyond the hinge or MIN where they fall. Stops at
-// epsilon, at the piece cap or at the iteration cap; the model is always one that was
+// epsilon, at the piece cap or at the iteration cap (and above epsilon may start afresh with
+// another seed, TrainerConfig::restarts); the model is always one that was
 // evaluated, with every piece inside its bounds. Models are compared by the robust loss at a fixed
 // scale (TrainerStats::robust_loss), not by the robust-weighted squared error, which a Tukey fit
 // could lower by pushing its samples out of the weights' window: a refit is kept only if it
@@ -229,7 +230,6 @@ class Trainer {
   bool begin(SampleSet<Scalar, N> samples, Model& model) {
     samples_ = samples;
     model_ = &model;
-    // Coarse only where it leaves more samples than a piece needs to be fitted.
     stride_ = first_stride();
     refining_ = false;
     stats_ = TrainerStats{};
