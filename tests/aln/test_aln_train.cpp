@@ -297,6 +297,14 @@ TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
   }
 }
 
+// Trains `model` (the room's ranges) from one piece on the first n room samples with `cfg`.
+aln::TrainerStats train_room_model(const aln::TrainerConfig& cfg, std::size_t n, Model3& model) {
+  g_trainer3.configure(cfg);
+  set_room_ranges(model);
+  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), model));
+  return g_trainer3.stats();
+}
+
 TEST(AlnTrain, ARestartTrainsAfreshWithTheNextSeedAndTheLeastLossOfAllStartsIsReturned) {
   // Two split rounds cannot reach this epsilon, so every start ends above it: with two
   // restarts the trainer trains seeds 5, 6 and 7 from one piece, as three trainings would,
@@ -310,11 +318,8 @@ TEST(AlnTrain, ARestartTrainsAfreshWithTheNextSeedAndTheLeastLossOfAllStartsIsRe
   std::array<aln::TrainerStats, 3> stats;
   std::size_t best = 0;
   for (std::size_t k = 0; k < alone.size(); ++k) {
-    set_room_ranges(alone[k]);
     cfg.seed = 5 + static_cast<std::uint32_t>(k);
-    g_trainer3.configure(cfg);
-    CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), alone[k]));
-    stats[k] = g_trainer3.stats();
+    stats[k] = train_room_model(cfg, n, alone[k]);
     CHECK(stats[k].robust_rms > cfg.epsilon);
     if (stats[k].robust_loss < stats[best].robust_loss) best = k;
   }
@@ -325,10 +330,7 @@ TEST(AlnTrain, ARestartTrainsAfreshWithTheNextSeedAndTheLeastLossOfAllStartsIsRe
   CHECK(stats[0].robust_loss != stats[2].robust_loss);
   cfg.seed = 5;
   cfg.restarts = 2;
-  g_trainer3.configure(cfg);
-  set_room_ranges(g_model3);
-  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
-  const aln::TrainerStats with = g_trainer3.stats();
+  const aln::TrainerStats with = train_room_model(cfg, n, g_model3);
   LONGS_EQUAL(2, with.restarts);
   CHECK(same_model(alone[best], g_model3));
   CHECK(with.robust_loss == stats[best].robust_loss);
@@ -351,17 +353,12 @@ TEST(AlnTrain, NoRestartIsMadeOnceAStartReachesEpsilon) {
   aln::TrainerConfig cfg;
   cfg.epsilon = 0.03;
   cfg.seed = 5;
-  g_trainer3.configure(cfg);
-  set_room_ranges(g_model3);
-  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
-  const aln::TrainerStats alone = g_trainer3.stats();
+  const aln::TrainerStats alone = train_room_model(cfg, n, g_model3);
   CHECK(alone.robust_rms <= cfg.epsilon);
   cfg.restarts = 3;
-  g_trainer3.configure(cfg);
-  set_room_ranges(g_model3b);
-  CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
-  LONGS_EQUAL(0, g_trainer3.stats().restarts);
-  LONGS_EQUAL(alone.passes, g_trainer3.stats().passes);
+  const aln::TrainerStats with = train_room_model(cfg, n, g_model3b);
+  LONGS_EQUAL(0, with.restarts);
+  LONGS_EQUAL(alone.passes, with.passes);
   CHECK(same_model(g_model3, g_model3b));
 }
 
