@@ -404,6 +404,79 @@ TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
   UNSIGNED_LONGS_EQUAL(360, g_other.stats().guard_candidates);
 }
 
+TEST(LocalModelBuilder, AFloorCueBaseCutsTheFreePolygonItsMarginInFrontOfIt) {
+  // A featured wall 3.5 m away all round (the fit's crossing about 2.8 m), weak bases (m = 0.5,
+  // which never lift the fit to m_safe) on a ring 2 m away and the floor seen to 1.97 m: the
+  // bases' own cut, base_margin_m in front of them, is the nearest.
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  for (int d = 0; d < 360; ++d) {
+    const float alpha = deg(static_cast<float>(d));
+    for (const float z : {0.1F, 0.4F, 0.9F, 1.4F}) {
+      (void)look.features.push_back(at(alpha, 3.5F, z, 0.9F));
+    }
+    (void)look.obstacles.push_back(at(alpha, 2.0F, 0.05F, 0.5F));
+    (void)look.free.push_back(at(alpha, 1.97F, 0.0F, 0.0F));
+  }
+  const mapping::LocalModelParams params = make_params();
+  g_other.start(params, look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+  CHECK(g_other.stats().model_valid);
+  const mapping::StarPolygon& free = g_other.map().free;
+  const float cut_m = 2.0F - params.base_margin_m;
+  float nearest_m = 3.0F;
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) {
+    CHECK(free.rho_m(k) <= cut_m + 1e-4F);
+    nearest_m = std::min(nearest_m, free.rho_m(k));
+  }
+  std::printf("\n  bases: free ρ from %.3f m\n", static_cast<double>(nearest_m));
+  // Not vacuous: the polygon reaches the cut all round.
+  CHECK(nearest_m > cut_m - 0.01F);
+}
+
+TEST(LocalModelBuilder, WithoutWalkStartsAFloorCueBaseShowsTheFloorBeforeItLessItsRangeError) {
+  // Only bases, on a ring 2 m away, and no free floor readings: the floor is seen up to each
+  // base less δr (δr = 0.1 r).
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  for (int d = 0; d < 360; ++d) {
+    (void)look.obstacles.push_back(at(deg(static_cast<float>(d)), 2.0F, 0.05F, 0.9F));
+  }
+  const mapping::LocalModelParams params = make_params();
+  g_other.start(params, look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+  const Reading base = at(deg(100.0F), 2.0F, 0.05F, 0.9F);
+  const float seen_m = evidence::horizontal_m(base) * (1.0F - params.rays.delta_r_fraction);
+  DOUBLES_EQUAL(seen_m, g_other.seen_free().radius_at_m(deg(100.0F)), 1e-3);
+}
+
+TEST(LocalModelBuilder, TheFreeSamplesOfAFloorPointLieOnItsLineOfSightShortOfIt) {
+  // One floor point seen free, away from the seam: the fit's samples are the line of sight's
+  // free samples, every one short of the point (none on or under the floor).
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  const Reading floor = at(1.0F, 2.0F, 0.0F, 0.0F);
+  (void)look.free.push_back(floor);
+  const mapping::LocalModelParams params = make_params();
+  g_other.start(params, look.features.span(), look.obstacles.span(), look.free.span());
+  g_other.run();
+  const std::span<const mapping::OccupancySample> samples = g_other.samples();
+  UNSIGNED_LONGS_EQUAL(params.free_samples_per_ray, samples.size());
+  for (const mapping::OccupancySample& s : samples) {
+    DOUBLES_EQUAL(floor.alpha_rad, s.x(0), 1e-6);
+    CHECK(s.x(2) > 0.0F);
+    CHECK(s.x(2) < floor.r_m);
+    DOUBLES_EQUAL(floor.h_m / floor.r_m, s.x(1) / s.x(2), 1e-5);
+    DOUBLES_EQUAL(0.0, s.y, 0.0);
+  }
+}
+
 TEST(LocalModelBuilder, TheGuardKeepsOnlyThePointsThatCanCutThePolygon) {
   // Bases on two rings, 2 m and 2.5 m away: all are corroborated guard points, but behind the
   // near ring the far one cuts nothing and is no ray's nearest.
@@ -549,10 +622,11 @@ TEST(LocalModelBuilder, AFeatureInTheBandShowsTheFloorBeforeItFreeOnlyWhenFeatur
   params.features_show_free = true;
   g_other.start(params, look.features.span(), look.obstacles.span(), free.span(), near_m.span());
   g_other.run();
-  // The walked half is seen to the walks' ends either way; the other half only by features
-  // (2 δr before them).
+  // The walked half is seen to the walks' ends either way; the other half only by features,
+  // to 2 δr before them (δr = 0.1 r: 2.0 m of the wall's 2.5).
   CHECK(g_other.seen_free().radius_at_m(deg(90.0F)) > kWall_m - 0.1F);
-  CHECK(g_other.seen_free().radius_at_m(deg(270.0F)) > 0.7F * kWall_m);
+  const float band_seen_m = kWall_m * (1.0F - 2.0F * params.rays.delta_r_fraction);
+  DOUBLES_EQUAL(band_seen_m, g_other.seen_free().radius_at_m(deg(270.0F)), 1e-3);
   params.features_show_free = false;
   g_other.start(params, look.features.span(), look.obstacles.span(), free.span(), near_m.span());
   g_other.run();

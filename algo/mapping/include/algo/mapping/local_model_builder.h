@@ -140,6 +140,8 @@ class LocalModelBuilder {
   // The farthest free floor seen along each vertex ray [m] (robot frame).
   [[nodiscard]] const StarPolygon& seen_free() const { return seen_free_; }
   [[nodiscard]] const OccupancyModel& model() const { return model_; }
+  // The samples the fit was trained on (seam copies included), valid until the next start().
+  [[nodiscard]] std::span<const OccupancySample> samples() const { return samples_.span(); }
   [[nodiscard]] const LocalModelStats& stats() const { return stats_; }
   [[nodiscard]] const LocalModelParams& params() const { return params_; }
   // §5.4.4 map points of this look (robot frame), appended: obstacle points where the free
