@@ -85,6 +85,20 @@ TEST(Extraction, CylindricalRoomSeenFromItsCentreGivesTheCircleMinusTheRobotRadi
                 0.02);
 }
 
+TEST(Extraction, TheRobotMayMoveWithoutItsMarginButNotOnceItsDiscTouchesAnObstacle) {
+  static mapping::StarPolygon free;
+  static mapping::StarPolygon navigable;
+  free.set_vertex_count(360);
+  // Obstacles 0.23 m all round: the robot's 0.2 m disc fits, its 0.05 m margin does not, so
+  // the polygon is shrunk by what clearance there is and the robot may still move.
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) free.set_rho_m(k, 0.23F);
+  CHECK_TRUE(mapping::shrink_for_robot(free, 0.2F, 0.05F, navigable));
+  for (std::size_t k = 0; k < navigable.vertex_count(); ++k) CHECK(navigable.rho_m(k) < 0.03F);
+  // 0.15 m all round: the disc already overlaps them.
+  for (std::size_t k = 0; k < free.vertex_count(); ++k) free.set_rho_m(k, 0.15F);
+  CHECK_FALSE(mapping::shrink_for_robot(free, 0.2F, 0.05F, navigable));
+}
+
 TEST(Extraction, AModelThatIsNotMonotoneInRangeIsRefused) {
   static Occupancy model;
   Occupancy::PieceType piece;
