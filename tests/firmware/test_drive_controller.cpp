@@ -34,6 +34,7 @@ struct SimBase {
   float left_scale = 1.0F;
   float right_scale = 1.0F;
   float track_m = 0.4F;
+  float w_accel_rad_s2 = 3.0F;  // how fast the yaw rate follows its setpoint
   bool stuck = false;
 
   void step(const DriveCommand& c) {
@@ -42,7 +43,8 @@ struct SimBase {
       return;
     }
     v_cmd_m_s += std::clamp(c.v_m_s - v_cmd_m_s, -1.0F * kDt_s, 1.0F * kDt_s);
-    w_cmd_rad_s += std::clamp(c.omega_rad_s - w_cmd_rad_s, -3.0F * kDt_s, 3.0F * kDt_s);
+    w_cmd_rad_s += std::clamp(c.omega_rad_s - w_cmd_rad_s, -w_accel_rad_s2 * kDt_s,
+                              w_accel_rad_s2 * kDt_s);
     w_cmd_rad_s = std::clamp(w_cmd_rad_s, -0.8F, 0.8F);
     const float left = (v_cmd_m_s - 0.5F * w_cmd_rad_s * track_m) * left_scale;
     const float right = (v_cmd_m_s + 0.5F * w_cmd_rad_s * track_m) * right_scale;
@@ -284,6 +286,64 @@ TEST(DriveController, ASidePushBeyondTheLimitAbortsTheStep) {
   CHECK(d.controller.status() == DriveStatus::kFailed);
   STRCMP_EQUAL("left the step's line", d.controller.failure());
   CHECK(d.base.pose.x_m < 1.5F);  // it stopped there, it did not go on
+}
+
+TEST(DriveController, ASidePushToTheOtherSideAbortsTheStepToo) {
+  d.base.pose = {0.0F, 0.0F, 0.0F};
+  d.start({2.0F, 0.0F});
+  while (d.controller.status() != DriveStatus::kDriving && d.log.periods < 1000) d.period();
+  for (int i = 0; i < 150; ++i) d.period();
+  d.base.pose.y_m -= 0.1F;  // to the right this time
+  d.period();
+  CHECK(d.controller.status() == DriveStatus::kStopping);
+  d.run();
+  STRCMP_EQUAL("left the step's line", d.controller.failure());
+}
+
+TEST(DriveController, NeverGoesFasterThanItCanStopInWhatIsLeftOfTheStep) {
+  d.base.pose = {0.0F, 0.0F, 0.0F};
+  const Point2 end{1.2F, 0.0F};
+  d.start(end);
+  const float a = d.controller.params().accel_m_s2;
+  std::uint64_t checked = 0;
+  while (d.controller.busy() && d.log.periods < 6000) {
+    const float left_m = end.x_m - d.base.pose.x_m;  // along the line (it is the x axis)
+    const DriveCommand c = d.period();
+    if (c.v_m_s > 0.0F) {
+      CHECK(c.v_m_s <= std::sqrt(2.0F * a * std::max(left_m, 0.0F)) + 1e-4F);
+      ++checked;
+    }
+  }
+  CHECK(checked > 100);
+  check_ended_at_rest_at(d, end);
+}
+
+TEST(DriveController, AHeavyBaseStopsTurningBeforeItDrivesOff) {
+  d.base.w_accel_rad_s2 = 0.4F;  // the yaw rate lags its setpoint: it overshoots the heading
+  d.base.pose = {0.0F, 0.0F, 0.0F};
+  const Point2 end{0.0F, 1.5F};  // 90° to the left
+  d.start(end);
+  float w_at_first_v = -1.0F;
+  while (d.controller.busy() && d.log.periods < 6000) {
+    const float w = d.base.w_rad_s;
+    const DriveCommand c = d.period();
+    if (c.v_m_s > 0.0F && w_at_first_v < 0.0F) w_at_first_v = std::fabs(w);
+  }
+  CHECK(w_at_first_v >= 0.0F);
+  CHECK(w_at_first_v <= 10.0F * d.controller.params().settle_rate_rad_s);
+  check_ended_at_rest_at(d, end);
+}
+
+TEST(DriveController, AnAbortDuringATurnFailsOnlyOnceTheBaseHasStoppedTurning) {
+  d.base.pose = {0.0F, 0.0F, 0.0F};
+  d.start({-1.0F, 0.1F});  // nearly behind: a long turn
+  for (int i = 0; i < 100; ++i) d.period();
+  CHECK(d.controller.status() == DriveStatus::kTurning);
+  CHECK(std::fabs(d.base.w_rad_s) > 0.5F);
+  d.controller.abort("obstacle ahead");
+  while (d.controller.status() == DriveStatus::kStopping && d.log.periods < 1000) d.period();
+  CHECK(d.controller.status() == DriveStatus::kFailed);
+  CHECK(std::fabs(d.base.w_rad_s) <= d.controller.params().settle_rate_rad_s);
 }
 
 TEST(DriveController, ASmallSidePushIsCorrected) {
