@@ -43,8 +43,8 @@ struct SimBase {
       return;
     }
     v_cmd_m_s += std::clamp(c.v_m_s - v_cmd_m_s, -1.0F * kDt_s, 1.0F * kDt_s);
-    w_cmd_rad_s += std::clamp(c.omega_rad_s - w_cmd_rad_s, -w_accel_rad_s2 * kDt_s,
-                              w_accel_rad_s2 * kDt_s);
+    w_cmd_rad_s +=
+        std::clamp(c.omega_rad_s - w_cmd_rad_s, -w_accel_rad_s2 * kDt_s, w_accel_rad_s2 * kDt_s);
     w_cmd_rad_s = std::clamp(w_cmd_rad_s, -0.8F, 0.8F);
     const float left = (v_cmd_m_s - 0.5F * w_cmd_rad_s * track_m) * left_scale;
     const float right = (v_cmd_m_s + 0.5F * w_cmd_rad_s * track_m) * right_scale;
