@@ -52,6 +52,17 @@ TEST(TargetTracker, AnUnconfirmedSightingIsTheCandidateToLookAtAgain) {
   check_near(tracker.estimate_m(), tracker.candidate_m(), 1e-6F);
 }
 
+TEST(TargetTracker, TheCandidateIsTheMeanOfItsGroupNotOneOfItsSightings) {
+  // Two sightings of one view 0.2 m apart, equally weighted: too few views to confirm, and
+  // the candidate is their mean, whichever came first.
+  const Eigen::Vector3f a = kTarget;
+  const Eigen::Vector3f b = kTarget + Eigen::Vector3f(0.2F, 0.0F, 0.0F);
+  tracker.add(a, 0.9F, 4);
+  tracker.add(b, 0.9F, 4);
+  CHECK_FALSE(tracker.confirmed());
+  check_near(0.5F * (a + b), tracker.candidate_m(), 1e-5F);
+}
+
 TEST(TargetTracker, SightingsFromTheSameViewNeverConfirm) {
   for (int i = 0; i < 10; ++i) {
     tracker.add(kTarget + Eigen::Vector3f(0.01F * static_cast<float>(i), 0.0F, 0.0F), 0.9F, 7);

@@ -60,6 +60,10 @@ TEST(Triangulation, RaysThatMeetBehindTheCameraAreRejected) {
                                 Eigen::Vector3f(1.0F, 0.0F, -0.1F).normalized(), point));
   CHECK_FALSE(triangulate_exact(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX(),
                                 Eigen::Vector3f(0, 0, -0.03F), Eigen::Vector3f::UnitX(), point));
+  // In front of the first camera (1 m along its ray) but behind the second.
+  CHECK_FALSE(triangulate_exact(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX(),
+                                Eigen::Vector3f(2.0F, 1.0F, 0.0F),
+                                Eigen::Vector3f(1.0F, 1.0F, 0.0F).normalized(), point));
 }
 
 TEST(Triangulation, ReadingIsTakenAboutThePtuCentre) {
