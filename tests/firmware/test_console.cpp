@@ -224,8 +224,9 @@ TEST(ConsoleParser, ReadsOnlyPlainDecimalNumbers) {
   DOUBLES_EQUAL(-1.5, v, 0.0);
   CHECK(parse_number("2e-3", v));
   DOUBLES_EQUAL(0.002, v, 1e-9);
+  // Trailing characters that can appear in a number but do not end one here: "1.5-", "1.2.3".
   for (const char* bad : {"", "-", ".", "e5", "0x10", "inf", "nan", "1.5x", "1 2", "1e99", "--1",
-                          "123456789012345678901234567890123"}) {
+                          "1.5-", "1.2.3", "2e", "3e+", "123456789012345678901234567890123"}) {
     CHECK_FALSE_TEXT(parse_number(bad, v), bad);
   }
 }
