@@ -322,6 +322,51 @@ TEST(FloorCue, PlainBoxesAreFoundAtTheirBaseAndFreeFloorStopsThere) {
   CHECK(check_detected(cue, 0.0F, 0.0F) >= 5);
 }
 
+TEST(FloorCue, ABoundarysEvidenceRisesFromWeakToClearWithItsContrast) {
+  // The boxes of the test above from the lower tilt. With the defaults the clearest
+  // boundaries reach evidence_clear; asking for a contrast no boundary has
+  // (clear_contrast = 1000 tolerances) leaves every one near evidence_weak.
+  load(plain_box("near", "1.4 0.5 0.25", "0.4 0.6 0.5") +
+       plain_box("far", "2.6 -0.6 0.25", "0.4 0.8 0.5", "0.55 0.5 0.45"));
+  render(0.0F, kLookTilt, 1, g_frame);
+  FloorCueParams p = trusting();
+  p.clear_contrast = 1000.0F;
+  static FloorCue dim{g_rig, p};
+  for (FloorCue* c : {&cue, &dim}) {
+    CHECK(FloorLearn::kLearned == c->learn(g_frame, 0.0F, kLookTilt));
+    out.obstacles.clear();
+    out.free.clear();
+    out.result = c->process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+    CHECK(out.result.boundaries >= 10);
+    float least = 1.0F;
+    float most = 0.0F;
+    for (std::size_t i = 0; i < c->column_count(); ++i) {
+      if (c->column(i).end != FloorColumn::End::kBoundary) continue;
+      least = std::min(least, c->column(i).evidence);
+      most = std::max(most, c->column(i).evidence);
+    }
+    CHECK(least >= p.evidence_weak);
+    CHECK(most <= p.evidence_clear);
+    if (c == &cue) {
+      DOUBLES_EQUAL(p.evidence_clear, most, 1e-6);
+    } else {
+      CHECK(most < p.evidence_weak + 0.05F);
+    }
+  }
+}
+
+TEST(FloorCue, ARegionOfFewerPixelsThanTheMinimumIsNotLearned) {
+  FloorCueParams p = trusting();
+  p.reference_min_pixels = 100000;  // more than the low-resolution frame has
+  static FloorCue strict{g_rig, p};
+  load("");
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kNoRegion == strict.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(strict.model().valid);
+  // The same frame with the default minimum is learned.
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+}
+
 TEST(FloorCue, AFeaturelessWallIsFoundInEveryColumn) {
   load(plain_box("wall", "2.0 0 0.75", "0.1 8 1.5", "0.8 0.8 0.75"));
   render(0.0F, kLookTilt, 1, g_frame);
