@@ -238,6 +238,40 @@ TEST(SimDevices, ObstaclesAboveTheRobotOrFlatOnTheFloorAreNotHit) {
   CHECK(g_sim.clearance_m(0.0, -2.0) > 0.0F);
 }
 
+TEST(SimDevices, ALowBoxAndAPillarAreHitAtTheirOutlines) {
+  start("cluttered_room");
+  const double r = static_cast<double>(SimParams{}.base.robot_radius_m);
+  // box_3: 0.4 x 0.6 m, 0.3 m high (below the camera, above the floor clearance), at
+  // (1.9, 1.6): its −x face is at x = 1.7.
+  DOUBLES_EQUAL(0.2 - r, g_sim.clearance_m(1.5, 1.6), 1e-4);
+  CHECK_FALSE(g_sim.teleport({1.5F, 1.6F, 0.0F}));  // the robot would stand in it
+  CHECK(g_sim.teleport({1.4F, 1.6F, 0.0F}));
+  // The pillar: a cylinder of radius 0.2 m at (−0.5, 1).
+  DOUBLES_EQUAL(0.5 - 0.2 - r, g_sim.clearance_m(0.0, 1.0), 1e-4);
+}
+
+TEST(SimDevices, TheBumperClosesWithinItsMarginBeforeTheBodyHits) {
+  start("thesis_room");
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  BumperInputSim bumper(g_sim);
+  make_ready(base, clock);
+  base.set_velocity(0.1F, 0.0F);  // slowly towards the partition (its face at y = 0.55)
+  std::size_t collisions_at_contact = 99;
+  CHECK(run_until(
+            clock,
+            [&] {
+              if (!bumper.read()) return false;
+              collisions_at_contact = g_sim.collisions();
+              return true;
+            },
+            40.0, 1000) > 0.0);
+  UNSIGNED_LONGS_EQUAL(0, collisions_at_contact);
+  const float gap = g_sim.clearance_m(g_sim.true_pose().x_m, g_sim.true_pose().y_m);
+  CHECK(gap >= 0.0F);
+  CHECK(gap <= SimParams{}.base.contact_margin_m);
+}
+
 TEST(SimDevices, AScriptedEstopPressIsSeenOnceAndReleased) {
   start("rectangular_room");
   ClockSim clock(g_sim);
