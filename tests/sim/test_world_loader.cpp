@@ -214,6 +214,8 @@ TEST(WorldLoader, MalformedFilesAreRejectedWithFileLineAndProblem) {
        replace(good, "<box><size>1 1 1</size></box>", "<sphere><radius>1</radius></sphere>"),
        "unsupported geometry <sphere>", 5},
       {"negative size", replace(good, "1 1 1</size>", "1 -1 1</size>"), "must be > 0", 5},
+      {"zero size", replace(good, "1 1 1</size>", "1 0 1</size>"), "must be > 0", 5},
+      {"size beyond 1 km", replace(good, "1 1 1</size>", "1 1 1001</size>"), "<= 1000 m", 5},
       {"not a number", replace(good, "1 1 0.5 0 0 0", "1 one 0.5 0 0 0"), "is not a number", 5},
       {"five pose numbers", replace(good, "1 1 0.5 0 0 0", "1 1 0.5 0 0"), "has 5 numbers", 5},
       {"seven pose numbers", replace(good, "1 1 0.5 0 0 0", "1 1 0.5 0 0 0 0"),
