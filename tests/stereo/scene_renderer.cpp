@@ -120,6 +120,18 @@ Rgb surface_colour(const Patch& p, float x_m, float y_m) {
       }
       return kPaperWhite;
     }
+    case Surface::kTriangleOnPlain:
+    case Surface::kTallTriangle: {
+      const float s = p.target_side_m;
+      const float h = (p.surface == Surface::kTallTriangle ? 3.0F : 1.0F) * s * 0.8660254F;
+      const float top = 2.0F * h / 3.0F;
+      const float below = y_m - (top - h);
+      if (below >= 0.0F && y_m <= top && std::fabs(x_m) <= 0.5F * s * (top - y_m) / h) {
+        return kTargetGreen;
+      }
+      return p.surface == Surface::kTallTriangle ? kPaperWhite
+                                                 : Rgb{p.colour[0], p.colour[1], p.colour[2]};
+    }
     case Surface::kGreenSquare:
       return (std::fabs(x_m) <= 0.5F * p.target_side_m && std::fabs(y_m) <= 0.5F * p.target_side_m)
                  ? kTargetGreen

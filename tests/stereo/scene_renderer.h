@@ -18,6 +18,10 @@ enum class Surface : std::uint8_t {
   kPaper,        // white matte paper
   kTarget,       // white paper with a green equilateral triangle of side target_side_m, vertex up
   kGreenSquare,  // white paper with a green square of side target_side_m (a decoy)
+  // Decoys: the target's green triangle on `colour` instead of white paper, and on paper a
+  // green triangle of base target_side_m three times as tall as the target's.
+  kTriangleOnPlain,
+  kTallTriangle,
 };
 
 // A rectangle: centre, in-plane unit axes (right, up as seen from the front) and half sizes.

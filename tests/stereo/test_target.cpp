@@ -135,6 +135,52 @@ TEST(Target, NothingIsFoundInFiftyScenesWithoutTheTarget) {
   LONGS_EQUAL(0, false_detections);
 }
 
+TEST(Target, AGreenTriangleOffWhitePaperOrOfAnotherShapeIsNotTheTarget) {
+  // The target's own triangle on a grey, a brown and a pale wall (no white paper round it),
+  // and on white paper a triangle three times as tall: each seen as the target would be,
+  // from 0.8 to 2.5 m, on a camouflage wall.
+  const stereo::RigModel rig;
+  int false_detections = 0;
+  int scenes = 0;
+  for (const float distance : {0.8F, 1.5F, 2.5F}) {
+    const stereo::CameraPose pose = rig.camera_pose(0.3F, 0.0F);
+    const Eigen::Vector3f forward = pose.rotation.col(2);
+    for (int decoy = 0; decoy < 4; ++decoy) {
+      test::SceneRenderer scene;
+      test::Patch wall = test::facing_wall(pose.centre_m, forward, distance + 0.02F, 5.0F,
+                                           test::Surface::kCamouflage, 9);
+      wall.scale_m = 0.08F;
+      scene.add(wall);
+      test::Patch sign =
+          test::facing_wall(pose.centre_m, forward, distance, 0.3F, test::Surface::kTarget, 1);
+      sign.surface = decoy == 3 ? test::Surface::kTallTriangle : test::Surface::kTriangleOnPlain;
+      sign.target_side_m = decoy == 3 ? 0.12F : 0.2F;
+      const Eigen::Vector3f colours[] = {
+          {0.5F, 0.5F, 0.5F}, {0.55F, 0.4F, 0.25F}, {0.75F, 0.72F, 0.6F}};
+      if (decoy < 3) sign.colour = colours[decoy];
+      scene.add(sign);
+      const image::TargetDetection d =
+          render_and_detect(rig, pose, scene, static_cast<std::uint32_t>(31 + decoy));
+      ++scenes;
+      if (d.found) {
+        ++false_detections;
+        std::printf("\n  decoy %d at %.1f m taken for the target (confidence %.2f)", decoy,
+                    static_cast<double>(distance), static_cast<double>(d.confidence));
+      }
+      // The same place with the target itself is found (the decoys are seen as it would be).
+      if (decoy == 0) {
+        sign.surface = test::Surface::kTarget;
+        test::SceneRenderer with_target;
+        with_target.add(wall);
+        with_target.add(sign);
+        CHECK(render_and_detect(rig, pose, with_target, 30).found);
+      }
+    }
+  }
+  CHECK_EQUAL(12, scenes);
+  LONGS_EQUAL(0, false_detections);
+}
+
 TEST(Target, CornerIsTriangulatedFromBothFramesOfAPair) {
   const stereo::RigModel rig;
   static stereo::StereoProcessor processor{rig};
