@@ -1,6 +1,7 @@
 // Tests of algo/image: YUYV downsampling, feature selection, Eq 3.1 match error, epipolar tracking.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -101,6 +102,31 @@ TEST(Image, FeaturesAreStrongestVerticalDerivativesInsideTheBandAndSpreadOut) {
   selector.select(f, {79.5F, 59.5F, 75.0F}, features);
   for (const Feature& a : features) {
     CHECK(std::fabs(static_cast<float>(a.u_px) - 79.5F) <= 26.5F);
+  }
+}
+
+TEST(Image, AnEdgeWeakerThanTheMinimumStrengthGivesNoFeatures) {
+  // Two horizontal edges across the band whose height varies along them: a step of
+  // 3 ± 0.6 grey levels at row 40 (derivative at most 1.8 per px, below min_strength = 2)
+  // and one of 6 ± 2 at row 80 (2–4 per px).
+  LowResFrame& f = frame_a();
+  f.width = 160;
+  f.height = 120;
+  for (std::uint32_t v = 0; v < f.height; ++v) {
+    for (std::uint32_t u = 0; u < f.width; ++u) {
+      const float wave = std::sin(0.5F * static_cast<float>(u));
+      f.luma[f.index(u, v)] =
+          100.0F + (v >= 40 ? 3.0F + 0.6F * wave : 0.0F) + (v >= 80 ? 6.0F + 2.0F * wave : 0.0F);
+    }
+  }
+  FeatureParams params;
+  FeatureSelector selector(params);
+  static core::FixedVector<Feature, 1024> features;
+  const std::size_t n = selector.select(f, {79.5F, 59.5F, 150.0F}, features);
+  CHECK(n >= 5);
+  for (std::size_t i = 0; i < n; ++i) {
+    CHECK(features[i].v_px >= 78 && features[i].v_px <= 81);
+    CHECK(features[i].strength >= params.min_strength);
   }
 }
 
