@@ -146,6 +146,15 @@ struct Look {
   FixedVector<Reading, 512> free;
 };
 
+// An empty look to fill, shared by the tests that build their own (one at a time).
+Look& empty_look() {
+  static Look look;
+  look.features.clear();
+  look.obstacles.clear();
+  look.free.clear();
+  return look;
+}
+
 // One look from the room's centre: stereo features on the wall at six heights every degree
 // (m = 0.9; the box, plain, gives none, and hides the wall's low part behind it); the floor
 // cue's obstacle readings at the base of the wall or the box (0.05, 0.2, 0.4 m above the
@@ -382,10 +391,7 @@ namespace {
 // the floor, one a degree on a ring at each of `rings` [m], and the floor seen free up to
 // 1.97 m.
 void run_on_base_rings(std::initializer_list<float> rings) {
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
+  Look& look = empty_look();
   for (int d = 0; d < 360; ++d) {
     const float alpha = deg(static_cast<float>(d));
     for (const float rho : rings) (void)look.obstacles.push_back(at(alpha, rho, 0.05F, 0.5F));
@@ -405,13 +411,10 @@ TEST(LocalModelBuilder, TheFloorCuesBasesRightAtTheFloorAreGuardCandidates) {
 }
 
 TEST(LocalModelBuilder, AFloorCueBaseCutsTheFreePolygonItsMarginInFrontOfIt) {
-  // A featured wall 3.5 m away all round (the fit's crossing about 2.8 m), weak bases (m = 0.5,
+  // A featured wall 3.5 m away all round (the fit's crossing beyond 2 m), weak bases (m = 0.5,
   // which never lift the fit to m_safe) on a ring 2 m away and the floor seen to 1.97 m: the
   // bases' own cut, base_margin_m in front of them, is the nearest.
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
+  Look& look = empty_look();
   for (int d = 0; d < 360; ++d) {
     const float alpha = deg(static_cast<float>(d));
     for (const float z : {0.1F, 0.4F, 0.9F, 1.4F}) {
@@ -439,10 +442,7 @@ TEST(LocalModelBuilder, AFloorCueBaseCutsTheFreePolygonItsMarginInFrontOfIt) {
 TEST(LocalModelBuilder, WithoutWalkStartsAFloorCueBaseShowsTheFloorBeforeItLessItsRangeError) {
   // Only bases, on a ring 2 m away, and no free floor readings: the floor is seen up to each
   // base less δr (δr = 0.1 r).
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
+  Look& look = empty_look();
   for (int d = 0; d < 360; ++d) {
     (void)look.obstacles.push_back(at(deg(static_cast<float>(d)), 2.0F, 0.05F, 0.9F));
   }
@@ -457,10 +457,7 @@ TEST(LocalModelBuilder, WithoutWalkStartsAFloorCueBaseShowsTheFloorBeforeItLessI
 TEST(LocalModelBuilder, TheFreeSamplesOfAFloorPointLieOnItsLineOfSightShortOfIt) {
   // One floor point seen free, away from the seam: the fit's samples are the line of sight's
   // free samples, every one short of the point (none on or under the floor).
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
+  Look& look = empty_look();
   const Reading floor = at(1.0F, 2.0F, 0.0F, 0.0F);
   (void)look.free.push_back(floor);
   const mapping::LocalModelParams params = make_params();
@@ -491,10 +488,7 @@ TEST(LocalModelBuilder, TheGuardKeepsOnlyThePointsThatCanCutThePolygon) {
 // up to the wall behind. Only the guard's weak readings stand between the robot and the shelf:
 // the robot must still not be let under it.
 TEST(LocalModelBuilder, AShelfSeenOnlyWithLowEvidenceIsNotDrivenUnder) {
-  static Look look;
-  look.features.clear();
-  look.obstacles.clear();
-  look.free.clear();
+  Look& look = empty_look();
   constexpr float kWeakFirst_deg = 120.0F;
   constexpr float kWeakLast_deg = 180.0F;
   constexpr float kShelf_m = 1.5F;

@@ -45,6 +45,15 @@ image::TargetDetection render_and_detect(const stereo::RigModel& rig,
   return d;
 }
 
+// A camouflage wall (blotches of 8 cm) facing the camera, distance_m + 2 cm in front of it
+// along its axis: the backdrop the target or a decoy stands in front of.
+test::Patch camouflage_backdrop(const stereo::CameraPose& pose, float distance_m) {
+  test::Patch wall = test::facing_wall(pose.centre_m, pose.rotation.col(2), distance_m + 0.02F,
+                                       5.0F, test::Surface::kCamouflage, 9);
+  wall.scale_m = 0.08F;
+  return wall;
+}
+
 }  // namespace
 
 TEST_GROUP(Target){};
@@ -60,10 +69,7 @@ TEST(Target, CornerIsFoundFromHalfAMetreToFourMetres) {
     test::SceneRenderer scene;
     // Camouflage wall behind, the paper a little in front of it, off the optical axis.
     const Eigen::Vector3f forward = pose.rotation.col(2);
-    test::Patch wall = test::facing_wall(pose.centre_m, forward, distance + 0.02F, 5.0F,
-                                         test::Surface::kCamouflage, 9);
-    wall.scale_m = 0.08F;
-    scene.add(wall);
+    scene.add(camouflage_backdrop(pose, distance));
     test::Patch paper =
         test::facing_wall(pose.centre_m, forward, distance, 0.15F, test::Surface::kTarget, 1);
     // On the optical axis (the camera may be tilted), shifted within the view.
@@ -141,15 +147,12 @@ TEST(Target, AGreenTriangleOffWhitePaperOrOfAnotherShapeIsNotTheTarget) {
   // from 0.8 to 2.5 m, on a camouflage wall.
   const stereo::RigModel rig;
   int false_detections = 0;
-  int scenes = 0;
   for (const float distance : {0.8F, 1.5F, 2.5F}) {
     const stereo::CameraPose pose = rig.camera_pose(0.3F, 0.0F);
     const Eigen::Vector3f forward = pose.rotation.col(2);
     for (int decoy = 0; decoy < 4; ++decoy) {
       test::SceneRenderer scene;
-      test::Patch wall = test::facing_wall(pose.centre_m, forward, distance + 0.02F, 5.0F,
-                                           test::Surface::kCamouflage, 9);
-      wall.scale_m = 0.08F;
+      const test::Patch wall = camouflage_backdrop(pose, distance);
       scene.add(wall);
       test::Patch sign =
           test::facing_wall(pose.centre_m, forward, distance, 0.3F, test::Surface::kTarget, 1);
@@ -161,7 +164,6 @@ TEST(Target, AGreenTriangleOffWhitePaperOrOfAnotherShapeIsNotTheTarget) {
       scene.add(sign);
       const image::TargetDetection d =
           render_and_detect(rig, pose, scene, static_cast<std::uint32_t>(31 + decoy));
-      ++scenes;
       if (d.found) {
         ++false_detections;
         std::printf("\n  decoy %d at %.1f m taken for the target (confidence %.2f)", decoy,
@@ -177,7 +179,6 @@ TEST(Target, AGreenTriangleOffWhitePaperOrOfAnotherShapeIsNotTheTarget) {
       }
     }
   }
-  CHECK_EQUAL(12, scenes);
   LONGS_EQUAL(0, false_detections);
 }
 
