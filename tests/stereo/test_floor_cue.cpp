@@ -331,7 +331,8 @@ TEST(FloorCue, ABoundarysEvidenceRisesFromWeakToClearWithItsContrast) {
   render(0.0F, kLookTilt, 1, g_frame);
   FloorCueParams p = trusting();
   p.clear_contrast = 1000.0F;
-  static FloorCue dim{g_rig, p};
+  static FloorCue dim{g_rig, p};  // large (kept frames): not on the stack
+  dim.reset();
   for (FloorCue* c : {&cue, &dim}) {
     CHECK(FloorLearn::kLearned == c->learn(g_frame, 0.0F, kLookTilt));
     out.obstacles.clear();
@@ -359,6 +360,7 @@ TEST(FloorCue, ARegionOfFewerPixelsThanTheMinimumIsNotLearned) {
   FloorCueParams p = trusting();
   p.reference_min_pixels = 100000;  // more than the low-resolution frame has
   static FloorCue strict{g_rig, p};
+  strict.reset();
   load("");
   render(0.0F, kLookTilt, 1, g_frame);
   CHECK(FloorLearn::kNoRegion == strict.learn(g_frame, 0.0F, kLookTilt));
