@@ -329,6 +329,7 @@ TEST(FeatureGuard, TheNavigablePolygonKeepsTheRobotClearOfABoxTheModelMissed) {
 
 TEST(FeatureGuard, CollectingCorroboratingAndExcludingAllocateNothing) {
   static FixedVector<Reading, 64> readings;
+  readings.clear();  // static: a repeated run (-r) starts from none
   box_face(readings, 35);
   static FixedVector<mapping::GuardPoint, 64> candidates;
   static FixedVector<Point2, 64> guard;
