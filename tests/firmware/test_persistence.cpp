@@ -13,6 +13,7 @@
 #include <ctime>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "firmware/mission_state.h"
 #include "firmware/persistence.h"
@@ -114,6 +115,11 @@ TEST(Persistence, HoldsAStateFilledToEveryCapacity) {
   while (g_a.exploration.push_back({3.40282347e38F, -0.0F})) {
   }
   CHECK(g_a.set_model(std::string(MissionState::kMaxModelBytes, 'M')));
+  // One byte more, or a NUL inside, is refused and leaves the model as it was.
+  CHECK_FALSE(g_a.set_model(std::string(MissionState::kMaxModelBytes + 1, 'X')));
+  CHECK_FALSE(g_a.set_model(std::string_view("ab\0cd", 5)));
+  CHECK_EQUAL(MissionState::kMaxModelBytes, g_a.model_text().size());
+  CHECK_EQUAL('M', g_a.model_text().front());
   for (int i = 0; i < 500; ++i) g_a.add_log(static_cast<std::uint64_t>(i), std::string(200, '~'));
   CHECK_EQUAL(MissionState::kMaxLogEntries, g_a.log.size());
   CHECK_EQUAL(499U, g_a.log.back().cycle);
