@@ -395,6 +395,15 @@ TEST(Safety, ACatchesAPressShorterThanAFrameThroughTheEdge) {
   CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
 }
 
+TEST(Safety, ABumperTapShorterThanAFrameStopsTheBaseAndCountsAsACollision) {
+  bumper.edge = true;  // touched and released between two polls
+  safety.poll();
+  CHECK(safety.engaged());
+  CHECK(safety.cause() == StopCause::kBumper);
+  CHECK_EQUAL(1U, safety.collisions());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+}
+
 TEST(Safety, StaysLatchedUntilClearedAndRefusesToClearWhileAnInputIsActive) {
   bumper.level = true;
   safety.poll();
