@@ -274,30 +274,24 @@ TEST(DriveController, ABaseThatDoesNotMoveTimesOut) {
   CHECK(took_s <= nominal_s * p.timeout_factor + 0.05F);
 }
 
-TEST(DriveController, ASidePushBeyondTheLimitAbortsTheStep) {
-  d.base.pose = {0.0F, 0.0F, 0.0F};
-  d.start({2.0F, 0.0F});
-  while (d.controller.status() != DriveStatus::kDriving && d.log.periods < 1000) d.period();
-  for (int i = 0; i < 150; ++i) d.period();
-  d.base.pose.y_m += 0.1F;  // knocked sideways, beyond max_cross_track_m (0.06 m)
-  d.period();
-  CHECK(d.controller.status() == DriveStatus::kStopping);
-  d.run();
-  CHECK(d.controller.status() == DriveStatus::kFailed);
-  STRCMP_EQUAL("left the step's line", d.controller.failure());
-  CHECK(d.base.pose.x_m < 1.5F);  // it stopped there, it did not go on
-}
-
-TEST(DriveController, ASidePushToTheOtherSideAbortsTheStepToo) {
-  d.base.pose = {0.0F, 0.0F, 0.0F};
-  d.start({2.0F, 0.0F});
-  while (d.controller.status() != DriveStatus::kDriving && d.log.periods < 1000) d.period();
-  for (int i = 0; i < 150; ++i) d.period();
-  d.base.pose.y_m -= 0.1F;  // to the right this time
-  d.period();
-  CHECK(d.controller.status() == DriveStatus::kStopping);
-  d.run();
-  STRCMP_EQUAL("left the step's line", d.controller.failure());
+TEST(DriveController, ASidePushBeyondTheLimitToEitherSideAbortsTheStep) {
+  for (const float push_m : {0.1F, -0.1F}) {  // left, then right; max_cross_track_m is 0.06 m
+    Drive drive;
+    drive.controller.configure(DriveParams{});
+    drive.base.pose = {0.0F, 0.0F, 0.0F};
+    drive.start({2.0F, 0.0F});
+    while (drive.controller.status() != DriveStatus::kDriving && drive.log.periods < 1000) {
+      drive.period();
+    }
+    for (int i = 0; i < 150; ++i) drive.period();
+    drive.base.pose.y_m += push_m;  // knocked sideways
+    drive.period();
+    CHECK(drive.controller.status() == DriveStatus::kStopping);
+    drive.run();
+    CHECK(drive.controller.status() == DriveStatus::kFailed);
+    STRCMP_EQUAL("left the step's line", drive.controller.failure());
+    CHECK(drive.base.pose.x_m < 1.5F);  // it stopped there, it did not go on
+  }
 }
 
 TEST(DriveController, NeverGoesFasterThanItCanStopInWhatIsLeftOfTheStep) {
