@@ -1,7 +1,7 @@
 // console_mode(): maps the firmware's --console choice onto the Linux HAL's ConsolePort modes.
 #pragma once
 
-#include "firmware/options.h"
+#include "firmware/app/options.h"
 #include "hal/linux/console_port.h"
 
 namespace boticelli::boards {

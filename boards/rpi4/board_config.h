@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "firmware/board.h"
-#include "firmware/config_file.h"
+#include "firmware/app/board.h"
+#include "firmware/app/config_file.h"
 
 namespace boticelli::boards::rpi4 {
 

@@ -1,5 +1,5 @@
 // boticelli for the Raspberry Pi 4 reference robot: hands the board to the firmware.
-#include "firmware/firmware_main.h"
+#include "firmware/app/firmware_main.h"
 #include "rpi4_board.h"
 
 namespace {

@@ -2,7 +2,7 @@
 #include "rpi4_board.h"
 
 #include "../console_mode.h"
-#include "firmware/log.h"
+#include "firmware/common/log.h"
 
 #include <cstdio>
 

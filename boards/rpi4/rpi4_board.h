@@ -5,7 +5,7 @@
 #include <optional>
 
 #include "board_config.h"
-#include "firmware/board.h"
+#include "firmware/app/board.h"
 #include "hal/hal.h"
 #include "hal/linux/console_port.h"
 #include "hal/linux/base_odrive_can.h"

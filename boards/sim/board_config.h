@@ -5,8 +5,8 @@
 #include <cstdint>
 
 #include "algo/stereo/rig.h"
-#include "firmware/board.h"
-#include "firmware/mission/mission_params.h"
+#include "firmware/app/board.h"
+#include "firmware/mission/params/mission_params.h"
 #include "hal/sim/renderer.h"
 #include "hal/sim/sim_world.h"
 

@@ -8,17 +8,17 @@
 #include <optional>
 #include <string_view>
 
-#include "firmware/console.h"
-#include "firmware/device_tasks.h"
-#include "firmware/executive.h"
-#include "firmware/mission_view.h"
-#include "firmware/parameters.h"
-#include "firmware/persistence.h"
-#include "firmware/safety.h"
-#include "firmware/service_notify.h"
-#include "firmware/state_saver.h"
-#include "firmware/task_table.h"
-#include "firmware/text_buffer.h"
+#include "firmware/console/console.h"
+#include "firmware/app/device_tasks.h"
+#include "firmware/executive/executive.h"
+#include "firmware/telemetry/mission_view.h"
+#include "firmware/common/parameters.h"
+#include "firmware/state/persistence.h"
+#include "firmware/safety/safety.h"
+#include "firmware/app/service_notify.h"
+#include "firmware/state/state_saver.h"
+#include "firmware/executive/task_table.h"
+#include "firmware/common/text_buffer.h"
 #include "sim_board.h"
 
 namespace boticelli::boards::sim {

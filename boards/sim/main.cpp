@@ -1,5 +1,5 @@
 // boticelli for the host simulation board: hands the board to the firmware.
-#include "firmware/firmware_main.h"
+#include "firmware/app/firmware_main.h"
 #include "sim_board.h"
 
 namespace {

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "firmware/atomic_file.h"
+#include "firmware/state/atomic_file.h"
 
 namespace boticelli::boards::sim {
 namespace {

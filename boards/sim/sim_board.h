@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include "board_config.h"
-#include "firmware/board.h"
+#include "firmware/app/board.h"
 #include "hal/hal.h"
 #include "hal/linux/console_port.h"
 #include "hal/sim/base_sim.h"

@@ -1,4 +1,4 @@
-// Mission: the Look–Think–Drive state machine (see mission.h).
+// Mission: the Look–Think–Drive phases and their dispatch over the mission's parts (mission.h).
 #include "firmware/mission/mission.h"
 
 #include <algorithm>
@@ -8,10 +8,10 @@
 
 #include "algo/aln/text_format.h"
 #include "algo/core/angles.h"
-#include "algo/image/low_res_frame.h"
-#include "firmware/mission/trace_writer.h"
-#include "firmware/snapshot.h"
-#include "firmware/text_buffer.h"
+#include "firmware/common/text_buffer.h"
+#include "firmware/mission/snapshot_builder.h"
+#include "firmware/telemetry/snapshot.h"
+#include "firmware/telemetry/trace_writer.h"
 
 namespace boticelli::firmware::mission {
 namespace {
@@ -40,9 +40,6 @@ class CpuScope {
   double& longest_;
   double start_;
 };
-
-// Model text buffer: the text format of the last fitted model (console `model`, state file).
-char g_model_text[MissionState::kMaxModelBytes];
 
 }  // namespace
 
@@ -115,9 +112,10 @@ Mission::Mission(const MissionContext& c)
       trace_(c.trace),
       snapshots_(c.snapshots),
       params_(make_mission_params(c.config)),
-      rig_(params_.rig),
-      stereo_(rig_, params_.stereo),
-      floor_cue_(rig_) {
+      pose_(c.hal.base),
+      scan_(params_),
+      look_(params_.rig, params_.stereo, params_.model.close_blocked_rays),
+      planner_(params_) {
   tracker_.configure(params_.target);
   driver_.configure(params_.drive);
 }
@@ -129,12 +127,9 @@ void Mission::start(std::uint64_t now_us) {
   result_ = Result::kRunning;
   end_reason_.clear();
   cycles_this_run_ = 0;
-  failed_cycles_ = 0;
-  turned_round_ = false;
-  map_.clear();
-  for (const core::Point2& p : state_.obstacles) (void)map_.obstacles().push_back(p);
-  for (const core::Point2& p : state_.exploration) (void)map_.exploration().push_back(p);
-  anchor_frame();
+  planner_.clear();
+  map_.start(state_);
+  pose_.anchor(state_.pose);
   tracker_.clear();
   if (state_.has_goal) {
     // A resumed goal was confirmed before the restart: it stands as two agreeing views.
@@ -142,35 +137,20 @@ void Mission::start(std::uint64_t now_us) {
     tracker_.add(g, 1.0F, 0xFFFFFFF0U);
     tracker_.add(g, 1.0F, 0xFFFFFFF1U);
   }
-  trail_.clear();
+  // A resumed mission shows its saved model until the first look is fitted.
+  model_text_.clear();
+  const std::string_view saved = state_.model_text();
+  std::copy(saved.begin(), saved.end(), model_text_.back().begin());
+  model_text_.publish(saved.size());
   path_.clear();
   breadcrumbs_.clear();
-  has_prior_look_ = false;  // a resumed mission's first look has none
-  retreating_ = false;
-  snapshot_pending_ = false;
-  snapshot_writing_ = false;
+  pending_move_ = move_ = Move::kNone;
+  snapshot_step_ = SnapshotStep::kIdle;
   look_lists_stale_ = false;
 }
 
-core::Pose2 Mission::odometry_pose() const {
-  const hal::Odometry o = hal_.base.odometry();
-  return core::compose(frame_from_odometry_, {static_cast<float>(o.x_m), static_cast<float>(o.y_m),
-                                              static_cast<float>(o.yaw_rad)});
-}
-
-void Mission::anchor_frame() {
-  const hal::Odometry o = hal_.base.odometry();
-  const core::Pose2 odometry{static_cast<float>(o.x_m), static_cast<float>(o.y_m),
-                             static_cast<float>(o.yaw_rad)};
-  frame_from_odometry_ = core::compose(state_.pose, core::inverse(odometry));
-}
-
-core::Pose2 Mission::frame_origin_in_world() const {
-  return core::compose(truth_->odometry_origin(), core::inverse(frame_from_odometry_));
-}
-
 core::Pose2 Mission::pose() const {
-  return odometry_pose();
+  return pose_.pose();
 }
 
 float Mission::pan_rad() const {
@@ -179,9 +159,9 @@ float Mission::pan_rad() const {
 
 MapCounts Mission::map_counts() const {
   MapCounts m;
-  m.polygon_vertices = static_cast<std::uint32_t>(builder_.map().free.vertex_count());
-  m.obstacle_points = static_cast<std::uint32_t>(map_.obstacles().size());
-  m.exploration_points = static_cast<std::uint32_t>(map_.exploration().size());
+  m.polygon_vertices = static_cast<std::uint32_t>(map_.local().free.vertex_count());
+  m.obstacle_points = static_cast<std::uint32_t>(map_.global().obstacles().size());
+  m.exploration_points = static_cast<std::uint32_t>(map_.global().exploration().size());
   return m;
 }
 
@@ -200,24 +180,11 @@ TargetEstimate Mission::target() const {
 float Mission::target_error_m() const {
   if (truth_ == nullptr || !tracker_.confirmed()) return std::numeric_limits<float>::quiet_NaN();
   // The estimate is in the mission frame; the truth knows where the odometry frame lies.
-  const core::Pose2 o = frame_origin_in_world();
+  const core::Pose2 o = pose_.frame_origin_in_world(truth_->odometry_origin());
   const Eigen::Vector3f& e = tracker_.estimate_m();
   const core::Point2 w = core::to_world(o, {e.x(), e.y()});
   const Eigen::Vector3f world(w.x_m, w.y_m, e.z());
   return (world - truth_->target_m()).norm();
-}
-
-void Mission::view_angles(std::size_t view, float& pan_rad, float& tilt_rad, bool& pair) const {
-  if (view >= scan_views()) {
-    pan_rad = aimed_pan_rad_;
-    tilt_rad = aimed_tilt_rad_;
-    pair = true;
-    return;
-  }
-  const LookView v = scan_view(params_, hal_.pan_tilt.limits(), view);
-  pan_rad = v.pan_rad;
-  tilt_rad = v.tilt_rad;
-  pair = v.pair;
 }
 
 void Mission::finish(Result result, const char* why) {
@@ -226,7 +193,7 @@ void Mission::finish(Result result, const char* why) {
   end_reason_.clear();
   end_reason_.append(why);
   phase_ = Phase::kDone;
-  want_frame_ = false;
+  scan_.stop_frames();
   driver_.reset();
   hal_.base.set_velocity(0.0F, 0.0F);
   TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
@@ -268,7 +235,7 @@ void Mission::control(std::uint64_t now_us) {
   if (hold_needed() && phase_ != Phase::kHold) {
     held_phase_ = phase_;
     phase_ = Phase::kHold;
-    want_frame_ = false;
+    scan_.stop_frames();
     released_ = false;
     if (driver_.busy()) driver_.abort("held");
   }
@@ -277,7 +244,7 @@ void Mission::control(std::uint64_t now_us) {
       const hal::PanTiltState ptu = hal_.pan_tilt.state();
       if (ptu.fault) return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
       if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) {
-        anchor_frame();  // the odometry as the base reports it once ready
+        pose_.anchor(state_.pose);  // the odometry as the base reports it once ready
         begin_look(now_us);
       }
       return;
@@ -304,11 +271,11 @@ void Mission::control_hold(std::uint64_t now_us) {
   hal_.base.set_velocity(0.0F, 0.0F);
   if (driver_.busy()) {
     const hal::Odometry o = hal_.base.odometry();
-    (void)driver_.update(odometry_pose(), o.v_m_s, o.omega_rad_s, now_us);
+    (void)driver_.update(pose_.pose(), o.v_m_s, o.omega_rad_s, now_us);
   }
   if (safety_.engaged()) {
     // A button stop is cleared once the button has been released for a while; a console
-    // stop waits for the console's `clear`.
+    // stop waits for the console's `clear-estop`.
     if (safety_.cause() == StopCause::kButton && !hal_.estop.read()) {
       if (!released_) {
         released_ = true;
@@ -330,143 +297,87 @@ void Mission::control_hold(std::uint64_t now_us) {
     return;
   }
   phase_ = held_phase_;
-  if (phase_ == Phase::kLook && look_step_ != LookStep::kProcess) {
-    look_step_ = LookStep::kMove;  // re-issue the interrupted move and wait again
-  }
+  if (phase_ == Phase::kLook) scan_.resume();  // re-issue the interrupted move and wait again
 }
 
 void Mission::begin_look(std::uint64_t now_us) {
   phase_ = Phase::kLook;
   // A planned move not begun is void.
-  drive_pending_ = turn_pending_ = turning_round_ = retreating_ = next_step_pending_ = false;
-  choosing_ = false;
-  view_ = 0;
-  second_frame_ = false;
-  look_step_ = LookStep::kMove;
+  pending_move_ = move_ = Move::kNone;
   look_lists_stale_ = true;  // cleared by the background before the first view
-  view_ready_ = false;
   view_part_ = 0;
-  look_pose_ = odometry_pose();
-  last_sighting_ = {};  // the robot has moved: no earlier frame pairs with this look's
-  aim_at_target();
-  step_deadline_us_ = now_us + params_.ptu_timeout_us;
-  think_started_ = false;
-  plan_started_ = false;
+  look_pose_ = pose_.pose();
+  scan_.begin(now_us, aim_at_target());
+  think_step_ = ThinkStep::kBegin;
+  plan_step_ = PlanStep::kValueStart;
 }
 
-void Mission::aim_at_target() {
-  aimed_ = false;
-  if (tracker_.sightings() == 0) return;
+AimedPair Mission::aim_at_target() const {
+  AimedPair aimed;
+  if (tracker_.sightings() == 0) return aimed;
   const Eigen::Vector3f& c = tracker_.confirmed() ? tracker_.estimate_m() : tracker_.candidate_m();
   const core::Point2 q = core::to_robot(look_pose_, {c.x(), c.y()});
   const float d = std::hypot(q.x_m, q.y_m);
   const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
   const float pan = std::atan2(q.y_m, q.x_m);
-  if (d > params_.limits.max_range_m || pan < lim.pan_min_rad || pan > lim.pan_max_rad) return;
+  if (d > params_.limits.max_range_m || pan < lim.pan_min_rad || pan > lim.pan_max_rad) {
+    return aimed;
+  }
   // The vertex midway between the pair's two tilts, so both frames hold it.
   const float elevation = std::atan2(c.z() - params_.rig.ptu_height_m, d);
   const float phi = params_.rig.tilt_step_rad;
-  aimed_pan_rad_ = pan;
-  aimed_tilt_rad_ = std::clamp(elevation + 0.5F * phi, lim.tilt_min_rad + phi, lim.tilt_max_rad);
-  aimed_ = true;
+  aimed.pan_rad = pan;
+  aimed.tilt_rad = std::clamp(elevation + 0.5F * phi, lim.tilt_min_rad + phi, lim.tilt_max_rad);
+  aimed.aimed = true;
+  return aimed;
 }
 
 void Mission::control_look(std::uint64_t now_us) {
   hal_.base.set_velocity(0.0F, 0.0F);
-  const hal::PanTiltState ptu = hal_.pan_tilt.state();
-  if (ptu.fault) return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
-  switch (look_step_) {
-    case LookStep::kMove: {
-      view_angles(view_, view_pan_rad_, view_tilt_rad_, view_pair_);
-      const float tilt =
-          second_frame_ ? view_tilt_rad_ - params_.rig.tilt_step_rad : view_tilt_rad_;
-      if (!hal_.pan_tilt.move_to(view_pan_rad_, tilt)) {
-        return abort_with("pan-tilt unit refused a move", hal_.pan_tilt.error());
-      }
-      step_deadline_us_ = now_us + params_.ptu_timeout_us;
-      look_step_ = LookStep::kSettle;
-      settle_until_us_ = 0;
+  switch (scan_.control(now_us, hal_.pan_tilt)) {
+    case ScanEvent::kBusy:
       return;
-    }
-    case LookStep::kSettle:
-      if (ptu.moving) {
-        if (now_us > step_deadline_us_) abort("pan-tilt move did not complete");
-        return;
-      }
-      if (settle_until_us_ == 0) settle_until_us_ = now_us + params_.settle_us;
-      if (now_us < settle_until_us_) return;
-      frame_ready_ = false;
-      want_frame_ = true;
-      step_deadline_us_ = now_us + params_.frame_timeout_us;
-      look_step_ = LookStep::kGrab;
-      return;
-    case LookStep::kGrab:
-      if (!frame_ready_) {
-        if (now_us > step_deadline_us_) abort_with("no camera frame", hal_.camera.error());
-        return;
-      }
-      want_frame_ = false;
-      if (!second_frame_) {
-        pair_pose_.pan_rad = ptu.pan_rad;
-        pair_pose_.first_tilt_rad = ptu.tilt_rad;
-      } else {
-        pair_pose_.second_tilt_rad = ptu.tilt_rad;
-      }
-      if (view_pair_ && !second_frame_) {
-        second_frame_ = true;
-        look_step_ = LookStep::kMove;
-        return;
-      }
-      view_ready_ = true;
-      look_step_ = LookStep::kProcess;
-      return;
-    case LookStep::kProcess:
-      if (view_ready_) return;  // the background has not taken the view yet
-      second_frame_ = false;
-      if (++view_ < view_count()) {
-        look_step_ = LookStep::kMove;
-        return;
-      }
-      // Look complete: park the camera level and think.
-      (void)hal_.pan_tilt.move_to(0.0F, 0.0F);
+    case ScanEvent::kDone:
       phase_ = Phase::kThink;
       return;
+    case ScanEvent::kPtuFault:
+      return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
+    case ScanEvent::kPtuRefused:
+      return abort_with("pan-tilt unit refused a move", hal_.pan_tilt.error());
+    case ScanEvent::kPtuTimeout:
+      return abort("pan-tilt move did not complete");
+    case ScanEvent::kNoFrame:
+      return abort_with("no camera frame", hal_.camera.error());
   }
 }
 
-void Mission::on_frame(const hal::Frame& frame) {
-  if (!want_frame_ || frame_ready_ || frame.timestamp_us < settle_until_us_) return;
-  image::LowResFrame& into = second_frame_ ? second_ : first_;
-  if (!image::downsample_yuyv(frame.data, frame.width_px, frame.height_px, frame.stride_bytes,
-                              params_.rig.downsample_factor, into)) {
-    return;
-  }
-  frame_ready_ = true;
+void Mission::drive(Move move) {
+  pending_move_ = move;
+  phase_ = Phase::kDrive;
 }
 
 void Mission::control_drive(std::uint64_t now_us) {
-  if (drive_pending_) {
-    drive_pending_ = false;
-    const core::Pose2 from = odometry_pose();
-    if (turn_pending_) {
-      turn_pending_ = false;
-      turning_round_ = true;
+  if (pending_move_ != Move::kNone) {
+    move_ = pending_move_;
+    pending_move_ = Move::kNone;
+    const core::Pose2 from = pose_.pose();
+    if (move_ == Move::kTurnRound) {
       driver_.start_turn(from, core::wrap_pi(from.yaw_rad + core::kPi<float>), now_us);
     } else {
-      if (!retreating_) breadcrumbs_.step_started({from.x_m, from.y_m});
-      driver_.start(from, decision_.target, now_us);
+      if (move_ != Move::kBackOff) breadcrumbs_.step_started({from.x_m, from.y_m});
+      driver_.start(from, planner_.target(), now_us);
     }
   }
   const hal::Odometry o = hal_.base.odometry();
-  const DriveCommand cmd = driver_.update(odometry_pose(), o.v_m_s, o.omega_rad_s, now_us);
+  const DriveCommand cmd = driver_.update(pose_.pose(), o.v_m_s, o.omega_rad_s, now_us);
   hal_.base.set_velocity(cmd.v_m_s, cmd.omega_rad_s);
   if (hal_.base.health() == hal::BaseHealth::kStopped && !safety_.engaged()) {
     return abort_with("base stopped by itself", hal_.base.error());
   }
   if (driver_.busy()) return;
   const bool ok = driver_.status() == DriveStatus::kDone;
-  const core::Pose2 here = odometry_pose();
-  trail_.add({here.x_m, here.y_m});
+  const core::Pose2 here = pose_.pose();
+  planner_.visited({here.x_m, here.y_m});
   if (tracker_.confirmed()) {
     const Eigen::Vector3f& g = tracker_.estimate_m();
     if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
@@ -475,27 +386,27 @@ void Mission::control_drive(std::uint64_t now_us) {
       return finish(Result::kFound, "within the stand-off of the target");
     }
   }
-  if (retreating_) {
-    retreating_ = false;
-    if (ok) breadcrumbs_.reached();
-    end_cycle(ok ? "no safe step, backed off" : driver_.failure());
-    if (phase_ != Phase::kDone) begin_look(now_us);
-    return;
-  }
-  if (turning_round_) {
-    // Only a finished turn counts: an interrupted one is tried again at the next dead end.
-    turning_round_ = false;
-    if (ok) {
-      turned_round_ = true;
-      turned_round_at_ = {here.x_m, here.y_m};
-    }
-    end_cycle(ok ? "turned round" : driver_.failure());
-    if (phase_ != Phase::kDone) begin_look(now_us);
-    return;
+  const Move done = move_;
+  move_ = Move::kNone;
+  switch (done) {
+    case Move::kBackOff:
+      if (ok) breadcrumbs_.reached();
+      end_cycle(ok ? "no safe step, backed off" : driver_.failure());
+      if (phase_ != Phase::kDone) begin_look(now_us);
+      return;
+    case Move::kTurnRound:
+      // Only a finished turn counts: an interrupted one is tried again at the next dead end.
+      if (ok) planner_.turned_round_at({here.x_m, here.y_m});
+      end_cycle(ok ? "turned round" : driver_.failure());
+      if (phase_ != Phase::kDone) begin_look(now_us);
+      return;
+    case Move::kStep:
+    case Move::kNone:
+      break;
   }
   if (ok && ++steps_this_look_ < params_.steps_per_look) {
     // Another step on the same look is worked out by the background (a unit of its own).
-    next_step_pending_ = true;
+    plan_step_ = PlanStep::kNextOnLook;
     phase_ = Phase::kPlan;
     return;
   }
@@ -503,52 +414,11 @@ void Mission::control_drive(std::uint64_t now_us) {
   if (phase_ != Phase::kDone) begin_look(now_us);
 }
 
-// Another step on the same look: the look's navigable polygon as seen from where the robot
-// is now (each ray as far as the straight move stays inside it), and the same value function.
-bool Mission::start_next_step_on_look() {
-  const core::Pose2 here = odometry_pose();
-  const mapping::StarPolygon& nav = builder_.map().navigable;
-  if (!nav.contains(core::to_robot(look_pose_, {here.x_m, here.y_m}))) return false;
-  from_here_.set_vertex_count(nav.vertex_count());
-  const float reach = params_.value.step_m;
-  constexpr int kSamples = 20;
-  for (std::size_t k = 0; k < from_here_.vertex_count(); ++k) {
-    const float a = from_here_.angle_rad(k) + here.yaw_rad;
-    float rho = 0.0F;
-    for (int i = 1; i <= kSamples; ++i) {
-      const float t = reach * static_cast<float>(i) / kSamples;
-      const core::Point2 p{here.x_m + t * std::cos(a), here.y_m + t * std::sin(a)};
-      if (!nav.contains(core::to_robot(look_pose_, p))) break;
-      rho = t;
-    }
-    from_here_.set_rho_m(k, rho);
-  }
-  chooser_.start(value_, from_here_, here, params_.step);
-  return true;
-}
-
-void Mission::finish_next_step_on_look() {
-  if (decision_.kind == planning::StepKind::kMove) {
-    drive_pending_ = true;
-    phase_ = Phase::kDrive;
-    return;
-  }
-  end_cycle("step done");
-  if (phase_ != Phase::kDone) begin_look(now_us_);
-}
-
 void Mission::end_cycle(const char* what) {
   ++state_.cycle;
   ++cycles_this_run_;
-  state_.pose = odometry_pose();
-  state_.obstacles.clear();
-  for (const core::Point2& p : map_.obstacles()) {
-    if (!state_.obstacles.push_back(p)) break;
-  }
-  state_.exploration.clear();
-  for (const core::Point2& p : map_.exploration()) {
-    if (!state_.exploration.push_back(p)) break;
-  }
+  state_.pose = pose_.pose();
+  map_.save(state_);
   state_.has_goal = tracker_.confirmed();
   if (state_.has_goal) {
     state_.goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
@@ -557,12 +427,13 @@ void Mission::end_cycle(const char* what) {
   TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
   line.appendf("cycle %s x_m=%.2f y_m=%.2f pieces=%u features=%u obst=%u expl=%u", what,
                static_cast<double>(state_.pose.x_m), static_cast<double>(state_.pose.y_m),
-               last_pieces_, last_features_, static_cast<unsigned>(map_.obstacles().size()),
-               static_cast<unsigned>(map_.exploration().size()));
+               last_pieces_, look_.last_features(),
+               static_cast<unsigned>(map_.global().obstacles().size()),
+               static_cast<unsigned>(map_.global().exploration().size()));
   state_.add_log(state_.cycle, line.view());
   if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
   if (snapshots_ != nullptr) {
-    snapshot_pending_ = true;
+    snapshot_step_ = SnapshotStep::kPending;
     snapshot_state_ = phase_name(phase_);
     snapshot_look_pose_ = look_pose_;
   }
@@ -579,7 +450,7 @@ void Mission::write_trace(std::uint64_t now_us) {
   if (trace_ == nullptr || now_us < next_trace_us_) return;
   next_trace_us_ += params_.trace_period_us;
   if (next_trace_us_ <= now_us) next_trace_us_ = now_us + params_.trace_period_us;
-  const core::Pose2 odo = odometry_pose();
+  const core::Pose2 odo = pose_.pose();
   const core::Pose2 truth = truth_ != nullptr ? truth_->robot_pose() : odo;
   const hal::PanTiltState ptu = hal_.pan_tilt.state();
   trace_->row(static_cast<double>(now_us) * 1e-6, truth, ptu.pan_rad, ptu.tilt_rad,
@@ -590,7 +461,7 @@ void Mission::write_trace(std::uint64_t now_us) {
 
 StepResult Mission::step(SliceBudget& budget) {
   // The last cycle's picture first: it shows that cycle's readings, model and value function.
-  if (snapshot_pending_ || snapshot_writing_) {
+  if (snapshot_step_ != SnapshotStep::kIdle) {
     if (!budget.next_unit()) return StepResult::kMore;
     CpuScope cpu(nullptr, longest(Unit::kSnapshot));
     snapshot_step();
@@ -598,417 +469,218 @@ StepResult Mission::step(SliceBudget& budget) {
   }
   if (phase_ == Phase::kDone) return StepResult::kMore;
   // The view just grabbed: stereo, target, floor cue on each frame (a unit each).
-  if (phase_ == Phase::kLook && view_ready_) {
+  if (phase_ == Phase::kLook && scan_.view_ready()) {
     if (!budget.next_unit()) return StepResult::kMore;
     if (look_lists_stale_) {
-      features_.clear();
-      floor_obstacles_.clear();
-      floor_free_.clear();
-      floor_free_near_.clear();
-      floor_blocked_.clear();
-      floor_cue_.begin_look();  // frames kept from the last look were seen from elsewhere
+      look_.begin_look();  // frames kept from the last look were seen from elsewhere
       look_lists_stale_ = false;
     }
-    if (process_view(view_part_++)) {
+    if (process_view(static_cast<ViewPart>(view_part_++))) {
       view_part_ = 0;
-      view_ready_ = false;
+      scan_.view_processed();
     }
     return StepResult::kMore;
   }
-  double* const think_cpu = &cpu_s_[1];
-  double* const plan_cpu = &cpu_s_[2];
-  if (phase_ == Phase::kThink) {
-    if (!think_started_) {
-      if (!budget.next_unit()) return StepResult::kMore;
-      CpuScope cpu(think_cpu, longest(Unit::kModel));
-      begin_think();
-    }
-    while (!builder_.done()) {
-      if (!budget.next_unit()) return StepResult::kMore;
-      CpuScope cpu(think_cpu, longest(Unit::kModel));
-      (void)builder_.step();
-    }
-    if (!budget.next_unit()) return StepResult::kMore;
-    CpuScope cpu(think_cpu, longest(Unit::kMap));
-    after_think();
-    return StepResult::kMore;
-  }
-  if (phase_ == Phase::kPlan && choosing_) {
-    // The step on the value function, one action per unit.
-    while (!chooser_.done()) {
-      if (!budget.next_unit()) return StepResult::kMore;
-      CpuScope cpu(plan_cpu, longest(Unit::kStep));
-      (void)chooser_.step();
-    }
-    if (!budget.next_unit()) return StepResult::kMore;
-    CpuScope cpu(plan_cpu, longest(Unit::kStep));
-    choosing_ = false;
-    decision_ = chooser_.decision();
-    if (choosing_on_look_) {
-      finish_next_step_on_look();
-    } else {
-      after_step_choice();
-    }
-    return StepResult::kDone;
-  }
-  if (phase_ == Phase::kPlan && next_step_pending_) {
-    if (!budget.next_unit()) return StepResult::kMore;
-    CpuScope cpu(plan_cpu, longest(Unit::kStep));
-    next_step_pending_ = false;
-    if (start_next_step_on_look()) {
-      choosing_ = true;
-      choosing_on_look_ = true;
-      return StepResult::kMore;
-    }
-    end_cycle("step done");
-    if (phase_ != Phase::kDone) begin_look(now_us_);
-    return StepResult::kDone;
-  }
-  if (phase_ == Phase::kPlan) {
-    if (!plan_started_) {
-      if (!budget.next_unit()) return StepResult::kMore;
-      CpuScope cpu(plan_cpu, longest(Unit::kPlanStart));
-      begin_plan();
-    }
-    while (!value_.done()) {
-      if (!budget.next_unit()) return StepResult::kMore;
-      CpuScope cpu(plan_cpu, longest(Unit::kValue));
-      (void)value_.step(params_.vi_work_per_unit);
-    }
-    if (!budget.next_unit()) return StepResult::kMore;
-    CpuScope cpu(plan_cpu, longest(Unit::kStep));
-    if (start_step_choice()) {
-      choosing_ = true;
-      choosing_on_look_ = false;
-      return StepResult::kMore;
-    }
-    return StepResult::kDone;
-  }
+  if (phase_ == Phase::kThink) return step_think(budget);
+  if (phase_ == Phase::kPlan) return step_plan(budget);
   return StepResult::kMore;
 }
 
-bool Mission::process_view(std::uint8_t part) {
-  CpuScope cpu(&cpu_s_[0], longest(Unit::kView));
-  switch (part) {
-    case 0:
-      if (view_pair_) {
-        (void)stereo_.process(first_, second_, pair_pose_, features_);
-        last_features_ = static_cast<std::uint32_t>(stereo_.points().size());
-      }
-      return false;
-    case 1:
-      if (view_pair_) {
-        const stereo::TargetFix fix = stereo_.locate_target(first_, second_, pair_pose_);
-        const auto view = static_cast<std::uint32_t>(state_.cycle * 256U + view_);
-        add_target_fix(fix, view);
-        // The vertex in this first frame and in the look's last one at another pan: a pair
-        // with a longer baseline than the tilt's (the later view's sighting).
-        if (fix.first.found) {
-          const stereo::TargetSighting here{fix.first, pair_pose_.pan_rad,
-                                            pair_pose_.first_tilt_rad};
-          add_target_fix(stereo_.locate_target_across(last_sighting_, here), view);
-          last_sighting_ = here;
-        }
-      }
-      // The aimed pair looks up at the target, not at the floor.
-      return view_ >= scan_views();
-    case 2:
-      // The floor cue: learn from the frames that see the floor close in front, then walk
-      // the columns; a low pair's second frame sees nearer floor than its first.
-      (void)floor_cue_.learn(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad);
-      (void)floor_cue_.process(first_, pair_pose_.pan_rad, pair_pose_.first_tilt_rad,
-                               floor_obstacles_, floor_free_, &floor_free_near_, blocked_output());
-      return !(view_pair_ && pair_pose_.second_tilt_rad < -0.3F);
-    default:
-      (void)floor_cue_.learn(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad);
-      (void)floor_cue_.process(second_, pair_pose_.pan_rad, pair_pose_.second_tilt_rad,
-                               floor_obstacles_, floor_free_, &floor_free_near_, blocked_output());
-      return true;
+StepResult Mission::step_think(SliceBudget& budget) {
+  double* const think_cpu = &cpu_s_[1];
+  if (think_step_ == ThinkStep::kBegin) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(think_cpu, longest(Unit::kModel));
+    begin_think();
   }
+  while (!map_.done()) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(think_cpu, longest(Unit::kModel));
+    map_.step();
+  }
+  if (!budget.next_unit()) return StepResult::kMore;
+  CpuScope cpu(think_cpu, longest(Unit::kMap));
+  after_think();
+  return StepResult::kMore;
+}
+
+StepResult Mission::step_plan(SliceBudget& budget) {
+  double* const plan_cpu = &cpu_s_[2];
+  switch (plan_step_) {
+    case PlanStep::kChoose:
+    case PlanStep::kChooseNextOnLook: {
+      // The step on the value function, one action per unit.
+      while (!planner_.choice_done()) {
+        if (!budget.next_unit()) return StepResult::kMore;
+        CpuScope cpu(plan_cpu, longest(Unit::kStep));
+        planner_.choose_heading();
+      }
+      if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(plan_cpu, longest(Unit::kStep));
+      if (plan_step_ == PlanStep::kChooseNextOnLook) {
+        finish_next_step_on_look();
+      } else {
+        after_step_choice();
+      }
+      return StepResult::kDone;
+    }
+    case PlanStep::kNextOnLook: {
+      if (!budget.next_unit()) return StepResult::kMore;
+      CpuScope cpu(plan_cpu, longest(Unit::kStep));
+      if (planner_.begin_next_on_look(pose_.pose(), look_pose_, map_.local().navigable)) {
+        plan_step_ = PlanStep::kChooseNextOnLook;
+        return StepResult::kMore;
+      }
+      end_cycle("step done");
+      if (phase_ != Phase::kDone) begin_look(now_us_);
+      return StepResult::kDone;
+    }
+    case PlanStep::kValueStart:
+    case PlanStep::kValue:
+      break;
+  }
+  if (plan_step_ == PlanStep::kValueStart) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(plan_cpu, longest(Unit::kPlanStart));
+    begin_plan();
+  }
+  while (!planner_.value_done()) {
+    if (!budget.next_unit()) return StepResult::kMore;
+    CpuScope cpu(plan_cpu, longest(Unit::kValue));
+    planner_.value_step();
+  }
+  if (!budget.next_unit()) return StepResult::kMore;
+  CpuScope cpu(plan_cpu, longest(Unit::kStep));
+  if (start_step_choice()) {
+    plan_step_ = PlanStep::kChoose;
+    return StepResult::kMore;
+  }
+  return StepResult::kDone;
+}
+
+bool Mission::process_view(ViewPart part) {
+  CpuScope cpu(&cpu_s_[0], longest(Unit::kView));
+  const GrabbedView view = scan_.view();
+  TargetFixes fixes;
+  const bool done = look_.process(part, view, fixes);
+  if (part == ViewPart::kTarget) {
+    const auto id = static_cast<std::uint32_t>(state_.cycle * 256U + view.index);
+    add_target_fix(fixes.pair, id);
+    add_target_fix(fixes.across, id);
+  }
+  return done;
 }
 
 void Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {
   if (!fix.found) return;
-  // PTU frame → robot → world (odometry); the PTU centre is on the robot's axis.
-  const core::Point2 w = core::to_world(look_pose_, {fix.point_ptu_m.x(), fix.point_ptu_m.y()});
-  const Eigen::Vector3f world(w.x_m, w.y_m, fix.point_ptu_m.z() + params_.rig.ptu_height_m);
-  tracker_.add(world, fix.confidence, view, fix.range_error_m);
+  tracker_.add(fix_in_world(look_pose_, fix, params_.rig.ptu_height_m), fix.confidence, view,
+               fix.range_error_m);
 }
 
 void Mission::begin_think() {
-  think_started_ = true;
-  (void)evidence::filter_readings(features_, params_.limits);
-  // The last look's free polygon, from where it stood as seen from here: what it saw free
-  // keeps rays whose walks this look finds blocked open that far.
-  mapping::PriorLook prior;
-  if (has_prior_look_) {
-    prior.free = &prior_look_free_;
-    prior.pose = prior_look_pose_;
-    prior.here = look_pose_;
-  }
-  builder_.start(params_.model, features_.span(), floor_obstacles_.span(), floor_free_.span(),
-                 floor_free_near_.span(), floor_blocked_.span(), prior);
+  think_step_ = ThinkStep::kModel;
+  look_.end_look(params_.limits);
+  map_.begin(params_.model, look_.readings(), look_pose_);
 }
 
 void Mission::after_think() {
-  const mapping::LocalMap& local = builder_.map();
-  last_pieces_ = static_cast<std::uint32_t>(builder_.stats().pieces);
-  if (builder_.stats().guard_dropped > 0 || builder_.stats().guard_points_full) {
+  const mapping::LocalModelBuilder& builder = map_.builder();
+  last_pieces_ = static_cast<std::uint32_t>(builder.stats().pieces);
+  if (builder.stats().guard_dropped > 0 || builder.stats().guard_points_full) {
     ++guard_truncated_looks_;
   }
-  // Map points (§5.4.4): obstacles where evidence backs the polygon's boundary; exploration
-  // points on the bounding circle and where only the lack of seen floor cuts it.
-  cycle_obstacles_.clear();
-  cycle_exploration_.clear();
-  const float radius = params_.model.extraction.bounding_radius_m;
-  (void)builder_.map_points(params_.points, cycle_obstacles_, cycle_exploration_);
-  // Known exploration points this look saw are explored; then this look's points go in.
-  (void)map_.mark_explored(look_pose_, builder_.seen_free(), radius, params_.points);
-  (void)map_.merge(look_pose_, local.free, radius, cycle_obstacles_, cycle_exploration_,
-                   params_.points);
-  prior_look_free_ = local.free;
-  prior_look_pose_ = look_pose_;
-  has_prior_look_ = true;
-  // A sighting no second view has confirmed yet: look at it again from the stand-off (the
-  // detector may miss it near the image's edge), unless the robot already looked from there.
-  if (!tracker_.confirmed() && tracker_.sightings() > 0) {
-    const Eigen::Vector3f& c = tracker_.candidate_m();
-    const float dx = look_pose_.x_m - c.x();
-    const float dy = look_pose_.y_m - c.y();
-    const float d = std::hypot(dx, dy);
-    if (d > params_.points.explored_look_radius_m + params_.rewards.goal_standoff_m) {
-      const float s = params_.rewards.goal_standoff_m / d;
-      const core::Point2 p{c.x() + s * dx, c.y() + s * dy};
-      bool known = false;
-      for (const core::Point2& q : map_.exploration()) {
-        known = known || core::distance_m(p, q) < params_.points.exploration_merge_radius_m;
-      }
-      if (!known) (void)map_.exploration().push_back(p);
-    }
-  }
-  // An exploration point the robot's disc cannot reach (it touches a known obstacle) would
-  // only draw the robot into a corner: move it clear, toward where the robot looked from.
-  (void)map_.clear_exploration({look_pose_.x_m, look_pose_.y_m}, params_.value.robot_radius_m,
-                               radius, params_.points);
+  FuseParams fuse;
+  fuse.points = params_.points;
+  fuse.robot_radius_m = params_.value.robot_radius_m;
+  fuse.goal_standoff_m = params_.rewards.goal_standoff_m;
+  const bool lone_sighting = !tracker_.confirmed() && tracker_.sightings() > 0;
+  map_.fuse(look_pose_, fuse, lone_sighting ? &tracker_.candidate_m() : nullptr);
   // The model in the text format, for the console and the state file.
-  const std::size_t n = aln::write_text(builder_.model(), g_model_text, sizeof g_model_text);
-  if (n > 0) (void)state_.set_model({g_model_text, n});
+  const std::span<char> text = model_text_.back();
+  const std::size_t n = aln::write_text(builder.model(), text.data(), text.size());
+  if (n > 0 && state_.set_model({text.data(), n})) model_text_.publish(n);
   phase_ = Phase::kPlan;
 }
 
 void Mission::begin_plan() {
-  plan_started_ = true;
-  planning::RewardSources sources;
-  sources.obstacles = map_.obstacles().span();
-  sources.exploration = map_.exploration().span();
-  sources.visited = trail_.points();
-  sources.has_goal = tracker_.confirmed();
-  if (sources.has_goal) sources.goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
-  planning::ValueIterationParams vp = params_.value;
-  vp.seed = static_cast<std::uint32_t>(state_.seed * 7919U + state_.cycle);
-  value_.start(vp, params_.rewards, sources, {look_pose_.x_m, look_pose_.y_m});
+  plan_step_ = PlanStep::kValue;
+  core::Point2 goal{};
+  if (tracker_.confirmed()) goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
+  planner_.start_value(map_.global(), tracker_.confirmed() ? &goal : nullptr,
+                       {look_pose_.x_m, look_pose_.y_m},
+                       static_cast<std::uint32_t>(state_.seed * 7919U + state_.cycle));
 }
 
 bool Mission::start_step_choice() {
-  const core::Pose2 here = odometry_pose();
-  if (map_.exploration().size() == 0 && !tracker_.confirmed()) {
-    // Turn round and look once more before giving up: the sector behind the robot is seen
-    // only by the image's edges at the PTU's pan limits (or not at all, if the pans and the
-    // field of view leave a gap), and a fresh look refits the model.
-    const bool turned_here =
-        turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
-    if (turned_here) {
+  const core::Pose2 here = pose_.pose();
+  switch (planner_.begin_choice(here, map_.local().navigable,
+                                map_.global().exploration().size() != 0, tracker_.confirmed())) {
+    case StepOutcome::kChoosing:
+      return true;
+    case StepOutcome::kNothingLeft:
       end_cycle("nothing left to explore");
       finish(Result::kNotFound, "nothing left to explore");
       return false;
-    }
-    turn_pending_ = true;
-    drive_pending_ = true;
-    phase_ = Phase::kDrive;
-    return false;
+    default:  // kTurnRound
+      drive(Move::kTurnRound);
+      return false;
   }
-  chooser_.start(value_, builder_.map().navigable, here, params_.step);
-  return true;
 }
 
 void Mission::after_step_choice() {
-  const core::Pose2 here = odometry_pose();
-  if (decision_.kind == planning::StepKind::kAtGoal) {
-    end_cycle("at the target");
-    return finish(Result::kFound, "within the stand-off of the target");
-  }
-  if (decision_.kind == planning::StepKind::kMove) {
-    // The thesis's consistency check: the whole step must lie in this look's polygon.
-    const mapping::StarPolygon& nav = builder_.map().navigable;
-    bool inside = true;
-    for (int i = 1; i <= 20 && inside; ++i) {
-      const float t = static_cast<float>(i) / 20.0F;
-      const core::Point2 p{here.x_m + t * (decision_.target.x_m - here.x_m),
-                           here.y_m + t * (decision_.target.y_m - here.y_m)};
-      inside = nav.contains(core::to_robot(look_pose_, p));
-    }
-    if (inside) {
-      failed_cycles_ = 0;
+  const core::Pose2 here = pose_.pose();
+  switch (planner_.end_choice(here, look_pose_, map_.local().navigable, breadcrumbs_)) {
+    case StepOutcome::kAtGoal:
+      end_cycle("at the target");
+      return finish(Result::kFound, "within the stand-off of the target");
+    case StepOutcome::kMove:
       steps_this_look_ = 0;
-      drive_pending_ = true;
-      phase_ = Phase::kDrive;
-      return;
-    }
-  }
-  // No safe step (an obstacle close by, or a poor fit, can leave no room in this look's
-  // polygon): the place counts as visited once more and the robot looks again; from the
-  // second such cycle in a row it first backs off along the step that brought it here. It
-  // gives up after a few such cycles in a row.
-  ++failed_cycles_;
-  trail_.add({here.x_m, here.y_m});
-  if (failed_cycles_ >= params_.back_off_after_failed_cycles &&
-      failed_cycles_ < params_.max_failed_cycles && back_off()) {
-    return;
+      return drive(Move::kStep);
+    case StepOutcome::kBackOff:
+      return drive(Move::kBackOff);
+    default:  // kNoSafeStep
+      break;
   }
   end_cycle("no safe step");
-  if (failed_cycles_ >= params_.max_failed_cycles) {
-    return finish(Result::kNotFound, "no safe step in several looks");
-  }
+  if (planner_.gave_up()) return finish(Result::kNotFound, "no safe step in several looks");
   begin_look(now_us_);
 }
 
-// The step back to the last breadcrumb: the robot's disc swept that segment on the way here, so
-// it is driven without this look's polygon (which may hold no room at all).
-bool Mission::back_off() {
-  const core::Pose2 here = odometry_pose();
-  core::Point2 back{};
-  if (!breadcrumbs_.back_target({here.x_m, here.y_m}, params_.step.min_step_m, back)) return false;
-  decision_ = {};
-  decision_.kind = planning::StepKind::kMove;
-  decision_.target = back;
-  retreating_ = true;
-  drive_pending_ = true;
-  phase_ = Phase::kDrive;
-  return true;
-}
-
-namespace {
-
-// Working storage of the pictures (static: they are large).
-core::FixedVector<SnapshotReading, kMaxLookFeatures + kMaxLookFloorObstacles> g_snap_readings;
-std::array<core::Point2, mapping::kMaxPolygonVertices> g_snap_free;
-std::array<core::Point2, mapping::kMaxPolygonVertices> g_snap_navigable;
-std::array<core::Point2, 2048> g_snap_outline_points;
-std::array<std::span<const core::Point2>, 256> g_snap_outlines;
-std::array<SnapshotCircle, 256> g_snap_circles;
-
-struct OccupancyView {
-  const mapping::LocalModelBuilder* builder;
-  core::Pose2 pose;
-};
-OccupancyView g_snap_occupancy{};  // the picture's occupancy field, read until it is done
-
-// The occupancy model sliced at the robot's heights: the highest occupancy over the slices.
-float occupancy_at(const void* context, float x_m, float y_m) {
-  const auto& v = *static_cast<const OccupancyView*>(context);
-  const core::Point2 q = core::to_robot(v.pose, {x_m, y_m});
-  const float rho = std::hypot(q.x_m, q.y_m);
-  const float alpha = core::wrap_two_pi(std::atan2(q.y_m, q.x_m));
-  const mapping::ExtractionParams& p = v.builder->params().extraction;
-  float m = 0.0F;
-  for (std::size_t i = 0; i < p.height_count; ++i) {
-    const float h = mapping::slice_height_m(p, i);
-    m = std::max(m, v.builder->occupancy(alpha, h, std::sqrt(rho * rho + h * h)));
-  }
-  return std::clamp(m, 0.0F, 1.0F);
-}
-
-float value_at(const void* context, float x_m, float y_m) {
-  return static_cast<const planning::ValueIteration*>(context)->value({x_m, y_m});
-}
-
-void to_world(const mapping::StarPolygon& poly, const core::Pose2& pose,
-              std::array<core::Point2, mapping::kMaxPolygonVertices>& out) {
-  for (std::size_t k = 0; k < poly.vertex_count(); ++k)
-    out[k] = core::to_world(pose, poly.vertex(k));
-}
-
-}  // namespace
-
-void Mission::begin_snapshot() {
-  if (snapshots_ == nullptr) return;
-  g_snap_readings.clear();
-  auto add = [&](const evidence::Reading& r) {
-    const core::Point2 w = core::to_world(snapshot_look_pose_, evidence::floor_point_m(r));
-    (void)g_snap_readings.push_back({w.x_m, w.y_m, r.m});
-  };
-  for (const evidence::Reading& r : features_) add(r);
-  for (const evidence::Reading& r : floor_obstacles_) add(r);
-  const mapping::LocalMap& local = builder_.map();
-  to_world(local.free, snapshot_look_pose_, g_snap_free);
-  to_world(local.navigable, snapshot_look_pose_, g_snap_navigable);
-  SnapshotFrame f;
-  // The cycle's count and pose stand until the next cycle ends, after this picture.
-  f.cycle = static_cast<std::uint32_t>(state_.cycle);
-  f.state = snapshot_state_;
-  f.robot = state_.pose;
-  f.robot_radius_m = config_.robot_radius_m;
-  // The view: the room so far (path, points) and 3.5 m around the robot.
-  float x0 = f.robot.x_m - 3.5F, x1 = f.robot.x_m + 3.5F;
-  float y0 = f.robot.y_m - 3.5F, y1 = f.robot.y_m + 3.5F;
-  for (const core::Point2& p : path_) {
-    x0 = std::min(x0, p.x_m - 1.0F);
-    x1 = std::max(x1, p.x_m + 1.0F);
-    y0 = std::min(y0, p.y_m - 1.0F);
-    y1 = std::max(y1, p.y_m + 1.0F);
-  }
-  f.view = {x0, y0, x1, y1};
-  f.readings = g_snap_readings.span();
-  g_snap_occupancy = {&builder_, snapshot_look_pose_};
-  f.occupancy = &occupancy_at;
-  f.occupancy_context = &g_snap_occupancy;
-  f.occupancy_threshold = params_.model.extraction.safe_occupancy;
-  f.free_polygon = {g_snap_free.data(), local.free.vertex_count()};
-  f.navigable_polygon = {g_snap_navigable.data(), local.navigable.vertex_count()};
-  f.obstacle_points = map_.obstacles().span();
-  f.exploration_points = map_.exploration().span();
-  if (tracker_.confirmed())
-    f.goal = core::Point2{tracker_.estimate_m().x(), tracker_.estimate_m().y()};
-  f.path = path_.span();
-  f.value = &value_at;
-  f.value_context = &value_;
-  if (decision_.kind == planning::StepKind::kMove) f.step_end = decision_.target;
-  if (truth_ != nullptr) {
-    // The truth is in the world frame; the pictures are in the mission frame.
-    const core::Pose2 origin = frame_origin_in_world();
-    std::size_t used = 0;
-    std::size_t count = 0;
-    for (const std::span<const core::Point2> outline : truth_->outlines()) {
-      if (count == g_snap_outlines.size() || used + outline.size() > g_snap_outline_points.size()) {
-        break;
-      }
-      for (std::size_t i = 0; i < outline.size(); ++i) {
-        g_snap_outline_points[used + i] = core::to_robot(origin, outline[i]);
-      }
-      g_snap_outlines[count++] = {g_snap_outline_points.data() + used, outline.size()};
-      used += outline.size();
-    }
-    std::size_t circles = 0;
-    for (const SnapshotCircle& c : truth_->circles()) {
-      if (circles == g_snap_circles.size()) break;
-      g_snap_circles[circles++] = {core::to_robot(origin, c.centre), c.radius_m};
-    }
-    f.truth_polygons = {g_snap_outlines.data(), count};
-    f.truth_circles = {g_snap_circles.data(), circles};
-  }
-  snapshots_->begin(f);
+void Mission::finish_next_step_on_look() {
+  if (planner_.end_next_on_look() == StepOutcome::kMove) return drive(Move::kStep);
+  end_cycle("step done");
+  if (phase_ != Phase::kDone) begin_look(now_us_);
 }
 
 // One unit of the cycle's picture: set it up (the first), then a panel or a band of rows.
 void Mission::snapshot_step() {
-  if (snapshot_pending_) {
-    begin_snapshot();
-    snapshot_pending_ = false;
-    snapshot_writing_ = true;
+  if (snapshot_step_ == SnapshotStep::kPending) {
+    SnapshotInputs in;
+    in.cycle = static_cast<std::uint32_t>(state_.cycle);
+    in.state = snapshot_state_;
+    in.robot = state_.pose;
+    in.robot_radius_m = config_.robot_radius_m;
+    in.look_pose = snapshot_look_pose_;
+    in.readings = &look_.readings();
+    in.builder = &map_.builder();
+    in.map = &map_.global();
+    core::Point2 goal{};
+    if (tracker_.confirmed()) {
+      goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
+      in.goal = &goal;
+    }
+    in.path = path_.span();
+    in.value = &planner_.value();
+    in.decision = &planner_.decision();
+    in.truth = truth_;
+    if (truth_ != nullptr)
+      in.frame_origin_in_world = pose_.frame_origin_in_world(truth_->odometry_origin());
+    begin_snapshot(in, *snapshots_);
+    snapshot_step_ = SnapshotStep::kWriting;
     return;
   }
   if (!snapshots_->step()) return;
-  snapshot_writing_ = false;
+  snapshot_step_ = SnapshotStep::kIdle;
   if (!snapshots_->ok()) {
     TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
     line.appendf("snapshot: %s", snapshots_->error());
@@ -1017,11 +689,11 @@ void Mission::snapshot_step() {
 }
 
 void Mission::finish_saving() {
-  while (snapshot_pending_ || snapshot_writing_) snapshot_step();  // the last cycle's picture
+  while (snapshot_step_ != SnapshotStep::kIdle) snapshot_step();  // the last cycle's picture
   if (saver_ == nullptr) return;
   // Where the base came to rest, not where the last cycle ended: it may still have rolled a
   // few millimetres after its step was done, or been stopped mid-drive.
-  state_.pose = odometry_pose();
+  state_.pose = pose_.pose();
   submit_pending_ = true;
   while (submit_pending_) submit_pending_ = !saver_->submit(state_);
   saver_->flush();

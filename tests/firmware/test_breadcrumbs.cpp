@@ -1,5 +1,5 @@
 // Tests of Breadcrumbs: the way back along the robot's own steps.
-#include "firmware/mission/breadcrumbs.h"
+#include "firmware/mission/drive/breadcrumbs.h"
 
 #include "CppUTest/TestHarness.h"
 

@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "board_config.h"  // boards/rpi4: its device keys
-#include "firmware/atomic_file.h"
-#include "firmware/board.h"
-#include "firmware/config_file.h"
-#include "firmware/parameters.h"
-#include "firmware/persistence.h"
-#include "firmware/state_saver.h"
+#include "firmware/state/atomic_file.h"
+#include "firmware/app/board.h"
+#include "firmware/app/config_file.h"
+#include "firmware/common/parameters.h"
+#include "firmware/state/persistence.h"
+#include "firmware/state/state_saver.h"
 
 #include "test_files.h"
 #include "CppUTest/TestHarness.h"

@@ -12,12 +12,13 @@
 
 #include "fake_clock.h"
 #include "fake_serial_port.h"
-#include "firmware/console.h"
-#include "firmware/console_line.h"
-#include "firmware/console_parser.h"
-#include "firmware/executive.h"
-#include "firmware/persistence.h"
-#include "firmware/state_saver.h"
+#include "firmware/console/console.h"
+#include "firmware/console/console_line.h"
+#include "firmware/console/console_parser.h"
+#include "firmware/executive/executive.h"
+#include "firmware/state/persistence.h"
+#include "firmware/state/state_saver.h"
+#include "firmware/telemetry/model_text.h"
 #include "firmware_fakes.h"
 
 #include "alloc_guard.h"
@@ -38,7 +39,16 @@ class FakeView final : public MissionView {
   std::uint32_t features() const override { return 321; }
   std::uint32_t pieces() const override { return 17; }
   std::uint64_t cycles() const override { return 4; }
-  std::string_view model_text() const override { return model; }
+  // The text from `source` when set (the mission's double buffer), else `model`; `held` says
+  // whether the console holds it.
+  std::string_view model_text() override {
+    held = true;
+    return source != nullptr ? source->hold() : std::string_view(model);
+  }
+  void release_model_text() override {
+    held = false;
+    if (source != nullptr) source->release();
+  }
   MapCounts map_counts() const override { return {12, 34, 5}; }
   TargetEstimate target() const override { return target_value; }
   std::uint64_t mission_log_begin() const override { return log_dropped; }
@@ -58,6 +68,8 @@ class FakeView final : public MissionView {
   boticelli::core::Pose2 pose_value{1.25F, -0.5F, 0.75F};
   TargetEstimate target_value{};
   std::string model;
+  ModelText* source = nullptr;
+  bool held = false;
 };
 
 class IdleTask final : public Task {
@@ -331,6 +343,47 @@ TEST(Console, SaysThereIsNoModelUntilTheMissionHasOne) {
   const auto reply = command("model");
   CHECK_EQUAL(1U, reply.size());
   STRCMP_EQUAL("ERR no model yet", reply[0].c_str());
+  CHECK_FALSE(view.held);  // nothing to send: nothing kept from the mission
+}
+
+namespace {
+ModelText g_texts;  // two 64 KB buffers: static
+std::string model_of(const char* form) {
+  std::string text = "VARIABLES 3\r\n";
+  while (text.size() < 3 * Console::kTxBytes) text += form;
+  return text;
+}
+void publish(ModelText& texts, const std::string& text) {
+  std::copy(text.begin(), text.end(), texts.back().begin());
+  texts.publish(text.size());
+}
+}  // namespace
+
+TEST(Console, AModelFittedWhileTheReplyStreamsNeitherTearsItNorIsLost) {
+  const std::string first = model_of("LINEARFORM 0.125 -0.5 1.0 0.25\r\n");
+  const std::string second = model_of("LINEARFORM 9.875 -7.5 3.0 0.75\r\n");
+  g_texts.clear();
+  publish(g_texts, first);
+  view.source = &g_texts;
+  port.set_write_limit(0);  // the line is busy: the reply waits in the output ring
+  port.clear_written();
+  port.feed("model\r");
+  service(5);
+  CHECK(view.held);  // still streaming ...
+  // ... while two cycles end, each with a new model (the second written where the first went)
+  publish(g_texts, model_of("LINEARFORM 5.5 -2.25 1.0 0.5\r\n"));
+  publish(g_texts, second);
+  port.set_write_limit(100);
+  service(600);
+  CHECK_FALSE(view.held);
+  std::string out = port.written();
+  CHECK(out.rfind(first, 0) == 0);  // the old text whole, not the new one's tail
+  CHECK_EQUAL(first.size() + 4, out.size());
+  port.clear_written();
+  port.feed("model\r");
+  service(600);
+  out = port.written();
+  CHECK(out.rfind(second, 0) == 0);  // and the new one for the next `model`
 }
 
 TEST(Console, StreamsAModelLargerThanItsOutputBufferThroughASlowLine) {

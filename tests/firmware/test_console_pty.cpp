@@ -10,8 +10,8 @@
 #include <string>
 
 #include "fake_clock.h"
-#include "firmware/console.h"
-#include "firmware/executive.h"
+#include "firmware/console/console.h"
+#include "firmware/executive/executive.h"
 #include "firmware_fakes.h"
 #include "hal/linux/serial_termios.h"
 

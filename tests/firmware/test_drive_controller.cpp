@@ -6,7 +6,7 @@
 
 #include "algo/core/angles.h"
 #include "algo/core/geometry.h"
-#include "firmware/mission/drive_controller.h"
+#include "firmware/mission/drive/drive_controller.h"
 
 #include "CppUTest/TestHarness.h"
 

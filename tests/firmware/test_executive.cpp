@@ -4,11 +4,11 @@
 #include <vector>
 
 #include "fake_clock.h"
-#include "firmware/device_tasks.h"
-#include "firmware/executive.h"
-#include "firmware/mission_view.h"
-#include "firmware/safety.h"
-#include "firmware/task_table.h"
+#include "firmware/app/device_tasks.h"
+#include "firmware/executive/executive.h"
+#include "firmware/telemetry/mission_view.h"
+#include "firmware/safety/safety.h"
+#include "firmware/executive/task_table.h"
 #include "firmware_fakes.h"
 
 #include "alloc_guard.h"

@@ -13,8 +13,8 @@
 
 #include "fake_clock.h"
 #include "fake_serial_port.h"
-#include "firmware/firmware_main.h"
-#include "firmware/persistence.h"
+#include "firmware/app/firmware_main.h"
+#include "firmware/state/persistence.h"
 #include "firmware_fakes.h"
 
 #include "CppUTest/TestHarness.h"

@@ -1,5 +1,5 @@
 // Tests of the mission's parameters from the board: the look's rows and its scan views.
-#include "firmware/mission/mission_params.h"
+#include "firmware/mission/params/mission_params.h"
 
 #include "CppUTest/TestHarness.h"
 

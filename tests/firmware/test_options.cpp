@@ -1,7 +1,7 @@
 // Tests of the firmware's command-line parsing.
 #include <cstring>
 
-#include "firmware/options.h"
+#include "firmware/app/options.h"
 #include "CppUTest/TestHarness.h"
 
 using namespace boticelli::firmware;

@@ -15,9 +15,9 @@
 #include <string>
 #include <string_view>
 
-#include "firmware/mission_state.h"
-#include "firmware/persistence.h"
-#include "firmware/state_saver.h"
+#include "firmware/state/mission_state.h"
+#include "firmware/state/persistence.h"
+#include "firmware/state/state_saver.h"
 
 #include "test_files.h"
 #include "CppUTest/TestHarness.h"

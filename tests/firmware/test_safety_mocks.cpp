@@ -1,6 +1,6 @@
 // Tests of the e-stop latch (firmware::Safety) against CppUMock mocks of its inputs and base:
 // which calls it makes on the HAL each poll, not only the state it ends in.
-#include "firmware/safety.h"
+#include "firmware/safety/safety.h"
 #include "hal_mocks.h"
 
 #include "CppUTest/TestHarness.h"

@@ -12,8 +12,8 @@
 #include <cstring>
 #include <string>
 
-#include "firmware/log.h"
-#include "firmware/service_notify.h"
+#include "firmware/common/log.h"
+#include "firmware/app/service_notify.h"
 
 #include "CppUTest/TestHarness.h"
 

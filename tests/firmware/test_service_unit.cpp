@@ -5,7 +5,7 @@
 #include <string>
 
 #include "board_config.h"  // boards/rpi4: the hardware watchdog's timeout
-#include "firmware/firmware_main.h"
+#include "firmware/app/firmware_main.h"
 
 #include "CppUTest/TestHarness.h"
 

@@ -15,7 +15,7 @@
 
 #include <png.h>
 
-#include "firmware/snapshot.h"
+#include "firmware/telemetry/snapshot.h"
 
 #include "alloc_guard.h"
 #include "CppUTest/TestHarness.h"

@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "firmware/mission/target_tracker.h"
+#include "firmware/mission/target/target_tracker.h"
 
 #include "CppUTest/TestHarness.h"
 

@@ -8,9 +8,9 @@
 #include <string_view>
 
 #include "board_config.h"  // boards/rpi4: the device keys
-#include "firmware/board.h"
-#include "firmware/config_file.h"
-#include "firmware/parameters.h"
+#include "firmware/app/board.h"
+#include "firmware/app/config_file.h"
+#include "firmware/common/parameters.h"
 
 namespace fw = boticelli::firmware;
 

@@ -9,10 +9,10 @@
 
 #include "fake_clock.h"
 #include "fake_serial_port.h"
-#include "firmware/console.h"
-#include "firmware/executive.h"
-#include "firmware/parameters.h"
-#include "firmware/safety.h"
+#include "firmware/console/console.h"
+#include "firmware/executive/executive.h"
+#include "firmware/common/parameters.h"
+#include "firmware/safety/safety.h"
 #include "firmware_fakes.h"
 
 namespace fw = boticelli::firmware;
@@ -25,7 +25,7 @@ class FuzzView final : public fw::MissionView {
   boticelli::core::Pose2 pose() const override { return {1.25F, -0.5F, 0.75F}; }
   float pan_rad() const override { return 0.5F; }
   std::uint32_t pieces() const override { return 17; }
-  std::string_view model_text() const override {
+  std::string_view model_text() override {
     return "VARIABLES 3\nOUTPUT 3\nLINEARFORMS 1\n0 0 0.01 0\nBLOCKS\n";
   }
 };

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <initializer_list>
 
-#include "firmware/options.h"
+#include "firmware/app/options.h"
 
 namespace {
 char g_bytes[4096 + 1];

@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "firmware/mission_state.h"
-#include "firmware/persistence.h"
+#include "firmware/state/mission_state.h"
+#include "firmware/state/persistence.h"
 
 namespace fw = boticelli::firmware;
 

@@ -27,7 +27,7 @@ namespace evidence = boticelli::evidence;
 
 namespace {
 
-// The board's choices (firmware/board.h, firmware/mission/mission_params.cpp).
+// The board's choices (firmware/board.h, firmware/mission/params/mission_params.cpp).
 constexpr float kPtuHeight_m = 0.6F;
 constexpr float kRobotRadius_m = 0.25F;
 constexpr float kRobotHeight_m = 0.8F;

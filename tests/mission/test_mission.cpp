@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "algo/core/geometry.h"
-#include "firmware/executive.h"
-#include "firmware/firmware_main.h"
+#include "firmware/executive/executive.h"
+#include "firmware/app/firmware_main.h"
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
 #include "sim_board.h"

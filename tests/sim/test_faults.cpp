@@ -10,7 +10,7 @@
 #include <string>
 
 #include "fault_scenario.h"
-#include "firmware/text_buffer.h"
+#include "firmware/common/text_buffer.h"
 #include "hal/sim/fault_plan.h"
 #include "sim_board.h"
 #include "sim_test_worlds.h"

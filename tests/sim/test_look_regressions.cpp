@@ -9,7 +9,7 @@
 #include "algo/mapping/extraction.h"
 #include "algo/mapping/local_model_builder.h"
 #include "board_config.h"
-#include "firmware/mission/mission_params.h"
+#include "firmware/mission/params/mission_params.h"
 
 #include "CppUTest/TestHarness.h"
 

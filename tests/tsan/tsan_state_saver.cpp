@@ -13,9 +13,9 @@
 #include <memory>
 #include <string>
 
-#include "firmware/mission_state.h"
-#include "firmware/persistence.h"
-#include "firmware/state_saver.h"
+#include "firmware/state/mission_state.h"
+#include "firmware/state/persistence.h"
+#include "firmware/state/state_saver.h"
 
 namespace fw = boticelli::firmware;
 

@@ -16,8 +16,8 @@
 #include "bench_process.h"
 #include "bench_worlds.h"
 #include "fault_scenario.h"
-#include "firmware/mission_state.h"
-#include "firmware/persistence.h"
+#include "firmware/state/mission_state.h"
+#include "firmware/state/persistence.h"
 #include "hal/sim/fault_plan.h"
 #include "sim_board.h"
 

@@ -25,8 +25,8 @@
 #include "bench_process.h"
 #include "bench_worlds.h"
 #include "board_config.h"
-#include "firmware/mission_state.h"
-#include "firmware/persistence.h"
+#include "firmware/state/mission_state.h"
+#include "firmware/state/persistence.h"
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
 

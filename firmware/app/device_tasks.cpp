@@ -1,0 +1,145 @@
+// Device tasks: camera polling, the watchdog kick, status LED and service status (see
+// device_tasks.h).
+#include "firmware/app/device_tasks.h"
+
+namespace boticelli::firmware {
+
+void CameraTask::run(std::uint64_t now_us) {
+  if (!seen_time_) {
+    seen_time_ = true;
+    last_frame_us_ = now_us;
+    last_poll_us_ = now_us - idle_poll_us_;
+  }
+  // Nobody wants a frame: poll seldom (a stalled camera is still noticed).
+  if (consumer_ != nullptr && !consumer_->wants_frames() &&
+      now_us - last_poll_us_ < idle_poll_us_) {
+    return;
+  }
+  last_poll_us_ = now_us;
+  hal::Frame frame;
+  switch (camera_.poll(frame)) {
+    case hal::CameraPoll::kFrame:
+      if (frame.width_px != camera_.width_px() || frame.height_px != camera_.height_px()) {
+        // Not the negotiated format: unusable, like no frame at all.
+        ++wrong_frames_;
+        camera_.release();
+        last_bad_ = "frames of the wrong size";
+        if (now_us - last_frame_us_ > stall_us_) mark_stalled(last_bad_);
+        break;
+      }
+      if (have_sequence_ && frame.sequence == last_sequence_) {
+        // The same buffer again (a frozen driver): not a new image, so not used, and it
+        // does not keep the camera healthy.
+        ++stale_frames_;
+        camera_.release();
+        last_bad_ = "the same frame again";
+        if (now_us - last_frame_us_ > stall_us_) mark_stalled(last_bad_);
+        break;
+      }
+      have_sequence_ = true;
+      last_sequence_ = frame.sequence;
+      last_bad_ = nullptr;
+      ++frames_;
+      last_frame_us_ = now_us;
+      healthy_ = true;
+      if (consumer_ != nullptr) consumer_->on_frame(frame);
+      camera_.release();
+      break;
+    case hal::CameraPoll::kFault:
+      ++faults_;
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled(nullptr);
+      break;
+    case hal::CameraPoll::kNoFrame:
+      if (now_us - last_frame_us_ > stall_us_) mark_stalled(nullptr);
+      break;
+  }
+}
+
+void CameraTask::mark_stalled(const char* what) {
+  healthy_ = false;
+  // The first words stay put while the stall lasts (the console logs a reason when it
+  // changes), so the time is the stall limit, not the growing age of the last frame.
+  reason_.clear();
+  reason_.appendf("no new frame for %.1f s", static_cast<double>(stall_us_) * 1e-6);
+  // The driver's own error, else what was wrong with the last frames it did deliver.
+  const char* why = what != nullptr ? what : camera_.error();
+  if (why[0] == '\0' && last_bad_ != nullptr) why = last_bad_;
+  if (why[0] != '\0') reason_.appendf(": %s", why);
+}
+
+void PanTiltTask::run(std::uint64_t now_us) {
+  ptu_.update();
+  const hal::PanTiltState s = ptu_.state();
+  if (!s.moving || s.pan_rad != last_pan_rad_ || s.tilt_rad != last_tilt_rad_ || !seen_) {
+    seen_ = true;
+    last_pan_rad_ = s.pan_rad;
+    last_tilt_rad_ = s.tilt_rad;
+    progress_us_ = now_us;
+    stuck_ = false;
+    return;
+  }
+  stuck_ = now_us - progress_us_ > stuck_us_;
+}
+
+bool PanTiltTask::healthy() const {
+  return !stuck_ && !ptu_.state().fault;
+}
+
+const char* PanTiltTask::health_reason() const {
+  if (stuck_) return "PTU: a move is not progressing";
+  const char* why = ptu_.error();
+  return why[0] != '\0' ? why : "unit fault";
+}
+
+const char* led_pattern_name(LedPattern pattern) {
+  switch (pattern) {
+    case LedPattern::kFault:
+      return "fault";
+    case LedPattern::kEstop:
+      return "estop";
+    case LedPattern::kTargetFound:
+      return "target";
+    case LedPattern::kOk:
+      return "ok";
+  }
+  return "?";
+}
+
+void WatchdogTask::run(std::uint64_t) {
+  const bool healthy = executive_.all_healthy();
+  if (healthy) {
+    watchdog_.kick();
+    notifier_.watchdog();
+    ++kicks_;
+  } else {
+    ++withheld_;
+  }
+  if (!healthy) {
+    pattern_ = LedPattern::kFault;
+  } else if (safety_ != nullptr && safety_->engaged()) {
+    pattern_ = LedPattern::kEstop;
+  } else if (view_ != nullptr && view_->target().status == TargetStatus::kConfirmed) {
+    pattern_ = LedPattern::kTargetFound;
+  } else {
+    pattern_ = LedPattern::kOk;
+  }
+  led_.write(((static_cast<std::uint32_t>(led_pattern_bits(pattern_)) >> step_) & 1U) != 0U);
+  if (step_ == 0) report_status(healthy);
+  step_ = (step_ + 1) % kStepsPerSecond;
+}
+
+void WatchdogTask::report_status(bool healthy) {
+  TextBuffer<160> text;
+  text.appendf("STATUS=state=%s cycle=%llu healthy=%d estop=%s target=%s",
+               view_ != nullptr ? view_->state_name() : "running",
+               static_cast<unsigned long long>(view_ != nullptr ? view_->cycles() : 0U),
+               healthy ? 1 : 0,
+               stop_cause_name(safety_ != nullptr ? safety_->cause() : StopCause::kNone),
+               target_status_name(view_ != nullptr ? view_->target().status : TargetStatus::kNone));
+  if (text.view() == status_.view()) return;
+  if (!notifier_.send(text.c_str())) return;  // tried again next second
+  status_.clear();
+  status_.append(text.view());
+}
+
+}  // namespace boticelli::firmware

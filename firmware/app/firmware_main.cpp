@@ -1,0 +1,399 @@
+// Firmware entry: options, board init, executive with the device tasks and the console, MISSION
+// line.
+#include "firmware/app/firmware_main.h"
+
+#include <csignal>
+#include <optional>
+#include <cstdio>
+#include <ctime>
+
+#include "firmware/app/config_file.h"
+#include "firmware/console/console.h"
+#include "firmware/app/device_tasks.h"
+#include "firmware/executive/executive.h"
+#include "firmware/common/log.h"
+#include "firmware/mission/mission.h"
+#include "firmware/telemetry/trace_writer.h"
+#include "firmware/state/mission_state.h"
+#include "firmware/app/options.h"
+#include "firmware/common/parameters.h"
+#include "firmware/state/persistence.h"
+#include "firmware/executive/realtime.h"
+#include "firmware/safety/safety.h"
+#include "firmware/app/service_notify.h"
+#include "firmware/telemetry/snapshot.h"
+#include "firmware/state/state_saver.h"
+#include "firmware/executive/task_table.h"
+#include "firmware/common/text_buffer.h"
+
+namespace boticelli::firmware {
+namespace {
+
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_signal(int signal) {
+  g_signal = signal;
+}
+
+const char* signal_name(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal";
+  }
+}
+
+double wall_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+// Static storage: nothing on the cyclic path allocates, and the large buffers (state, file
+// image, console ring) stay off the stack.
+MissionState g_state;
+StateStore g_store;
+ParameterTable g_parameters;
+ConfigSchema g_config_keys;
+mission::TraceWriter g_trace;
+SnapshotWriter g_snapshots;
+LogRing g_log_ring;
+
+// Everything that is bound to the board's devices, rebuilt in place for each run (static
+// storage, no heap; firmware_main may be called again, e.g. by tests).
+struct Runtime {
+  Runtime(hal::Hal& hal, const BoardConfig& config, StateStore* store, const TruthSource* truth,
+          mission::TraceWriter* trace, SnapshotWriter* snapshots)
+      : saver(g_store),
+        executive(hal.clock),
+        safety(hal.estop, hal.bumper, hal.base),
+        mission({hal, config, safety, executive, g_state, store != nullptr ? &saver : nullptr,
+                 truth, trace, snapshots}),
+        console(hal.console, executive, safety, mission, g_parameters),
+        estop_task(safety),
+        base_task(hal.base, safety),
+        ptu_task(hal.pan_tilt),
+        camera_task(hal.camera),
+        mission_task(mission),
+        console_task(console),
+        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {
+    camera_task.set_consumer(&mission);
+    watchdog_task.set_status_sources(&safety, &mission);
+  }
+
+  ServiceNotifier notifier;
+  StateSaver saver;
+  Executive executive;
+  Safety safety;
+  mission::Mission mission;
+  Console console;
+  EstopTask estop_task;
+  BaseTask base_task;
+  PanTiltTask ptu_task;
+  CameraTask camera_task;
+  mission::MissionTask mission_task;
+  ConsoleTask console_task;
+  WatchdogTask watchdog_task;
+};
+std::optional<Runtime> g_runtime;
+
+int fail(const char* what, const char* why) {
+  service_log().log(LogLevel::kError, "%s%s%s", what, why[0] != '\0' ? ": " : "", why);
+  return 1;
+}
+
+void warn_line(const char* message, void* /*context*/) {
+  service_log().log(LogLevel::kWarn, "%s", message);
+}
+
+// The configuration file: --config FILE (must exist) or the board's default path (may be
+// missing: the compiled-in defaults). False after logging the error.
+bool apply_config(const Options& options, Board& board, char* error, std::size_t error_size) {
+  ServiceLog& slog = service_log();
+  g_config_keys.clear();
+  if (!board.reset_config(g_config_keys)) {
+    slog.log(LogLevel::kError, "configuration: key table full");
+    return false;
+  }
+  const char* path =
+      options.config_file != nullptr ? options.config_file : board.default_config_path();
+  if (path == nullptr) return true;
+  const ConfigLoad loaded = load_config_file(path, g_config_keys, error, error_size);
+  if (loaded == ConfigLoad::kLoaded) {
+    slog.log(LogLevel::kInfo, "configuration from %s", path);
+    return true;
+  }
+  if (loaded == ConfigLoad::kMissing && options.config_file == nullptr) {
+    slog.log(LogLevel::kInfo, "no %s: compiled-in defaults", path);
+    return true;
+  }
+  slog.log(LogLevel::kError, "configuration: %s", error);
+  return false;
+}
+
+}  // namespace
+
+int firmware_main(int argc, const char* const* argv, Board& board, const MainHooks* hooks) {
+  const double wall_start_s = wall_seconds();
+  const BoardInfo& info = board.info();
+  Options options;
+  ServiceLog& slog = service_log();
+  slog.open();
+  g_log_ring.clear();
+  slog.attach(&g_log_ring, nullptr);
+  const ParseResult parsed = parse_options(argc, argv, info.simulated, options);
+  if (!parsed.ok) {
+    slog.log(LogLevel::kError, "%s", parsed.error);
+    std::fputs(usage_text(), stderr);
+    return 2;
+  }
+  if (options.show_help) {
+    std::fputs(usage_text(), stdout);
+    return 0;
+  }
+  std::printf("boticelli %s board=%s (%s)\n", BOTICELLI_VERSION, info.name, info.description);
+  std::fflush(stdout);
+  if (options.show_version) return 0;
+
+  char error[384] = "";
+  // A bad configuration is a usage error (2): the service is not restarted on it.
+  if (!apply_config(options, board, error, sizeof error)) return 2;
+  if (!board.init(options, error, sizeof error)) return fail(error, "");
+  const BoardConfig& config = board.config();
+  hal::Hal& hal = board.hal();
+  slog.attach(&g_log_ring, &hal.clock);
+
+  // Mission state: fresh, or resumed from --state DIR.
+  StateStore* store = nullptr;
+  if (options.state_dir != nullptr) {
+    if (!g_store.open(options.state_dir, error, sizeof error)) return fail(error, "");
+    store = &g_store;
+  }
+  g_state.clear();
+  g_state.seed = options.seed;
+  if (options.resume) {
+    // Nothing saved yet (first start of a service that always passes --resume): a new
+    // mission. A file that is there but corrupt is never loaded and stops the start.
+    const LoadResult loaded = g_store.load(g_state, error, sizeof error);
+    if (loaded == LoadResult::kMissing) {
+      g_state.clear();
+      g_state.seed = options.seed;
+      slog.log(LogLevel::kInfo, "%s: starting a new mission", error);
+    } else if (loaded != LoadResult::kLoaded) {
+      // Restarting cannot mend the file: the usage code, which the service unit does not
+      // restart on (RestartPreventExitStatus), so an operator looks at it.
+      (void)fail("cannot resume", error);
+      return kExitUsage;
+    } else {
+      if (!board.place_robot(g_state.pose, error, sizeof error))
+        return fail("cannot resume", error);
+      slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.path(),
+               static_cast<unsigned long long>(g_state.cycle));
+    }
+  } else if (store != nullptr) {
+    // A new mission never overwrites a saved one: it is kept as mission.state.1 (older ones
+    // shift up), so a start without --resume by mistake loses nothing.
+    char kept[520] = "";
+    const LoadResult kept_result = g_store.keep_previous(kept, sizeof kept, error, sizeof error);
+    if (kept_result == LoadResult::kIoError) return fail("state", error);
+    if (kept_result == LoadResult::kLoaded) {
+      slog.log(LogLevel::kWarn, "new mission: the saved one is kept as %s (--resume continues it)",
+               kept);
+    }
+  }
+
+  // Devices.
+  if (!hal.console.open()) return fail("console", hal.console.error());
+  if (!hal.base.init()) return fail("base", hal.base.error());
+  if (!hal.pan_tilt.init()) return fail("pan-tilt unit", hal.pan_tilt.error());
+  if (!hal.camera.init()) return fail("camera", hal.camera.error());
+  bool watchdog_armed = false;
+  if (config.watchdog_timeout_ms != 0) {
+    watchdog_armed = hal.watchdog.start(config.watchdog_timeout_ms);
+    if (!watchdog_armed) {
+      slog.log(LogLevel::kWarn, "watchdog not armed (%s)", hal.watchdog.error());
+    }
+  }
+  if (options.trace_file != nullptr && !g_trace.open(options.trace_file, error, sizeof error)) {
+    return fail(error, "");
+  }
+  if (options.snapshots_dir != nullptr &&
+      !g_snapshots.open(options.snapshots_dir, error, sizeof error)) {
+    return fail(error, "");
+  }
+  g_parameters = ParameterTable{};
+  g_runtime.emplace(hal, config, store, board.truth(),
+                    options.trace_file != nullptr ? &g_trace : nullptr,
+                    options.snapshots_dir != nullptr ? &g_snapshots : nullptr);
+  Runtime& rt = *g_runtime;
+  // On a real-time board the state is written by a thread of its own (fsync can take tens
+  // of milliseconds on an SD card); on the simulation it is written in the background slot.
+  if (store != nullptr && config.realtime) rt.saver.start();
+  ServiceNotifier& notifier = rt.notifier;
+  if (!notifier.open()) slog.log(LogLevel::kWarn, "%s", notifier.error());
+  Executive& executive = rt.executive;
+  Safety& safety = rt.safety;
+  mission::Mission& mission = rt.mission;
+  Console& console = rt.console;
+  console.set_log_ring(&g_log_ring, &hal.clock);
+  console.set_board_name(info.name);
+  console.set_fault_injection(board.fault_injection());
+
+  // The executive and its tasks.
+  Task* const tasks[kTaskCount] = {&rt.estop_task,   &rt.base_task,    &rt.ptu_task,
+                                   &rt.camera_task,  &rt.mission_task, &rt.console_task,
+                                   &rt.watchdog_task};
+  const char* why = "";
+  for (std::size_t i = 0; i < kTaskCount; ++i) {
+    if (!executive.add_task(kTaskTable[i], *tasks[i], &why)) return fail("executive", why);
+  }
+  executive.set_background(&mission);
+  console.set_telemetry_ms(static_cast<float>(config.telemetry_period_ms));
+  float background_slice_us = 0.0F;
+  if (!console.register_parameters() ||
+      !g_parameters.add({"bg_slice_us", &background_slice_us, 0.0F,
+                         static_cast<float>(config.minor_frame_us), true,
+                         "longest background slice [us], 0 = rest of the frame"})) {
+    return fail("console parameters", "table full");
+  }
+  if (store != nullptr) {
+    // The values `param save` kept: a file that is not TOML stops the start (2); a name the
+    // table no longer has, or a value it refuses, is skipped with a warning.
+    const ConfigLoad loaded = load_parameters_file(g_store.parameters_path(), g_parameters, error,
+                                                   sizeof error, warn_line, nullptr);
+    if (loaded == ConfigLoad::kInvalid) {
+      slog.log(LogLevel::kError, "saved parameters: %s", error);
+      return 2;
+    }
+    if (loaded == ConfigLoad::kLoaded) {
+      slog.log(LogLevel::kInfo, "parameters from %s: %zu changed", g_store.parameters_path(),
+               g_parameters.changed_count());
+    }
+    console.set_parameter_saver(&rt.saver);
+  }
+
+  if (config.realtime) {
+    RealtimeConfig realtime;
+    realtime.fifo_priority = config.fifo_priority;
+    const RealtimeReport report = prepare_realtime(realtime);
+    slog.log(report.fifo && report.memory_locked ? LogLevel::kInfo : LogLevel::kWarn, "%s",
+             report.message);
+  }
+
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  // A hang-up (the controlling terminal or the console's session gone) stops in the same
+  // orderly way: base stopped, MISSION line; the default action would kill the process with
+  // the base still driving.
+  sigaction(SIGHUP, &action, nullptr);
+
+  ExecutiveConfig exec_config;
+  exec_config.frame_us = config.minor_frame_us;
+  exec_config.background_units_per_slice = config.background_units_per_slice;
+  if (!executive.start(exec_config, &why)) return fail("executive", why);
+  const std::uint64_t start_us = hal.clock.now_us();
+  mission.start(start_us);
+  console.log(LogLevel::kInfo, "boticelli %s on %s: ready", BOTICELLI_VERSION, info.name);
+  notifier.ready();
+  if (hooks != nullptr && hooks->loop_started != nullptr) hooks->loop_started(hooks->context);
+
+  const char* stop_reason = "";
+  for (;;) {
+    executive.set_background_max_slice_us(static_cast<std::uint32_t>(background_slice_us));
+    executive.run_frame();
+    if (hooks != nullptr && hooks->after_frame != nullptr) hooks->after_frame(hooks->context);
+    if (g_signal != 0) {
+      stop_reason = signal_name(g_signal);
+      break;
+    }
+    if (console.shutdown_requested()) {
+      stop_reason = "console shutdown";
+      break;
+    }
+    if (options.max_cycles != 0 && mission.cycles_this_run() >= options.max_cycles) {
+      stop_reason = "max cycles";
+      break;
+    }
+    if (mission.finished()) {
+      stop_reason = mission.end_reason();
+      break;
+    }
+  }
+  if (hooks != nullptr && hooks->loop_ended != nullptr) {
+    hooks->loop_ended(hooks->context, executive);
+  }
+  if (!mission.finished()) {
+    // Stopped from outside: --max-cycles is the end of the search, anything else an abort.
+    if (options.max_cycles != 0 && mission.cycles_this_run() >= options.max_cycles) {
+      mission.finish_not_found("max cycles");
+    } else {
+      mission.abort(stop_reason);
+    }
+  }
+
+  // Orderly stop: base and PTU halted, watchdog disarmed, console drained (bounded).
+  notifier.stopping();
+  hal.base.stop();
+  hal.pan_tilt.halt();
+  if (watchdog_armed) hal.watchdog.stop();
+  hal.status_led.write(false);  // off: the firmware is not running
+  console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
+  console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
+              mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
+  if (mission.guard_truncated_looks() > 0) {
+    console.log(LogLevel::kWarn, "mission guard_truncated_looks=%u (a full list dropped readings)",
+                static_cast<unsigned>(mission.guard_truncated_looks()));
+  }
+  {
+    // The longest unit of each kind [ms of host thread CPU]: what a slice or the mission
+    // task's budget must hold on the robot.
+    TextBuffer<256> line;
+    line.append("mission longest_ms");
+    for (std::size_t u = 0; u < static_cast<std::size_t>(mission::Unit::kCount); ++u) {
+      const auto unit = static_cast<mission::Unit>(u);
+      line.appendf(" %s=%.2f", mission::unit_name(unit), mission.longest_unit_s(unit) * 1e3);
+    }
+    console.log(LogLevel::kInfo, "%s", line.c_str());
+  }
+  for (int i = 0; i < 50 && console.pending_output() > 0 && console.healthy(); ++i) {
+    console.drain();
+    hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);
+  }
+  mission.finish_saving();
+  if (rt.saver.failures() > 0) {
+    rt.saver.last_error(error, sizeof error);
+    slog.log(LogLevel::kError, "%llu state saves failed, last: %s",
+             static_cast<unsigned long long>(rt.saver.failures()), error);
+  }
+  if (g_trace.is_open() && !g_trace.close(error, sizeof error)) {
+    slog.log(LogLevel::kError, "%s", error);
+  }
+  const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
+  const mission::Result result = mission.result();
+  // The reason last, quoted (it has spaces): why the mission ended, with the device's words
+  // when a device ended it ("base stopped by itself: base: left axis: heartbeat lost ...").
+  TextBuffer<160> reason;
+  for (const char* c = mission.end_reason(); *c != '\0'; ++c) {
+    reason.appendf("%c", *c == '"' ? '\'' : *c);
+  }
+  std::printf(
+      "MISSION result=%s cycles=%llu collisions=%llu sim_time_s=%.3f wall_time_s=%.3f "
+      "target_error_m=%.3f reason=\"%s\"\n",
+      mission::result_name(result), static_cast<unsigned long long>(g_state.cycle),
+      static_cast<unsigned long long>(safety.collisions()), sim_time_s,
+      wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()), reason.c_str());
+  std::fflush(stdout);
+  g_runtime.reset();
+  g_signal = 0;
+  return result == mission::Result::kFound ? kExitFound : kExitNotFound;
+}
+
+}  // namespace boticelli::firmware

@@ -1,0 +1,66 @@
+// BoardConfig: the declarative description of the robot a board drives (dimensions, camera,
+// look, timing); the board's values override these defaults, a configuration file overrides both.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace boticelli::firmware {
+
+// Declarative description of the robot a board drives. Values are the board's own (see
+// boards/<board>/board_config.cpp); units are in the names. The thesis's reference robot
+// (§3.4, App. A): 640x480 camera averaged to 160x120 with F = 150 px there, L = 21 cm,
+// tilt step Φ = 7.7°.
+struct BoardConfig {
+  // Camera at full resolution (what the driver delivers).
+  std::uint32_t camera_width_px = 640;
+  std::uint32_t camera_height_px = 480;
+  float focal_px = 600.0F;        // focal length at full resolution [px]
+  float principal_x_px = 320.0F;  // principal point [px]
+  float principal_y_px = 240.0F;
+  float radial_k1 = 0.0F;  // radial distortion, normalised coordinates
+  // Pan-tilt unit and the L-shaped camera support (App. A).
+  float ptu_height_m = 0.6F;       // PTU centre (pan and tilt axes) above the floor [m]
+  float lever_m = 0.21F;           // tilt axis to camera optical centre, L [m]
+  float support_angle_rad = 0.0F;  // angle Ω of the L-support between lever and optical axis [rad]
+  float tilt_step_rad = 0.134390352F;  // tilt between the two stereo frames, Φ = 7.7° [rad]
+  // Base.
+  float robot_radius_m = 0.25F;      // radius of the cylinder that contains the robot [m]
+  float robot_height_m = 0.8F;       // height of that cylinder [m]
+  float wheel_radius_m = 0.08F;      // [m]
+  float track_width_m = 0.40F;       // distance between the wheels [m]
+  float max_speed_m_s = 0.3F;        // forward speed limit [m/s]
+  float max_turn_rate_rad_s = 0.8F;  // yaw rate limit [rad/s]
+  // Executive and console.
+  std::uint32_t minor_frame_us = 10000;  // executive minor frame [µs]
+  std::uint32_t console_baud = 115200;
+  std::uint32_t telemetry_period_ms = 1000;
+  // Linux process set-up for the executive (firmware/realtime.h): mlockall, prefaulted
+  // stack, SCHED_FIFO at this priority when permitted. Off on the host simulation.
+  bool realtime = false;
+  int fifo_priority = 50;
+  std::uint32_t watchdog_timeout_ms = 2000;  // /dev/watchdog timeout; 0 = do not arm it
+  // Background units per frame (0 = limited by time only); a simulated board may set it so
+  // the work done per frame does not depend on the host's speed.
+  std::uint32_t background_units_per_slice = 0;
+  std::uint32_t checkpoint_period_ms = 1000;  // state checkpoint period while no cycle ends
+  // The mission's look (§6.2.1, §6.3): pan positions spread over the PTU's pan range (the
+  // camera's 56° field of view closes the circle beyond it), and tilt rows; each row is a
+  // stereo pair (tilt, tilt − Φ) or a single frame for the floor cue only.
+  std::uint32_t look_pan_positions = 15;
+  static constexpr std::size_t kMaxTiltRows = 4;
+  std::array<float, kMaxTiltRows> look_tilt_rad = {0.0F, -0.5F, -0.8F, 0.0F};
+  std::array<bool, kMaxTiltRows> look_tilt_is_pair = {true, true, false, false};
+  std::uint32_t look_tilt_rows = 2;
+  std::uint32_t camera_settle_ms = 60;  // after the PTU stops, before a frame counts [ms]
+  // What the camera can be trusted for (thesis §3.4: about 0.1 m to 4.5 m).
+  float max_range_m = 4.5F;
+  float ceiling_height_m = 2.5F;     // readings above this height are errors [m]
+  float clearance_margin_m = 0.05F;  // kept beyond the robot radius from every obstacle [m]
+  float ground_clearance_m = 0.03F;  // lowest obstacle height the base cannot drive over [m]
+  float goal_standoff_m = 0.75F;     // the mission ends this far from the target [m]
+  std::uint32_t steps_per_look = 3;  // steps driven on one look's polygon before the next look
+};
+
+}  // namespace boticelli::firmware

@@ -1,0 +1,73 @@
+// Mission parameters: every stage's settings derived once from the board config, so the stages
+// and their capacities agree.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/evidence/reading_limits.h"
+#include "algo/mapping/local_model_builder.h"
+#include "algo/mapping/map_points.h"
+#include "algo/planning/planner.h"
+#include "algo/planning/rewards.h"
+#include "algo/planning/value_iteration.h"
+#include "algo/stereo/rig.h"
+#include "algo/stereo/stereo_processor.h"
+#include "firmware/common/board_config.h"
+#include "firmware/mission/drive/drive_controller.h"
+#include "firmware/mission/target/target_tracker.h"
+#include "hal/pan_tilt.h"
+
+namespace boticelli::firmware::mission {
+
+struct LookRow {
+  float tilt_rad = 0.0F;
+  bool pair = true;  // a stereo pair (tilt, tilt − Φ); else one frame for the floor cue
+};
+
+struct MissionParams {
+  stereo::RigParams rig;
+  stereo::StereoParams stereo;
+  evidence::ReadingLimits limits;
+  mapping::LocalModelParams model;
+  mapping::MapPointParams points;
+  planning::ValueIterationParams value;
+  planning::RewardParams rewards;
+  planning::StepParams step;
+  DriveParams drive;
+  TargetTrackerParams target;
+  std::uint32_t pan_positions = 15;
+  LookRow rows[BoardConfig::kMaxTiltRows]{};
+  std::size_t row_count = 0;
+  std::uint32_t settle_us = 60000;           // PTU at rest → frames count after this [µs]
+  std::uint32_t frame_timeout_us = 3000000;  // no usable frame this long: camera fault [µs]
+  std::uint32_t ptu_timeout_us = 8000000;    // a PTU move taking longer: PTU fault [µs]
+  std::uint32_t release_hold_us = 500000;    // e-stop released this long → carry on [µs]
+  std::uint32_t trace_period_us = 100000;    // one trace row per this much time [µs]
+  std::uint32_t vi_work_per_unit = 256;      // value-iteration work per background unit
+  std::size_t max_failed_cycles = 4;         // cycles in a row with no safe step → not_found
+  // From this many such cycles in a row the robot backs off along its last step before the
+  // next look (a fresh look on the spot first: the fit of one look can leave no room).
+  std::size_t back_off_after_failed_cycles = 2;
+  std::uint32_t steps_per_look = 3;  // steps on one look's navigable polygon
+};
+
+// The camera rig the stereo and the sim renderer both use, from the board's declaration.
+stereo::RigParams make_rig_params(const BoardConfig& config);
+
+// Every stage's settings from the board (robot size, PTU height, camera, look, limits). The
+// look's rows come lowest tilt first: the lowest teaches the floor cue what the floor looks
+// like before the higher rows, which see less floor.
+MissionParams make_mission_params(const BoardConfig& config);
+
+// One view of the look's scan: `view` counts pans within a row (spread over the PTU's pan
+// limits, every other row swept back), then rows; a pair's tilt leaves room for its second
+// frame, tilt − Φ, above the tilt limit.
+struct LookView {
+  float pan_rad = 0.0F;
+  float tilt_rad = 0.0F;
+  bool pair = true;
+};
+LookView scan_view(const MissionParams& params, const hal::PanTiltLimits& limits, std::size_t view);
+
+}  // namespace boticelli::firmware::mission

@@ -1,0 +1,129 @@
+// StepPlanner: value iteration, the step and its outcome (see step_planner.h).
+#include "firmware/mission/plan/step_planner.h"
+
+#include <cmath>
+
+namespace boticelli::firmware::mission {
+
+const char* step_outcome_name(StepOutcome outcome) {
+  switch (outcome) {
+    case StepOutcome::kChoosing:
+      return "choosing";
+    case StepOutcome::kMove:
+      return "move";
+    case StepOutcome::kTurnRound:
+      return "turn_round";
+    case StepOutcome::kBackOff:
+      return "back_off";
+    case StepOutcome::kAtGoal:
+      return "at_goal";
+    case StepOutcome::kNoSafeStep:
+      return "no_safe_step";
+    case StepOutcome::kNothingLeft:
+      return "nothing_left";
+  }
+  return "unknown";
+}
+
+void StepPlanner::clear() {
+  trail_.clear();
+  failed_cycles_ = 0;
+  turned_round_ = false;
+}
+
+void StepPlanner::start_value(const mapping::GlobalMap& map, const core::Point2* goal,
+                              core::Point2 centre, std::uint32_t seed) {
+  planning::RewardSources sources;
+  sources.obstacles = map.obstacles().span();
+  sources.exploration = map.exploration().span();
+  sources.visited = trail_.points();
+  sources.has_goal = goal != nullptr;
+  if (sources.has_goal) sources.goal = *goal;
+  planning::ValueIterationParams vp = params_.value;
+  vp.seed = seed;
+  value_.start(vp, params_.rewards, sources, centre);
+}
+
+StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
+                                      const mapping::StarPolygon& navigable, bool has_exploration,
+                                      bool has_goal) {
+  if (!has_exploration && !has_goal) {
+    // Turn round and look once more before giving up: the sector behind the robot is seen
+    // only by the image's edges at the PTU's pan limits (or not at all, if the pans and the
+    // field of view leave a gap), and a fresh look refits the model.
+    const bool turned_here =
+        turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
+    return turned_here ? StepOutcome::kNothingLeft : StepOutcome::kTurnRound;
+  }
+  chooser_.start(value_, navigable, here, params_.step);
+  return StepOutcome::kChoosing;
+}
+
+StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& look_pose,
+                                    const mapping::StarPolygon& navigable,
+                                    Breadcrumbs& breadcrumbs) {
+  decision_ = chooser_.decision();
+  if (decision_.kind == planning::StepKind::kAtGoal) return StepOutcome::kAtGoal;
+  if (decision_.kind == planning::StepKind::kMove) {
+    // The thesis's consistency check: the whole step must lie in this look's polygon.
+    bool inside = true;
+    for (int i = 1; i <= 20 && inside; ++i) {
+      const float t = static_cast<float>(i) / 20.0F;
+      const core::Point2 p{here.x_m + t * (decision_.target.x_m - here.x_m),
+                           here.y_m + t * (decision_.target.y_m - here.y_m)};
+      inside = navigable.contains(core::to_robot(look_pose, p));
+    }
+    if (inside) {
+      failed_cycles_ = 0;
+      return StepOutcome::kMove;
+    }
+  }
+  // No safe step (an obstacle close by, or a poor fit, can leave no room in this look's
+  // polygon): the place counts as visited once more and the robot looks again; from the
+  // second such cycle in a row it first backs off along the step that brought it here. It
+  // gives up after a few such cycles in a row.
+  ++failed_cycles_;
+  trail_.add({here.x_m, here.y_m});
+  if (failed_cycles_ >= params_.back_off_after_failed_cycles &&
+      failed_cycles_ < params_.max_failed_cycles) {
+    // The step back to the last breadcrumb: the robot's disc swept that segment on the way
+    // here, so it is driven without this look's polygon (which may hold no room at all).
+    core::Point2 back{};
+    if (breadcrumbs.back_target({here.x_m, here.y_m}, params_.step.min_step_m, back)) {
+      decision_ = {};
+      decision_.kind = planning::StepKind::kMove;
+      decision_.target = back;
+      return StepOutcome::kBackOff;
+    }
+  }
+  return StepOutcome::kNoSafeStep;
+}
+
+bool StepPlanner::begin_next_on_look(const core::Pose2& here, const core::Pose2& look_pose,
+                                     const mapping::StarPolygon& navigable) {
+  if (!navigable.contains(core::to_robot(look_pose, {here.x_m, here.y_m}))) return false;
+  from_here_.set_vertex_count(navigable.vertex_count());
+  const float reach = params_.value.step_m;
+  constexpr int kSamples = 20;
+  for (std::size_t k = 0; k < from_here_.vertex_count(); ++k) {
+    const float a = from_here_.angle_rad(k) + here.yaw_rad;
+    float rho = 0.0F;
+    for (int i = 1; i <= kSamples; ++i) {
+      const float t = reach * static_cast<float>(i) / kSamples;
+      const core::Point2 p{here.x_m + t * std::cos(a), here.y_m + t * std::sin(a)};
+      if (!navigable.contains(core::to_robot(look_pose, p))) break;
+      rho = t;
+    }
+    from_here_.set_rho_m(k, rho);
+  }
+  chooser_.start(value_, from_here_, here, params_.step);
+  return true;
+}
+
+StepOutcome StepPlanner::end_next_on_look() {
+  decision_ = chooser_.decision();
+  return decision_.kind == planning::StepKind::kMove ? StepOutcome::kMove
+                                                     : StepOutcome::kNoSafeStep;
+}
+
+}  // namespace boticelli::firmware::mission

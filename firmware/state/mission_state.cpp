@@ -1,0 +1,77 @@
+// MissionState helpers: model text, bounded mission log, comparison (see mission_state.h).
+#include "firmware/state/mission_state.h"
+
+#include <cstring>
+
+namespace boticelli::firmware {
+
+bool MissionState::set_model(std::string_view text) {
+  if (text.size() > kMaxModelBytes || text.find('\0') != std::string_view::npos) return false;
+  std::memcpy(model.data(), text.data(), text.size());
+  model_bytes = text.size();
+  return true;
+}
+
+void MissionState::add_log(std::uint64_t at_cycle, std::string_view text) {
+  if (log.full()) {
+    for (std::size_t i = 1; i < log.size(); ++i) log[i - 1] = log[i];
+    log.pop_back();
+    ++log_dropped;
+  }
+  MissionLogEntry e;
+  e.cycle = at_cycle;
+  const std::size_t n =
+      text.size() < MissionLogEntry::kMaxTextBytes ? text.size() : MissionLogEntry::kMaxTextBytes;
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    e.text[i] = (c >= 0x20 && c <= 0x7E) ? c : '?';
+  }
+  e.text[n] = '\0';
+  (void)log.push_back(e);
+}
+
+void MissionState::clear() {
+  cycle = 0;
+  seed = 1;
+  pose = {};
+  has_goal = false;
+  goal = {};
+  goal_height_m = 0.0F;
+  obstacles.clear();
+  exploration.clear();
+  model_bytes = 0;
+  log.clear();
+  log_dropped = 0;
+}
+
+namespace {
+bool same_points(const core::FixedVectorBase<core::Point2>& a,
+                 const core::FixedVectorBase<core::Point2>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].x_m != b[i].x_m || a[i].y_m != b[i].y_m) return false;
+  }
+  return true;
+}
+}  // namespace
+
+bool operator==(const MissionState& a, const MissionState& b) {
+  if (a.cycle != b.cycle || a.seed != b.seed || a.pose.x_m != b.pose.x_m ||
+      a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad || a.has_goal != b.has_goal) {
+    return false;
+  }
+  if (a.has_goal && (a.goal.x_m != b.goal.x_m || a.goal.y_m != b.goal.y_m ||
+                     a.goal_height_m != b.goal_height_m)) {
+    return false;
+  }
+  if (!same_points(a.obstacles, b.obstacles) || !same_points(a.exploration, b.exploration)) {
+    return false;
+  }
+  if (a.model_text() != b.model_text() || a.log.size() != b.log.size()) return false;
+  for (std::size_t i = 0; i < a.log.size(); ++i) {
+    if (a.log[i].cycle != b.log[i].cycle || a.log[i].view() != b.log[i].view()) return false;
+  }
+  return true;
+}
+
+}  // namespace boticelli::firmware

@@ -1,0 +1,63 @@
+// MissionView: what the console and telemetry may ask the mission (state, pose, model, map).
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+
+#include "algo/core/geometry.h"
+#include "firmware/state/mission_state.h"
+
+namespace boticelli::firmware {
+
+struct MapCounts {
+  std::uint32_t polygon_vertices = 0;    // vertices of the current navigation polygon
+  std::uint32_t obstacle_points = 0;     // global obstacle list
+  std::uint32_t exploration_points = 0;  // global exploration list
+};
+
+// The mission's idea of where the target is: none yet, seen once (a candidate not yet
+// confirmed by a second view) or confirmed (the goal).
+enum class TargetStatus : std::uint8_t { kNone, kSeen, kConfirmed };
+struct TargetEstimate {
+  TargetStatus status = TargetStatus::kNone;
+  std::uint32_t sightings = 0;  // views that saw it
+  float x_m = 0.0F;             // mission frame, as pose() [m]
+  float y_m = 0.0F;
+  float z_m = 0.0F;  // height above the floor [m]
+};
+const char* target_status_name(TargetStatus status);
+
+// Read-only view the mission implements; the console calls it from its task, so every call
+// must be quick and must not allocate.
+class MissionView {
+ public:
+  virtual ~MissionView() = default;
+  virtual const char* state_name() const = 0;           // e.g. "look", "think", "drive", "idle"
+  virtual core::Pose2 pose() const = 0;                 // mission frame [m, rad]
+  virtual float pan_rad() const = 0;                    // current PTU pan [rad]
+  virtual std::uint32_t features() const { return 0; }  // features tracked in the last view
+  virtual std::uint32_t pieces() const { return 0; }    // linear pieces of the occupancy ALN
+  virtual std::uint64_t cycles() const { return 0; }    // completed Look-Think-Drive cycles
+  // The current occupancy ALN in the text format; empty when there is none yet. The text
+  // stays valid and unchanged until release_model_text() (a model fitted meanwhile is shown
+  // after the release), so the console can stream it over many frames.
+  virtual std::string_view model_text() { return {}; }
+  virtual void release_model_text() {}
+  virtual MapCounts map_counts() const { return {}; }
+  virtual TargetEstimate target() const { return {}; }
+  // The mission log kept in the state file (MissionState::log), by line number: the first
+  // line still kept, one past the last, and a line (nullptr when no longer or not yet kept).
+  virtual std::uint64_t mission_log_begin() const { return 0; }
+  virtual std::uint64_t mission_log_end() const { return 0; }
+  virtual const MissionLogEntry* mission_log_line(std::uint64_t number) const {
+    (void)number;
+    return nullptr;
+  }
+
+ protected:
+  MissionView() = default;
+  MissionView(const MissionView&) = default;
+  MissionView& operator=(const MissionView&) = default;
+};
+
+}  // namespace boticelli::firmware
