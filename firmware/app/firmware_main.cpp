@@ -10,6 +10,7 @@
 #include "firmware/app/config_file.h"
 #include "firmware/console/console.h"
 #include "firmware/app/device_tasks.h"
+#include "firmware/app/runtime.h"
 #include "firmware/executive/executive.h"
 #include "firmware/common/log.h"
 #include "firmware/mission/mission.h"
@@ -65,42 +66,11 @@ SnapshotWriter g_snapshots;
 LogRing g_log_ring;
 
 // Everything that is bound to the board's devices, rebuilt in place for each run (static
-// storage, no heap; firmware_main may be called again, e.g. by tests).
-struct Runtime {
-  Runtime(hal::Hal& hal, const BoardConfig& config, StateStore* store, const TruthSource* truth,
-          mission::TraceWriter* trace, SnapshotWriter* snapshots)
-      : saver(g_store),
-        executive(hal.clock),
-        safety(hal.estop, hal.bumper, hal.base),
-        mission({hal, config, safety, executive, g_state, store != nullptr ? &saver : nullptr,
-                 truth, trace, snapshots}),
-        console(hal.console, executive, safety, mission, g_parameters),
-        estop_task(safety),
-        base_task(hal.base, safety),
-        ptu_task(hal.pan_tilt),
-        camera_task(hal.camera),
-        mission_task(mission),
-        console_task(console),
-        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {
-    camera_task.set_consumer(&mission);
-    watchdog_task.set_status_sources(&safety, &mission);
-  }
-
-  ServiceNotifier notifier;
-  StateSaver saver;
-  Executive executive;
-  Safety safety;
-  mission::Mission mission;
-  Console console;
-  EstopTask estop_task;
-  BaseTask base_task;
-  PanTiltTask ptu_task;
-  CameraTask camera_task;
-  mission::MissionTask mission_task;
-  ConsoleTask console_task;
-  WatchdogTask watchdog_task;
-};
+// storage, no heap; firmware_main may be called again, e.g. by tests): the runtime, then the
+// mission made on its safety latch, executive and saver.
 std::optional<Runtime> g_runtime;
+std::optional<mission::Mission> g_mission;
+std::optional<mission::MissionTask> g_mission_task;
 
 int fail(const char* what, const char* why) {
   service_log().log(LogLevel::kError, "%s%s%s", what, why[0] != '\0' ? ": " : "", why);
@@ -227,10 +197,20 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     return fail(error, "");
   }
   g_parameters = ParameterTable{};
-  g_runtime.emplace(hal, config, store, board.truth(),
-                    options.trace_file != nullptr ? &g_trace : nullptr,
-                    options.snapshots_dir != nullptr ? &g_snapshots : nullptr);
+  g_mission_task.reset();  // made on the last run's runtime: gone before it
+  g_mission.reset();
+  g_runtime.emplace(hal, hal.console, g_store, g_parameters);
   Runtime& rt = *g_runtime;
+  g_mission.emplace(mission::MissionContext{
+      hal, config, rt.safety, rt.executive, g_state, store != nullptr ? &rt.saver : nullptr,
+      board.truth(), options.trace_file != nullptr ? &g_trace : nullptr,
+      options.snapshots_dir != nullptr ? &g_snapshots : nullptr});
+  mission::Mission& mission = *g_mission;
+  g_mission_task.emplace(mission);
+  const char* why = "";
+  if (!rt.attach({*g_mission_task, mission, mission, mission}, &why)) {
+    return fail("executive", why);
+  }
   // On a real-time board the state is written by a thread of its own (fsync can take tens
   // of milliseconds on an SD card); on the simulation it is written in the background slot.
   if (store != nullptr && config.realtime) rt.saver.start();
@@ -238,21 +218,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   if (!notifier.open()) slog.log(LogLevel::kWarn, "%s", notifier.error());
   Executive& executive = rt.executive;
   Safety& safety = rt.safety;
-  mission::Mission& mission = rt.mission;
-  Console& console = rt.console;
+  Console& console = *rt.console;
   console.set_log_ring(&g_log_ring, &hal.clock);
   console.set_board_name(info.name);
   console.set_fault_injection(board.fault_injection());
-
-  // The executive and its tasks.
-  Task* const tasks[kTaskCount] = {&rt.estop_task,   &rt.base_task,    &rt.ptu_task,
-                                   &rt.camera_task,  &rt.mission_task, &rt.console_task,
-                                   &rt.watchdog_task};
-  const char* why = "";
-  for (std::size_t i = 0; i < kTaskCount; ++i) {
-    if (!executive.add_task(kTaskTable[i], *tasks[i], &why)) return fail("executive", why);
-  }
-  executive.set_background(&mission);
   console.set_telemetry_ms(static_cast<float>(config.telemetry_period_ms));
   float background_slice_us = 0.0F;
   if (!console.register_parameters() ||
@@ -391,6 +360,8 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       static_cast<unsigned long long>(safety.collisions()), sim_time_s,
       wall_seconds() - wall_start_s, static_cast<double>(mission.target_error_m()), reason.c_str());
   std::fflush(stdout);
+  g_mission_task.reset();
+  g_mission.reset();
   g_runtime.reset();
   g_signal = 0;
   return result == mission::Result::kFound ? kExitFound : kExitNotFound;

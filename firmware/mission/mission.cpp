@@ -112,6 +112,7 @@ Mission::Mission(const MissionContext& c)
       trace_(c.trace),
       snapshots_(c.snapshots),
       params_(make_mission_params(c.config)),
+      release_(params_.release_hold_us),
       pose_(c.hal.base),
       scan_(params_),
       look_(params_.rig, params_.stereo, params_.model.close_blocked_rays),
@@ -236,7 +237,7 @@ void Mission::control(std::uint64_t now_us) {
     held_phase_ = phase_;
     phase_ = Phase::kHold;
     scan_.stop_frames();
-    released_ = false;
+    release_.restart();
     if (driver_.busy()) driver_.abort("held");
   }
   switch (phase_) {
@@ -276,16 +277,7 @@ void Mission::control_hold(std::uint64_t now_us) {
   if (safety_.engaged()) {
     // A button stop is cleared once the button has been released for a while; a console
     // stop waits for the console's `clear-estop`.
-    if (safety_.cause() == StopCause::kButton && !hal_.estop.read()) {
-      if (!released_) {
-        released_ = true;
-        released_since_us_ = now_us;
-      } else if (now_us - released_since_us_ >= params_.release_hold_us) {
-        (void)safety_.clear();
-      }
-    } else {
-      released_ = false;
-    }
+    (void)release_.update(safety_, hal_.estop, now_us);
     return;
   }
   if (executive_.background_paused()) return;

@@ -1,6 +1,6 @@
 // One test per (device, fault type) pair on the sim board: the fault injected at the HAL
 // boundary, the firmware's device tasks, e-stop latch, console and state saver around a
-// stand-in mission; each run is checked against its expectation (boards/sim/fault_scenario.h)
+// stand-in mission; each run is checked against its expectation (boards/sim/harness/fault_scenario.h)
 // and for zero heap allocations from the first frame to the last.
 #include <unistd.h>
 
@@ -87,7 +87,7 @@ TEST_GROUP(Faults) {
   }
 };
 
-// The expectation for each pair is in boards/sim/fault_scenario.cpp (docs/reliability.md).
+// The expectation for each pair is in boards/sim/harness/fault_scenario.cpp (docs/reliability.md).
 // FAULT_PAIR runs in every build; FAULT_PAIR_MORE is ignored under the sanitizers
 // (BOTICELLI_FAULTS_QUICK), where a pair costs 15-40 s: one base and one storage pair there.
 #define FAULT_PAIR(name, device, type)                \

@@ -1,5 +1,5 @@
 // Benchmark suite "soak": two hours of simulated time on the sim board under a seeded random
-// plan of faults the robot is expected to ride out (boards/sim/fault_scenario.h's rig):
+// plan of faults the robot is expected to ride out (boards/sim/harness/fault_scenario.h's rig):
 // allocations after init (counted by replacing the global operator new here), statistics,
 // every fault ended safe, the state file loadable at every quiet moment.
 // SOAK_SECONDS (default 7200), SOAK_SEED (default 1), SOAK_FAULTS (default 250, at most 256).

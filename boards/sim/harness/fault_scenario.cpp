@@ -14,7 +14,9 @@
 #include "firmware/telemetry/mission_view.h"
 #include "firmware/common/parameters.h"
 #include "firmware/state/persistence.h"
+#include "firmware/safety/button_release.h"
 #include "firmware/safety/safety.h"
+#include "firmware/app/runtime.h"
 #include "firmware/app/service_notify.h"
 #include "firmware/state/state_saver.h"
 #include "firmware/executive/task_table.h"
@@ -205,14 +207,10 @@ class StandIn final : public fw::Task,
   void run(std::uint64_t now_us) override {
     now_us_ = now_us;
     if (safety_.engaged()) {
-      if (safety_.cause() == fw::StopCause::kButton && !hal_.estop.read()) {
-        if (released_since_us_ == 0) released_since_us_ = now_us;
-        if (now_us - released_since_us_ >= 500000U) (void)safety_.clear();
-      } else {
-        released_since_us_ = 0;
-      }
-    } else if (hal_.base.health() == hal::BaseHealth::kReady) {
-      hal_.base.set_velocity(0.0F, 0.4F);
+      (void)release_.update(safety_, hal_.estop, now_us);
+    } else {
+      release_.restart();
+      if (hal_.base.health() == hal::BaseHealth::kReady) hal_.base.set_velocity(0.0F, 0.4F);
     }
     const hal::PanTiltState ptu = hal_.pan_tilt.state();
     if (!ptu.moving && !ptu.fault) {
@@ -255,7 +253,7 @@ class StandIn final : public fw::Task,
   fw::MissionState& state_;
   fw::StateSaver* saver_;
   std::uint64_t now_us_ = 0;
-  std::uint64_t released_since_us_ = 0;
+  fw::ButtonRelease release_;  // the mission's rule for a button stop's release
   std::uint64_t next_save_us_ = 0;
   std::uint64_t frames_ = 0;
   std::uint64_t ptu_moves_ = 0;
@@ -264,37 +262,18 @@ class StandIn final : public fw::Task,
   bool wants_frames_ = true;
 };
 
-// The firmware's pieces around the stand-in, wired as firmware_main wires them (static
-// storage: a few hundred kB, one scenario at a time).
+// The firmware's runtime around the stand-in, as firmware_main runs it around the mission
+// (static storage: a few hundred kB, one scenario at a time).
 struct Rig {
   Rig(hal::Hal& hal, fw::StateStore& store, bool saving)
-      : saver(store),
-        executive(hal.clock),
-        safety(hal.estop, hal.bumper, hal.base),
-        stand_in(hal, safety, state, saving ? &saver : nullptr),
-        console(port, executive, safety, stand_in, parameters),
-        estop_task(safety),
-        base_task(hal.base, safety),
-        ptu_task(hal.pan_tilt),
-        camera_task(hal.camera),
-        console_task(console),
-        watchdog_task(executive, hal.watchdog, notifier, hal.status_led) {}
+      : runtime(hal, port, store, parameters),
+        stand_in(hal, runtime.safety, state, saving ? &runtime.saver : nullptr) {}
 
   fw::MissionState state;
-  fw::StateSaver saver;
-  fw::ServiceNotifier notifier;
-  fw::Executive executive;
-  fw::Safety safety;
-  StandIn stand_in;
   CapturePort port;
   fw::ParameterTable parameters;
-  fw::Console console;
-  fw::EstopTask estop_task;
-  fw::BaseTask base_task;
-  fw::PanTiltTask ptu_task;
-  fw::CameraTask camera_task;
-  fw::ConsoleTask console_task;
-  fw::WatchdogTask watchdog_task;
+  fw::Runtime runtime;
+  StandIn stand_in;
 };
 
 fw::StateStore g_store;
@@ -331,27 +310,19 @@ bool start_rig(SimBoard& board, const FaultScenarioConfig& config, bool wants_fr
   g_rig.emplace(hal, g_store, config.state_dir != nullptr);
   Rig& rig = *g_rig;
   rig.state.clear();
-  rig.camera_task.set_consumer(&rig.stand_in);
   rig.stand_in.set_wants_frames(wants_frames);
-  rig.watchdog_task.set_status_sources(&rig.safety, &rig.stand_in);
-  fw::Task* const tasks[fw::kTaskCount] = {&rig.estop_task,   &rig.base_task, &rig.ptu_task,
-                                           &rig.camera_task,  &rig.stand_in,  &rig.console_task,
-                                           &rig.watchdog_task};
   const char* why = "";
-  for (std::size_t i = 0; i < fw::kTaskCount; ++i) {
-    if (!rig.executive.add_task(fw::kTaskTable[i], *tasks[i], &why)) {
-      std::snprintf(error, error_size, "executive: %s", why);
-      return false;
-    }
+  if (!rig.runtime.attach({rig.stand_in, rig.stand_in, rig.stand_in, rig.stand_in}, &why)) {
+    std::snprintf(error, error_size, "executive: %s", why);
+    return false;
   }
-  rig.executive.set_background(&rig.stand_in);
-  rig.console.set_telemetry_ms(0.0F);
-  rig.console.set_fault_injection(&board);
-  if (config.state_dir != nullptr) rig.console.set_parameter_saver(&rig.saver);
+  rig.runtime.console->set_telemetry_ms(0.0F);
+  rig.runtime.console->set_fault_injection(&board);
+  if (config.state_dir != nullptr) rig.runtime.console->set_parameter_saver(&rig.runtime.saver);
   fw::ExecutiveConfig exec_config;
   exec_config.frame_us = board.config().minor_frame_us;
   exec_config.background_units_per_slice = board.config().background_units_per_slice;
-  if (!rig.executive.start(exec_config, &why)) {
+  if (!rig.runtime.executive.start(exec_config, &why)) {
     std::snprintf(error, error_size, "executive: %s", why);
     return false;
   }
@@ -406,7 +377,7 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   std::uint64_t moves_at_end = 0;
   if (config.loop_started != nullptr) config.loop_started(config.context);
   while (hal.clock.now_us() < stop_us) {
-    rig.executive.run_frame();
+    rig.runtime.executive.run_frame();
     ++out.frames;
     const std::uint64_t now = hal.clock.now_us();
     const bool at_rest = wheels_at_rest(sim);
@@ -415,7 +386,7 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
       continue;
     }
     if (now < end_us) {
-      if (!rig.executive.all_healthy() || !rig.console.storage_healthy()) {
+      if (!rig.runtime.executive.all_healthy() || !rig.runtime.console->storage_healthy()) {
         out.unhealthy_during = true;
       }
       // When the device began to misbehave: the onset, or for an intermittent fault the
@@ -461,23 +432,23 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
     }
   }
   rig.port.feed("status\r");
-  rig.executive.run_frame();
-  rig.executive.run_frame();
+  rig.runtime.executive.run_frame();
+  rig.runtime.executive.run_frame();
   if (config.loop_ended != nullptr) config.loop_ended(config.context);
   out.stayed_stopped = stopped_seen && !broke_stop;
   out.moving_after = !wheels_at_rest(sim);
-  out.healthy_after = rig.executive.all_healthy() && rig.console.storage_healthy();
+  out.healthy_after = rig.runtime.executive.all_healthy() && rig.runtime.console->storage_healthy();
   out.camera_frames_during = frames_at_end;
   out.camera_frames_after = rig.stand_in.frames() - frames_at_end;
   out.ptu_moves_after = rig.stand_in.ptu_moves() - moves_at_end;
   out.worst_frame_lag_ms = rig.stand_in.worst_lag_ms();
-  out.frame_overruns = rig.executive.frame_stats().overruns;
-  out.missed_frames = rig.executive.frame_stats().missed_frames;
+  out.frame_overruns = rig.runtime.executive.frame_stats().overruns;
+  out.missed_frames = rig.runtime.executive.frame_stats().missed_frames;
   out.watchdog_expirations = sim.watchdog_expirations();
   out.collisions = sim.collisions();
   if (config.state_dir != nullptr) {
-    out.saves = rig.saver.saved();
-    out.save_failures = rig.saver.failures();
+    out.saves = rig.runtime.saver.saved();
+    out.save_failures = rig.runtime.saver.failures();
     char error[256] = "";
     const fw::LoadResult loaded = g_store.load(g_loaded, error, sizeof error);
     out.state_loadable =
@@ -523,7 +494,7 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
   std::uint64_t line_active_since_us = 0;
   if (config.loop_started != nullptr) config.loop_started(config.context);
   while (hal.clock.now_us() < end_us) {
-    rig.executive.run_frame();
+    rig.runtime.executive.run_frame();
     ++out.frames;
     const std::uint64_t now = hal.clock.now_us();
     bool any_active = false;
@@ -555,10 +526,11 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
     if (check_at_us == 0 || now < check_at_us) continue;
     check_at_us = 0;
     ++out.quiet_checks;
-    const bool healthy = rig.executive.all_healthy() && rig.console.storage_healthy();
+    const bool healthy =
+        rig.runtime.executive.all_healthy() && rig.runtime.console->storage_healthy();
     const bool moving = !wheels_at_rest(sim);
     bool loads = true;
-    if (config.state_dir != nullptr && rig.saver.saved() > 0) {
+    if (config.state_dir != nullptr && rig.runtime.saver.saved() > 0) {
       char error[256] = "";
       loads = g_store.load(g_loaded, error, sizeof error) == fw::LoadResult::kLoaded;
       if (!loads) ++out.state_loads_failed;
@@ -570,10 +542,10 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
         fw::TextBuffer<200> what;
         what.appendf("t_s=%.1f moving=%d state_loads=%d storage=%d",
                      static_cast<double>(now) * 1e-6, moving ? 1 : 0, loads ? 1 : 0,
-                     rig.console.storage_healthy() ? 1 : 0);
-        for (std::size_t i = 0; i < rig.executive.task_count(); ++i) {
-          if (const char* why = rig.executive.task_health(i); why != nullptr) {
-            what.appendf(" %s: %s", rig.executive.spec(i).name, why);
+                     rig.runtime.console->storage_healthy() ? 1 : 0);
+        for (std::size_t i = 0; i < rig.runtime.executive.task_count(); ++i) {
+          if (const char* why = rig.runtime.executive.task_health(i); why != nullptr) {
+            what.appendf(" %s: %s", rig.runtime.executive.spec(i).name, why);
           }
         }
         std::snprintf(out.first_unsafe, sizeof out.first_unsafe, "%s", what.c_str());
@@ -586,17 +558,17 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
   out.faults_started = faults.started();
   out.faults_ended = faults.ended();
   out.collisions = sim.collisions();
-  out.saves = rig.saver.saved();
-  out.save_failures = rig.saver.failures();
-  const fw::FrameStats& f = rig.executive.frame_stats();
+  out.saves = rig.runtime.saver.saved();
+  out.save_failures = rig.runtime.saver.failures();
+  const fw::FrameStats& f = rig.runtime.executive.frame_stats();
   out.frame_overruns = f.overruns;
   out.missed_frames = f.missed_frames;
   out.worst_jitter_us = f.jitter_worst_us;
-  for (std::size_t i = 0; i < rig.executive.task_count(); ++i) {
-    const std::uint32_t w = rig.executive.task_stats(i).worst_us;
+  for (std::size_t i = 0; i < rig.runtime.executive.task_count(); ++i) {
+    const std::uint32_t w = rig.runtime.executive.task_stats(i).worst_us;
     if (w > out.worst_task_us) out.worst_task_us = w;
   }
-  out.console_dropped_bytes = rig.console.dropped_bytes();
+  out.console_dropped_bytes = rig.runtime.console->dropped_bytes();
   out.watchdog_expirations = sim.watchdog_expirations();
   out.ran = true;
   g_rig.reset();
