@@ -252,7 +252,7 @@ class Aln {
 
   // Alpha-beta with a hint: the piece responsible for a nearby earlier query (e.g. the
   // previous point on a ray). The hint's branch is evaluated first at every node on its
-  // path, so when the hint is still responsible most other branches are cut off (ALN.md).
+  // path, so when the hint is still responsible most other branches are cut off.
   // Same value as evaluate(); at an exact tie between two pieces it may name the other one.
   // An out-of-range hint means no hint.
   [[nodiscard]] EvalResult<Scalar> evaluate_alpha_beta(const Vec& x, std::uint16_t hint) const {

@@ -14,108 +14,16 @@
 
 #include "algo/aln/aln.h"
 #include "algo/aln/constrained_lsq.h"
+#include "algo/aln/hinge_split.h"
+#include "algo/aln/robust_loss.h"
 #include "algo/aln/samples.h"
+#include "algo/aln/trainer_config.h"
+#include "algo/aln/trainer_pass.h"
+#include "algo/aln/trainer_sums.h"
 
 namespace boticelli::aln {
 
-// When a piece is split (thesis §4.7.3: "linear pieces with greater than the specified error
-// are split in two, until the allowable error E in Eq 4.22 is achieved").
-enum class SplitRule : std::uint8_t {
-  kPieceRms,    // split every piece whose own RMS error exceeds epsilon (as the thesis)
-  kOverallRms,  // while the overall RMS exceeds epsilon, split the pieces with above-mean SSE
-};
-
-// Iteratively reweighted least squares inside each piece's fit, so a few percent of
-// outliers do not force extra pieces (the thesis names robust regression as future work).
-enum class RobustWeighting : std::uint8_t { kNone, kHuber, kTukey };
-
-// How a piece is split (see Trainer::split_v and Trainer::split_hinge).
-enum class SplitCandidates : std::uint8_t {
-  kCentroidV,  // one V at the piece's centroid along the input that explains most residual
-  kHinges,     // the best of the hinges on every input at 15 positions, either side
-};
-
-struct TrainerConfig {
-  double epsilon = 0.15;            // allowed RMS error, output units (Eq 4.22)
-  std::size_t max_pieces = 0;       // piece cap; 0 = the model's capacity
-  std::size_t max_iterations = 10;  // split rounds (the thesis caps iterations)
-  SplitRule split_rule = SplitRule::kPieceRms;
-  RobustWeighting robust = RobustWeighting::kNone;
-  double robust_scale = 0.0;         // residual scale s, output units; 0 = epsilon. A piece
-                                     // uses max(s, its own robust RMS): Huber k = 1.345 s,
-                                     // Tukey c = 4.685 s.
-  std::size_t max_refit_passes = 8;  // assign/refit (Lloyd) passes per split round
-  // Rounds whose splits were undone (they did not lower the error) before training gives up;
-  // each such round tries other pieces than the last.
-  std::size_t max_failed_rounds = 8;
-  // Whether an undone round counts against max_iterations (the default, and the mission's)
-  // or only against max_failed_rounds, so that max_iterations rounds are kept. Kept rounds
-  // reach epsilon in more of the thesis table's rows (the thesis-table and vs-octomap suites
-  // use them); in the mission, over seeds 1-5 on 18 worlds, they found 74 of 90 targets
-  // against 78 (docs/benchmarks.md).
-  bool count_undone_rounds = true;
-  // The V split is what the mission is measured with (docs/benchmarks.md: over three seeds
-  // on the unseen-style worlds it found 18 of 24 targets, the hinges 14); the hinges fit the
-  // thesis table's rooms with fewer pieces and reach epsilon where the V does not.
-  SplitCandidates split = SplitCandidates::kCentroidV;
-  std::uint32_t seed = 1;  // jitter of the split (V tilt; hinge draw and shift); same seed,
-                           // same model
-  // Coarse to fine: with a stride k > 1 the split rounds see every k-th sample only (k times
-  // cheaper passes); then the model they end with is refitted on all samples (Lloyd passes
-  // until the loss stops falling, then pruning; no more splits). The model returned is the
-  // best of the fine passes, all of them judged on every sample. 1 (the default): one phase.
-  std::size_t coarse_stride = 1;
-  // Passes of the fine phase (0: max_refit_passes, and until the loss stops falling).
-  std::size_t max_fine_passes = 0;
-  // Whether each pruning is judged by a pass over the samples and undone if it raised the
-  // loss (a piece no sample uses can still shape the model at samples). Without it the
-  // pruned model goes on unjudged (its stats are those of the model before the pruning),
-  // and only robust training checks the model it ends on; in vs-octomap, 5 of its 24 fits
-  // had prunings that raised the loss. The mission keeps it off: over seeds 1-5 on 18
-  // worlds it found 72 of 90 targets with it on against 78 (docs/benchmarks.md).
-  bool check_pruning = false;
-  // A refit that raised the loss (a piece's least squares ignore that moving it changes which
-  // piece is responsible where) is retried from the best model of the round with half the
-  // step towards the least-squares pieces, then a quarter; false: the round ends after two
-  // such passes, refitting from the worse model's sums.
-  bool damped_refit = false;
-  // A round also ends when a refit lowered the loss by less than this fraction of it (the
-  // Lloyd passes have converged); 0: only when the loss stops falling (by 1e-4 of it) or at
-  // max_refit_passes. vs-octomap uses 0.01 (18% less training over trainer seeds 1-6, the
-  // same mean coverage); the mission keeps 0: over seeds 1-5 on 18 worlds it found 78 of 90
-  // targets with 0.01 in 1,296 cycles, against 78 in 1,207 (docs/benchmarks.md).
-  double round_tolerance = 0.0;
-  // Fresh starts where they pay: a training that ends above epsilon (its robust RMS) begins
-  // again from one piece with the next seed (seed + 1, seed + 2, ...), up to this many
-  // times, and the model with the least loss of all the starts is returned. A start that
-  // reaches epsilon ends training. 0 (the default, and the mission's): one start. A warm
-  // start (start_from) restarts from one piece too.
-  std::size_t restarts = 0;
-};
-
-struct TrainerStats {
-  std::size_t pieces = 0;
-  std::size_t iterations = 0;      // split rounds counted against max_iterations
-  std::size_t failed_rounds = 0;   // split rounds undone (they did not lower the error)
-  std::size_t pruning_undone = 0;  // prunings undone (the pruned model fitted worse)
-  std::size_t rounds = 0;          // split rounds begun (kept and undone)
-  std::size_t passes = 0;          // passes over the samples (coarse and fine)
-  std::size_t coarse_passes = 0;   // ... of which over every coarse_stride-th sample only
-  std::size_t bin_passes = 0;      // ... of which gathered the hinge splits' sums alone
-  std::uint64_t sample_visits = 0;
-  // Fresh starts made (TrainerConfig::restarts). The counts above (passes, visits) are of all
-  // the starts; the rest of the stats are those of the start whose model was returned.
-  std::size_t restarts = 0;
-  double rms = 0.0;         // weighted RMS error of the model at the last pass (output units)
-  double robust_rms = 0.0;  // the same with the robust weights (equals rms without them)
-  // What training minimises and judges every model by: sum w rho(r / s) s^2 at the fixed
-  // scale s = robust_scale (or epsilon), rho the Huber or Tukey loss; sum w r^2 without
-  // robust weights. The model returned is the one with the least loss training evaluated.
-  double robust_loss = 0.0;
-  bool done = false;
-};
-
-// Trains an Aln<Scalar, N, MaxPieces>. The method (ALN.md "better training"): every pass
+// Trains an Aln<Scalar, N, MaxPieces>. The method (docs/architecture.md, "ALN library"): every pass
 // assigns each sample to its responsible piece (block evaluation, Aln::evaluate_block) and
 // accumulates that piece's normal equations; then each piece is refitted exactly by box-constrained
 // least squares (its weight bounds, Eqs 4.27-4.28), a k-plane / Lloyd iteration. When the error
@@ -294,43 +202,8 @@ class Trainer {
     return true;
   }
 
-  // Sums of one bin of one input's split candidates, in coordinates u = x - the bin's centre.
-  struct HingeBin {
-    double sw = 0.0;   // sum w
-    double su = 0.0;   // sum w u
-    double suu = 0.0;  // sum w u^2
-    double sr = 0.0;   // sum w r (r the sample's residual)
-    double sru = 0.0;  // sum w r u
-  };
-
-  // Per-piece sums over the samples it is responsible for, in coordinates shifted by the
-  // piece's centroid at the start of the pass (better conditioned).
-  struct Accumulator {
-    double sw = 0.0;  // sum of (robust) weights
-    std::size_t count = 0;
-    VecD sx = VecD::Zero();
-    double sy = 0.0;
-    MatD sxx = MatD::Zero();
-    VecD sxy = VecD::Zero();
-    double sse = 0.0;        // robust-weighted squared residuals
-    double loss = 0.0;       // robust loss at the fixed scale (sse without robust weights)
-    double sse_plain = 0.0;  // sample-weighted squared residuals
-    double sw_plain = 0.0;
-    double sr = 0.0;  // sum w r
-    // For the V split: |d_j| = |x_j - centroid_j| / width_j (the V a split would add).
-    VecD sra = VecD::Zero();  // sum w r |d_j|
-    VecD sa = VecD::Zero();   // sum w |d_j|
-    VecD saa = VecD::Zero();  // sum w d_j^2
-    // Split candidates: kSplitBins equal bins per input over [bin_lo, bin_lo + kSplitBins
-    // bin_step), samples outside in the end bins; and the span the samples really had.
-    VecD bin_lo = VecD::Zero();
-    VecD bin_step = VecD::Ones();
-    VecD bin_scale = VecD::Ones();  // 1 / bin_step
-    VecD seen_lo = VecD::Constant(std::numeric_limits<double>::infinity());
-    VecD seen_hi = VecD::Constant(-std::numeric_limits<double>::infinity());
-    std::array<std::array<HingeBin, kSplitBins>, static_cast<std::size_t>(N)> bins{};
-    bool binned = false;  // whether `bins` hold this pass's sums (gather_bins_)
-  };
+  // Per-piece sums over the samples it is responsible for (trainer_sums.h).
+  using Accumulator = train_detail::Accumulator<N, SplitBins>;
   using Accumulators = std::array<Accumulator, MaxPieces>;
 
   double lo(int i) const { return static_cast<double>(model_->weight_lo(i)); }
@@ -348,38 +221,18 @@ class Trainer {
     return rng_;
   }
 
-  static constexpr double kHuber = 1.345;
-  static constexpr double kTukey = 4.685;
-
   // The fixed residual scale models are compared at (the pieces' own scales only weight
   // their refits).
   double base_scale() const {
     return config_.robust_scale > 0.0 ? config_.robust_scale : config_.epsilon;
   }
 
+  // The robust weight of residual r at scale s, and its loss at base_scale() (robust_loss.h).
   double robust_weight(double r, double s) const {
-    if (config_.robust == RobustWeighting::kNone || !std::isfinite(s)) return 1.0;
-    const double u = std::fabs(r) / s;
-    if (config_.robust == RobustWeighting::kHuber) return u <= kHuber ? 1.0 : kHuber / u;
-    if (u >= kTukey) return 0.0;
-    const double t = 1.0 - (u / kTukey) * (u / kTukey);
-    return t * t;
+    return train_detail::robust_weight(config_.robust, r, s);
   }
-
-  // rho(r / s) s^2 of the M-estimator whose weights robust_weight() gives, at s = base_scale():
-  // Huber r^2 / 2 inside k s, then linear; Tukey rising to c^2 s^2 / 6 at c s, then constant,
-  // so a residual pushed out of the window costs the most, not nothing.
   double robust_loss(double r) const {
-    const double s = base_scale();
-    if (!(s > 0.0)) return r * r;
-    const double u = std::fabs(r) / s;
-    if (config_.robust == RobustWeighting::kHuber) {
-      return u <= kHuber ? 0.5 * r * r : s * s * kHuber * (u - 0.5 * kHuber);
-    }
-    constexpr double kTukeyMax = kTukey * kTukey / 6.0;
-    if (u >= kTukey) return kTukeyMax * s * s;
-    const double t = 1.0 - (u / kTukey) * (u / kTukey);
-    return kTukeyMax * (1.0 - t * t * t) * s * s;
+    return train_detail::robust_loss(config_.robust, r, base_scale());
   }
 
   void begin_pass() {
@@ -411,25 +264,22 @@ class Trainer {
   }
 
   // Visits [begin, end) of the pass (sample k·stride_ for visit k): the model evaluated a
-  // block of samples at a time (Aln::evaluate_block), then each sample added to its
-  // responsible piece's sums.
+  // block of samples at a time (trainer_pass.h), then each sample added to its responsible
+  // piece's sums.
   void visit_range(std::size_t begin, std::size_t end) {
-    constexpr std::size_t kBlock = Model::kBlock;
-    std::array<Vec, kBlock> x;
-    std::array<Scalar, kBlock> value;
-    std::array<std::uint16_t, kBlock> piece;
-    for (std::size_t k = begin; k < end; k += kBlock) {
-      const std::size_t n = std::min(kBlock, end - k);
-      for (std::size_t i = 0; i < n; ++i) x[i] = samples_[(k + i) * stride_].x;
-      model_->evaluate_block(std::span<const Vec>(x.data(), n), value, piece);
-      if (check_ == Check::kBins) {
-        for (std::size_t i = 0; i < n; ++i) {
-          visit_bins(samples_[(k + i) * stride_], value[i], piece[i]);
-        }
-        continue;
-      }
-      for (std::size_t i = 0; i < n; ++i) visit(samples_[(k + i) * stride_], value[i], piece[i]);
+    if (check_ == Check::kBins) {
+      train_detail::visit_in_blocks(
+          *model_, samples_, stride_, begin, end,
+          [this](const Sample<Scalar, N>& s, Scalar value, std::uint16_t responsible) {
+            visit_bins(s, value, responsible);
+          });
+      return;
     }
+    train_detail::visit_in_blocks(
+        *model_, samples_, stride_, begin, end,
+        [this](const Sample<Scalar, N>& s, Scalar value, std::uint16_t responsible) {
+          visit(s, value, responsible);
+        });
   }
 
   // One sample, the model's value at it and its responsible piece.
@@ -462,8 +312,8 @@ class Trainer {
       return;
     }
     if constexpr (kSplitBins > 0) {
-      keep_span(s, a);
-      if (gather_bins_) add_to_bins(s, w, r, a);
+      train_detail::keep_span(s, a);
+      if (gather_bins_) train_detail::add_to_bins(s, w, r, a);
     }
   }
 
@@ -473,39 +323,13 @@ class Trainer {
     if constexpr (kSplitBins > 0) {
       const double r = static_cast<double>(s.y) - static_cast<double>(value);
       const double w = static_cast<double>(s.weight) * robust_weight(r, scale_[responsible]);
-      add_to_bins(s, w, r, (*current_)[responsible]);
+      train_detail::add_to_bins(s, w, r, (*current_)[responsible]);
     }
   }
 
   // Hinge splits only where the trainer keeps their sums (SplitBins > 0).
   [[nodiscard]] bool hinges() const {
     return kSplitBins > 0 && config_.split == SplitCandidates::kHinges;
-  }
-
-  // The span of a piece's samples (where the next pass puts its bins).
-  static void keep_span(const Sample<Scalar, N>& s, Accumulator& a) {
-    for (int j = 0; j < N; ++j) {
-      const double xj = static_cast<double>(s.x(j));
-      a.seen_lo(j) = std::min(a.seen_lo(j), xj);
-      a.seen_hi(j) = std::max(a.seen_hi(j), xj);
-    }
-  }
-
-  // A sample's share of its piece's hinge sums: its bin on each input.
-  void add_to_bins(const Sample<Scalar, N>& s, double w, double r, Accumulator& a) const {
-    for (int j = 0; j < N; ++j) {
-      const double xj = static_cast<double>(s.x(j));
-      const double t = (xj - a.bin_lo(j)) * a.bin_scale(j);
-      const std::size_t b =
-          t <= 0.0 ? 0 : std::min(static_cast<std::size_t>(t), kSplitBins - 1);  // NaN-free: t > 0
-      const double u = xj - (a.bin_lo(j) + (static_cast<double>(b) + 0.5) * a.bin_step(j));
-      HingeBin& bin = a.bins[static_cast<std::size_t>(j)][b];
-      bin.sw += w;
-      bin.su += w * u;
-      bin.suu += w * u * u;
-      bin.sr += w * r;
-      bin.sru += w * r * u;
-    }
   }
 
   // The span of each piece's samples in the pass whose sums `acc` holds: where the next
@@ -947,94 +771,21 @@ class Trainer {
     stats_.pieces = model_->piece_count();
   }
 
-  // Splits piece p into kind(A', B) with A' = A + c0 and B = A' + g (x_j - t) on the hinge's
-  // side (g (t - x_j) on the other), so kind(A', B) = A + c0 + max(0, g h) for MAX (g > 0) or
-  // A + c0 + min(0, g h) for MIN (g < 0), h = max(0, +-(x_j - t)): a hinge along input j at
-  // t. Every bin edge of every input, on both sides, is a candidate; c0 and g are the
-  // weighted least-squares fit of the piece's residuals r ~ c0 + g h from the bins' sums,
-  // with g held so that B's weight stays inside its bounds. The candidate is drawn (seeded)
-  // from those that lower the squared error within kSplitTie of the most (neighbouring hinge
-  // positions score almost alike) and its hinge shifted a little (seeded), so another seed
-  // gives another model to retry with.
-  struct SplitChoice {
-    int axis = -1;
-    double t = 0.0;
-    double side = 1.0;
-    double g = 0.0;
-    double c0 = 0.0;
-    double gain = 0.0;
-  };
-  static constexpr double kSplitTie = 0.95;
-
-  static constexpr std::size_t kSplitCandidates =
-      static_cast<std::size_t>(N) * (kSplitBins > 0 ? kSplitBins - 1 : 0) * 2;
-
-  // Every candidate of piece `piece` from its pass's sums `a`, in O(kSplitBins) per input:
-  // the bins' moments about the span's low end, summed from either end, give each edge's
-  // sums of h = max(0, +-(x - t)), h^2 and r h directly.
-  void split_candidates(const Accumulator& a, const PieceType& piece,
-                        std::array<SplitChoice, kSplitCandidates>& out) const {
-    const double sw = a.sw;
-    const double rbar = a.sr / sw;
-    std::size_t k = 0;
-    for (int j = 0; j < N; ++j) {
-      const auto& bins = a.bins[static_cast<std::size_t>(j)];
-      const double step = a.bin_step(j);
-      // Moments of v = x - bin_lo per bin: m0 = sum w, m1 = sum w v, m2 = sum w v^2,
-      // r0 = sum w r, r1 = sum w r v.
-      std::array<std::array<double, 5>, kSplitBins> m{};
-      for (std::size_t b = 0; b < kSplitBins; ++b) {
-        const HingeBin& bin = bins[b];
-        const double c = (static_cast<double>(b) + 0.5) * step;
-        m[b] = {bin.sw, bin.su + c * bin.sw, bin.suu + 2.0 * c * bin.su + c * c * bin.sw, bin.sr,
-                bin.sru + c * bin.sr};
-      }
-      std::array<double, 5> total{};
-      for (const auto& mb : m) {
-        for (std::size_t i = 0; i < 5; ++i) total[i] += mb[i];
-      }
-      std::array<double, 5> left{};  // the bins below the edge
-      const double w_j = static_cast<double>(piece.weight(j));
-      for (std::size_t e = 1; e < kSplitBins; ++e) {
-        for (std::size_t i = 0; i < 5; ++i) left[i] += m[e - 1][i];
-        const double tau = static_cast<double>(e) * step;
-        for (const double side : {1.0, -1.0}) {
-          std::array<double, 5> s{};
-          for (std::size_t i = 0; i < 5; ++i) s[i] = side > 0.0 ? total[i] - left[i] : left[i];
-          const double sh = side * (s[1] - tau * s[0]);
-          const double shh = s[2] - 2.0 * tau * s[1] + tau * tau * s[0];
-          const double srh = side * (s[4] - tau * s[3]);
-          out[k++] = candidate(j, a.bin_lo(j) + tau, side, w_j, sw, rbar, sh, shh, srh, step);
-        }
-      }
-    }
-  }
-
-  // The least-squares hinge r ~ c0 + g h from its sums, g held so that B's weight along j,
-  // w_j + side g, stays inside the bounds; gain = the fall in the squared error.
-  SplitChoice candidate(int j, double t, double side, double w_j, double sw, double rbar, double sh,
-                        double shh, double srh, double step) const {
-    const double hbar = sh / sw;
-    const double var_h = shh / sw - hbar * hbar;
-    if (!(var_h > 1e-12 * step * step)) return SplitChoice{};
-    const double cov = srh / sw - rbar * hbar;
-    const double g_lo = side > 0.0 ? lo(j) - w_j : w_j - hi(j);
-    const double g_hi = side > 0.0 ? hi(j) - w_j : w_j - lo(j);
-    const double g = std::clamp(cov / var_h, std::min(g_lo, 0.0), std::max(g_hi, 0.0));
-    const double gain = sw * (2.0 * g * cov - g * g * var_h);
-    if (!(gain > 0.0) || g == 0.0) return SplitChoice{};
-    return SplitChoice{j, t, side, g, rbar - g * hbar, gain};
-  }
+  // A hinge split's candidates and how they are scored (hinge_split.h).
+  using SplitChoice = train_detail::SplitChoice;
+  static constexpr double kSplitTie = train_detail::kSplitTie;
+  static constexpr std::size_t kSplitCandidates = train_detail::kSplitCandidates<N, SplitBins>;
 
   bool split(std::size_t p, const Accumulator& a) {
     return hinges() ? split_hinge(p, a) : split_v(p, a);
   }
 
+  // Splits piece p by the hinge drawn (seeded) among its best candidates (hinge_split.h).
   bool split_hinge(std::size_t p, const Accumulator& a) {
     if (!(a.sw > 0.0)) return false;
     const PieceType old = model_->piece(p);
     std::array<SplitChoice, kSplitCandidates> candidates{};
-    split_candidates(a, old, candidates);
+    train_detail::split_candidates(*model_, a, old, candidates);
     // The best gain, then a seeded draw among the candidates close to it.
     double top = 0.0;
     for (const SplitChoice& c : candidates) top = std::max(top, c.gain);
