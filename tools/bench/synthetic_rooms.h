@@ -50,7 +50,7 @@ struct RoomSpec {
   double max_range_m = 4.5;  // visibility of the sensor (§3.4)
 };
 
-// How the camera looks at the room (DESIGN.md "Look", thesis §3.4): a pinhole camera on
+// How the camera looks at the room (docs/mission.md "A cycle", thesis §3.4): a pinhole camera on
 // the PTU centre, one image per (pan, tilt) position. Defaults: the thesis's 160×120 image
 // with F = 150 px (56° × 44° field of view, as the sim board's camera), about 15 pan
 // positions, and two tilts — level (walls up to 22° above the horizon) and 0.5 rad down

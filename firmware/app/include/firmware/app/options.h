@@ -1,4 +1,4 @@
-// Options: the firmware's command line (DESIGN.md "Contracts"), parsed without allocation or
+// Options: the firmware's command line (`boticelli --help`, man page boticelli(8)), parsed without allocation or
 // exceptions.
 #pragma once
 

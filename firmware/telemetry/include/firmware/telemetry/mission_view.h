@@ -32,7 +32,7 @@ const char* target_status_name(TargetStatus status);
 class MissionView {
  public:
   virtual ~MissionView() = default;
-  virtual const char* state_name() const = 0;           // e.g. "look", "think", "drive", "idle"
+  virtual const char* state_name() const = 0;           // e.g. "look", "think", "drive", "hold"
   virtual core::Pose2 pose() const = 0;                 // mission frame [m, rad]
   virtual float pan_rad() const = 0;                    // current PTU pan [rad]
   virtual std::uint32_t features() const { return 0; }  // features tracked in the last view

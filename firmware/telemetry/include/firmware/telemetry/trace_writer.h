@@ -1,4 +1,4 @@
-// TraceWriter: the --trace CSV (DESIGN.md contracts) — pose, PTU angles and state, written
+// TraceWriter: the --trace CSV (docs/mission.md, "The trace") — pose, PTU angles and state, written
 // without allocation and renamed into place when closed.
 #pragma once
 
