@@ -13,19 +13,18 @@
 #include <string>
 #include <vector>
 
-#include "algo/core/fixed_vector.h"
 #include "algo/core/geometry.h"
 #include "algo/evidence/reading.h"
 #include "algo/evidence/reading_limits.h"
 #include "algo/image/low_res_frame.h"
 #include "algo/mapping/local_model_builder.h"
-#include "algo/stereo/floor_cue.h"
 #include "algo/stereo/rig.h"
 #include "algo/stereo/stereo_processor.h"
 #include "bench.h"
 #include "bench_worlds.h"
 #include "board_config.h"
-#include "firmware/mission/mission.h"
+#include "firmware/mission/look/look_processor.h"
+#include "firmware/mission/look/look_scan.h"
 #include "firmware/mission/params/mission_params.h"
 #include "firmware/mission/target/target_tracker.h"
 #include "firmware/telemetry/snapshot.h"
@@ -45,11 +44,6 @@ constexpr double kTargetViewM = 3.5;      // target counted "in view" up to this
 constexpr float kTargetMarginPx = 16.0F;  // ... and this far inside the full-resolution image
 constexpr std::size_t kVisibilityRays = 720;
 
-using Readings = core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFeatures>;
-using FloorObstacles =
-    core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFloorObstacles>;
-using FloorFree = core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFloorFree>;
-
 // Large objects live outside the stack.
 hal::sim::World g_world;
 hal::sim::TextureBank g_bank;
@@ -57,11 +51,6 @@ hal::sim::SimWorld g_sim;
 hal::sim::Renderer g_renderer;
 image::LowResFrame g_first;
 image::LowResFrame g_second;
-Readings g_features;
-FloorObstacles g_floor_obstacles;
-FloorFree g_floor_free;
-core::FixedVector<float, firmware::mission::kMaxLookFloorFree> g_floor_free_near;
-core::FixedVector<evidence::Reading, firmware::mission::kMaxLookFloorBlocked> g_floor_blocked;
 mapping::LocalModelBuilder g_builder;
 
 firmware::SnapshotWriter g_snapshots;
@@ -72,7 +61,8 @@ std::uint32_t g_look_number = 0;
 // BOTICELLI_LOOK_SNAPSHOTS=DIR: a picture of every look whose free polygon is not wholly free
 // or whose navigable polygon's disc touches an obstacle (readings, polygons, the true walls),
 // named by the look's number in the run.
-void snapshot_look(std::uint32_t number, const core::Pose2& pose, const mapping::LocalMap& map,
+void snapshot_look(std::uint32_t number, const core::Pose2& pose,
+                   const firmware::mission::LookReadings& look, const mapping::LocalMap& map,
                    float radius_m) {
   static std::vector<firmware::SnapshotReading> readings;
   static std::vector<core::Point2> free_poly, nav_poly;
@@ -83,8 +73,8 @@ void snapshot_look(std::uint32_t number, const core::Pose2& pose, const mapping:
     const core::Point2 w = core::to_world(pose, evidence::floor_point_m(r));
     readings.push_back({w.x_m, w.y_m, r.m});
   };
-  for (const evidence::Reading& r : g_features) add(r);
-  for (const evidence::Reading& r : g_floor_obstacles) add(r);
+  for (const evidence::Reading& r : look.features) add(r);
+  for (const evidence::Reading& r : look.floor_obstacles) add(r);
   free_poly.clear();
   nav_poly.clear();
   for (std::size_t k = 0; k < map.free.vertex_count(); ++k)
@@ -350,9 +340,10 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
   const firmware::BoardConfig config = boards::sim::make_config();
   const firmware::mission::MissionParams params = firmware::mission::make_mission_params(config);
   const boards::sim::SimSettings settings = boards::sim::make_settings(config, 1);
-  static const stereo::RigModel rig(params.rig);
-  static stereo::StereoProcessor stereo(rig, params.stereo);
-  static stereo::FloorCue floor_cue(rig);
+  // The mission's look pipeline: stereo, target fixes and the floor cue of each view.
+  static firmware::mission::LookProcessor look(params.rig, params.stereo,
+                                               params.model.close_blocked_rays);
+  const stereo::RigModel& rig = look.rig();
 
   const std::string path = dir + "/" + name + ".sdf";
   char error[256] = "";
@@ -364,9 +355,6 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     return 1;
   }
   const hal::PanTiltLimits lim = settings.physics.ptu.limits;
-  // As Mission::blocked_output: blocked walks are kept only if the Think stage uses them.
-  core::FixedVectorBase<evidence::Reading>* const blocked =
-      params.model.close_blocked_rays ? &g_floor_blocked : nullptr;
   const std::vector<firmware::mission::LookView> views = look_views(params, lim);
   const stereo::CameraIntrinsics& cam = rig.camera();
   const std::size_t stride = std::size_t{2} * cam.width_px;
@@ -398,20 +386,14 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
   WorldStats st;
   std::uint32_t frame_index = 0;
   for (const core::Pose2& pose : pose_list) {
-    g_features.clear();
-    g_floor_obstacles.clear();
-    g_floor_free.clear();
-    g_floor_free_near.clear();
-    g_floor_blocked.clear();
-    floor_cue.reset();  // the mission's first look: nothing known about the floor yet
+    look.reset();  // the mission's first look: nothing known about the floor yet
     firmware::mission::TargetTracker tracker;
     tracker.configure(params.target);
     bool pose_in_view = false;
-    std::uint32_t view_number = 0;
     double render_ns = 0, stereo_ns = 0, target_ns = 0, floor_ns = 0;
-    stereo::TargetSighting last_sighting;  // as Mission::process_view: across pans
-    hal::sim::RigidTransform last_sighting_pose;
-    for (const firmware::mission::LookView& view : views) {
+    hal::sim::RigidTransform last_sighting_pose;  // the first frame of the look's last sighting
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const firmware::mission::LookView& view = views[v];
       stereo::PairPose pp;
       pp.pan_rad = quantise(view.pan_rad, lim.pan_resolution_rad);
       pp.first_tilt_rad = quantise(view.tilt_rad, lim.tilt_resolution_rad);
@@ -435,99 +417,92 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
                                      params.rig.downsample_factor, g_second);
       }
       render_ns += static_cast<double>(cpu_ns() - t0);
-      if (view.pair) {
+
+      // The view's parts in order, as the mission's background runs them, each timed.
+      const firmware::mission::GrabbedView grabbed{g_first, g_second, pp, view.pair, v, false};
+      firmware::mission::TargetFixes fixes;
+      bool done = false;
+      for (std::uint8_t part = 0; !done; ++part) {
+        const auto p = static_cast<firmware::mission::ViewPart>(part);
         t0 = cpu_ns();
-        (void)stereo.process(g_first, g_second, pp, g_features);
-        stereo_ns += static_cast<double>(cpu_ns() - t0);
-        // Range error of this pair's points against the ray caster along the same line of
-        // sight from the first optical centre.
-        for (const stereo::StereoPoint& sp : stereo.points()) {
-          const core::Point2 w = core::to_world(pose, {sp.point_ptu_m.x(), sp.point_ptu_m.y()});
-          const Eigen::Vector3f p(w.x_m, w.y_m, sp.point_ptu_m.z() + params.rig.ptu_height_m);
-          const Eigen::Vector3f d = p - first_pose.translation_m;
-          std::size_t surface = 0;
-          float t = 0.0F;
-          if (!hal::sim::cast_ray(g_world, first_pose.translation_m, d, surface, t)) continue;
-          const double err =
-              std::fabs(static_cast<double>(d.norm()) * (1.0 - static_cast<double>(t)));
-          st.range_error_m.push_back(err);
-          if (sp.range_error_m > 0.0F)
-            st.range_error_rel.push_back(err / static_cast<double>(sp.range_error_m));
+        done = look.process(p, grabbed, fixes);
+        const auto ns = static_cast<double>(cpu_ns() - t0);
+        switch (p) {
+          case firmware::mission::ViewPart::kStereo:
+            stereo_ns += ns;
+            break;
+          case firmware::mission::ViewPart::kTarget:
+            target_ns += ns;
+            break;
+          case firmware::mission::ViewPart::kFloorFirst:
+          case firmware::mission::ViewPart::kFloorSecond:
+            floor_ns += ns;
+            break;
         }
-        t0 = cpu_ns();
-        const stereo::TargetFix fix = stereo.locate_target(g_first, g_second, pp);
-        target_ns += static_cast<double>(cpu_ns() - t0);
-        const bool in_image = target_in_image(first_pose, second_pose, cam, kTargetMarginPx);
-        const bool anywhere = target_in_image(first_pose, second_pose, cam, -kTargetMarginPx);
-        const bool in_view =
-            in_image &&
-            static_cast<double>((g_world.target_point_m - first_pose.translation_m).norm()) <=
-                kTargetViewM;
-        st.target_views += in_view ? 1U : 0U;
-        pose_in_view = pose_in_view || in_view;
-        stereo::TargetFix across;
-        bool across_in_view = false;
-        bool across_anywhere = false;
-        if (fix.first.found) {
-          const stereo::TargetSighting here{fix.first, pp.pan_rad, pp.first_tilt_rad};
-          t0 = cpu_ns();
-          across = stereo.locate_target_across(last_sighting, here);
-          target_ns += static_cast<double>(cpu_ns() - t0);
+        if (!view.pair) continue;
+        if (p == firmware::mission::ViewPart::kStereo) {
+          // Range error of this pair's points against the ray caster along the same line of
+          // sight from the first optical centre.
+          for (const stereo::StereoPoint& sp : look.stereo().points()) {
+            const core::Point2 w = core::to_world(pose, {sp.point_ptu_m.x(), sp.point_ptu_m.y()});
+            const Eigen::Vector3f pt(w.x_m, w.y_m, sp.point_ptu_m.z() + params.rig.ptu_height_m);
+            const Eigen::Vector3f d = pt - first_pose.translation_m;
+            std::size_t surface = 0;
+            float t = 0.0F;
+            if (!hal::sim::cast_ray(g_world, first_pose.translation_m, d, surface, t)) continue;
+            const double err =
+                std::fabs(static_cast<double>(d.norm()) * (1.0 - static_cast<double>(t)));
+            st.range_error_m.push_back(err);
+            if (sp.range_error_m > 0.0F)
+              st.range_error_rel.push_back(err / static_cast<double>(sp.range_error_m));
+          }
+        } else if (p == firmware::mission::ViewPart::kTarget) {
+          const stereo::TargetFix& fix = fixes.pair;
+          const stereo::TargetFix& across = fixes.across;
+          const bool in_image = target_in_image(first_pose, second_pose, cam, kTargetMarginPx);
+          const bool anywhere = target_in_image(first_pose, second_pose, cam, -kTargetMarginPx);
+          const bool in_view =
+              in_image &&
+              static_cast<double>((g_world.target_point_m - first_pose.translation_m).norm()) <=
+                  kTargetViewM;
+          st.target_views += in_view ? 1U : 0U;
+          pose_in_view = pose_in_view || in_view;
+          // The look's fixes in the tracker as the mission adds them: the pair's, then the
+          // one across pans, with the view's id (the first cycle's).
+          const auto id = static_cast<std::uint32_t>(v);
+          if (fix.found) {
+            const Eigen::Vector3f pt =
+                firmware::mission::fix_in_world(pose, fix, params.rig.ptu_height_m);
+            tracker.add(pt, fix.confidence, id, fix.range_error_m);
+            const double e = (pt - g_world.target_point_m).norm();
+            if (in_view) {
+              ++st.target_found;
+              st.target_error_m.push_back(e);
+            } else if (anywhere) {
+              ++st.target_far;  // beyond kTargetViewM or at the image edge: counted apart
+              st.target_far_error_m.push_back(e);
+            } else {
+              ++st.target_false;  // not in both frames (16 px slack) or hidden: false
+            }
+          }
           if (across.found) {
+            const Eigen::Vector3f pt =
+                firmware::mission::fix_in_world(pose, across, params.rig.ptu_height_m);
+            tracker.add(pt, across.confidence, id, across.range_error_m);
+            const double e = (pt - g_world.target_point_m).norm();
             // In view, or false, as for a pair: the two first frames.
-            across_in_view =
-                target_in_image(last_sighting_pose, first_pose, cam, kTargetMarginPx) &&
+            if (target_in_image(last_sighting_pose, first_pose, cam, kTargetMarginPx) &&
                 static_cast<double>((g_world.target_point_m - first_pose.translation_m).norm()) <=
-                    kTargetViewM;
-            across_anywhere =
-                target_in_image(last_sighting_pose, first_pose, cam, -kTargetMarginPx);
+                    kTargetViewM) {
+              st.target_across_error_m.push_back(e);
+            } else if (!target_in_image(last_sighting_pose, first_pose, cam, -kTargetMarginPx)) {
+              ++st.target_false;
+            }
           }
-          last_sighting = here;
-          last_sighting_pose = first_pose;
-        }
-        // PTU frame → world, as Mission::add_target_fix.
-        const auto in_world = [&](const Eigen::Vector3f& ptu) {
-          const core::Point2 w = core::to_world(pose, {ptu.x(), ptu.y()});
-          return Eigen::Vector3f(w.x_m, w.y_m, ptu.z() + params.rig.ptu_height_m);
-        };
-        if (across.found) {
-          const Eigen::Vector3f p = in_world(across.point_ptu_m);
-          tracker.add(p, across.confidence, view_number, across.range_error_m);
-          const double e = (p - g_world.target_point_m).norm();
-          if (across_in_view) {
-            st.target_across_error_m.push_back(e);
-          } else if (!across_anywhere) {
-            ++st.target_false;
-          }
-        }
-        if (fix.found) {
-          const Eigen::Vector3f p = in_world(fix.point_ptu_m);
-          const double e = (p - g_world.target_point_m).norm();
-          tracker.add(p, fix.confidence, view_number, fix.range_error_m);
-          if (in_view) {
-            ++st.target_found;
-            st.target_error_m.push_back(e);
-          } else if (anywhere) {
-            ++st.target_far;  // beyond kTargetViewM or at the image edge: counted apart
-            st.target_far_error_m.push_back(e);
-          } else {
-            ++st.target_false;  // not in both frames (16 px slack) or hidden: false
-          }
+          // The processor pairs the next sighting across pans with this one.
+          if (fix.first.found) last_sighting_pose = first_pose;
         }
       }
-      ++view_number;
-      // The floor cue as Mission::process_view: learn and walk the first frame, and a low
-      // pair's second frame too (it sees nearer floor than the first).
-      t0 = cpu_ns();
-      (void)floor_cue.learn(g_first, pp.pan_rad, pp.first_tilt_rad);
-      (void)floor_cue.process(g_first, pp.pan_rad, pp.first_tilt_rad, g_floor_obstacles,
-                              g_floor_free, &g_floor_free_near, blocked);
-      if (view.pair && pp.second_tilt_rad < -0.3F) {
-        (void)floor_cue.learn(g_second, pp.pan_rad, pp.second_tilt_rad);
-        (void)floor_cue.process(g_second, pp.pan_rad, pp.second_tilt_rad, g_floor_obstacles,
-                                g_floor_free, &g_floor_free_near, blocked);
-      }
-      floor_ns += static_cast<double>(cpu_ns() - t0);
     }
     if (pose_in_view) {
       ++st.pose_target_views;
@@ -539,20 +514,24 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
         st.pose_target_error_m.push_back((est - g_world.target_point_m).norm());
       }
     }
+    const firmware::mission::LookReadings& readings = look.readings();
     std::size_t weak = 0;
-    for (const evidence::Reading& r : g_features) weak += r.m < 0.6F ? 1U : 0U;
-    st.readings.push_back(static_cast<double>(g_features.size()));
-    st.weak_share.push_back(g_features.empty() ? 0.0
-                                               : static_cast<double>(weak) /
-                                                     static_cast<double>(g_features.size()));
-    st.floor_obstacles.push_back(static_cast<double>(g_floor_obstacles.size()));
-    st.floor_free.push_back(static_cast<double>(g_floor_free.size()));
+    for (const evidence::Reading& r : readings.features) weak += r.m < 0.6F ? 1U : 0U;
+    st.readings.push_back(static_cast<double>(readings.features.size()));
+    st.weak_share.push_back(readings.features.empty()
+                                ? 0.0
+                                : static_cast<double>(weak) /
+                                      static_cast<double>(readings.features.size()));
+    st.floor_obstacles.push_back(static_cast<double>(readings.floor_obstacles.size()));
+    st.floor_free.push_back(static_cast<double>(readings.floor_free.size()));
 
-    // Think, as Mission::begin_think: filter by the reading limits, then the local model.
+    // Think: the look ends (features filtered by the reading limits), then the local model
+    // from its readings (the first look: no prior look's free polygon).
     const std::int64_t t0 = cpu_ns();
-    (void)evidence::filter_readings(g_features, params.limits);
-    g_builder.start(params.model, g_features.span(), g_floor_obstacles.span(), g_floor_free.span(),
-                    g_floor_free_near.span(), g_floor_blocked.span());
+    look.end_look(params.limits);
+    g_builder.start(params.model, readings.features.span(), readings.floor_obstacles.span(),
+                    readings.floor_free.span(), readings.floor_free_near.span(),
+                    readings.floor_blocked.span());
     g_builder.run();
     st.think_ms.push_back(static_cast<double>(cpu_ns() - t0) * 1e-6);
     st.pieces.push_back(static_cast<double>(g_builder.stats().pieces));
@@ -573,7 +552,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
                    name.c_str(), g_look_number, static_cast<double>(pose.x_m),
                    static_cast<double>(pose.y_m), static_cast<double>(pose.yaw_rad), q.safety,
                    q.nav_safety);
-      snapshot_look(g_look_number, pose, g_builder.map(), radius);
+      snapshot_look(g_look_number, pose, readings, g_builder.map(), radius);
     }
     ++g_look_number;
     st.safety.push_back(q.safety);

@@ -66,6 +66,12 @@ class LookProcessor {
   // The look is complete: drops the features outside the reading limits (the Think stage's
   // input).
   void end_look(const evidence::ReadingLimits& limits);
+  // A recorded look replayed (the look regression tests): begin_look(), and the caller fills
+  // the lists returned in place of process(); end_look() then as for a look taken.
+  LookReadings& begin_replay() {
+    begin_look();
+    return readings_;
+  }
 
   [[nodiscard]] const LookReadings& readings() const { return readings_; }
   // The stereo points of the last pair processed (PTU frame).
