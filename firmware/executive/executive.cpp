@@ -122,12 +122,12 @@ void Executive::run_background(std::uint64_t now_us) {
     deadline_us = now_us + config_.background_max_slice_us;
   }
   SliceBudget budget(clock_, deadline_us, config_.background_units_per_slice);
-  const StepResult result = background_->step(budget);
+  const SliceResult result = background_->run_slice(budget);
   const std::uint64_t after_us = clock_.now_us();
   ++frame_.background_slices;
   frame_.background_used_us += after_us - now_us;
   if (after_us > deadline_us) ++frame_.background_overruns;
-  if (result == StepResult::kDone) ++frame_.background_done;
+  if (result == SliceResult::kDone) ++frame_.background_done;
 }
 
 bool Executive::all_healthy() const {

@@ -451,18 +451,18 @@ void Mission::write_trace(std::uint64_t now_us) {
 
 // ---------------------------------------------------------------- background
 
-StepResult Mission::step(SliceBudget& budget) {
+SliceResult Mission::run_slice(SliceBudget& budget) {
   // The last cycle's picture first: it shows that cycle's readings, model and value function.
   if (snapshot_step_ != SnapshotStep::kIdle) {
-    if (!budget.next_unit()) return StepResult::kMore;
+    if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(nullptr, longest(Unit::kSnapshot));
     snapshot_step();
-    return StepResult::kMore;
+    return SliceResult::kMore;
   }
-  if (phase_ == Phase::kDone) return StepResult::kMore;
+  if (phase_ == Phase::kDone) return SliceResult::kMore;
   // The view just grabbed: stereo, target, floor cue on each frame (a unit each).
   if (phase_ == Phase::kLook && scan_.view_ready()) {
-    if (!budget.next_unit()) return StepResult::kMore;
+    if (!budget.next_unit()) return SliceResult::kMore;
     if (look_lists_stale_) {
       look_.begin_look();  // frames kept from the last look were seen from elsewhere
       look_lists_stale_ = false;
@@ -471,83 +471,83 @@ StepResult Mission::step(SliceBudget& budget) {
       view_part_ = 0;
       scan_.view_processed();
     }
-    return StepResult::kMore;
+    return SliceResult::kMore;
   }
-  if (phase_ == Phase::kThink) return step_think(budget);
-  if (phase_ == Phase::kPlan) return step_plan(budget);
-  return StepResult::kMore;
+  if (phase_ == Phase::kThink) return think_slice(budget);
+  if (phase_ == Phase::kPlan) return plan_slice(budget);
+  return SliceResult::kMore;
 }
 
-StepResult Mission::step_think(SliceBudget& budget) {
+SliceResult Mission::think_slice(SliceBudget& budget) {
   double* const think_cpu = &cpu_s_[1];
   if (think_step_ == ThinkStep::kBegin) {
-    if (!budget.next_unit()) return StepResult::kMore;
+    if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(think_cpu, longest(Unit::kModel));
     begin_think();
   }
   while (!map_.done()) {
-    if (!budget.next_unit()) return StepResult::kMore;
+    if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(think_cpu, longest(Unit::kModel));
     map_.step();
   }
-  if (!budget.next_unit()) return StepResult::kMore;
+  if (!budget.next_unit()) return SliceResult::kMore;
   CpuScope cpu(think_cpu, longest(Unit::kMap));
   after_think();
-  return StepResult::kMore;
+  return SliceResult::kMore;
 }
 
-StepResult Mission::step_plan(SliceBudget& budget) {
+SliceResult Mission::plan_slice(SliceBudget& budget) {
   double* const plan_cpu = &cpu_s_[2];
   switch (plan_step_) {
     case PlanStep::kChoose:
     case PlanStep::kChooseNextOnLook: {
       // The step on the value function, one action per unit.
       while (!planner_.choice_done()) {
-        if (!budget.next_unit()) return StepResult::kMore;
+        if (!budget.next_unit()) return SliceResult::kMore;
         CpuScope cpu(plan_cpu, longest(Unit::kStep));
         planner_.choose_heading();
       }
-      if (!budget.next_unit()) return StepResult::kMore;
+      if (!budget.next_unit()) return SliceResult::kMore;
       CpuScope cpu(plan_cpu, longest(Unit::kStep));
       if (plan_step_ == PlanStep::kChooseNextOnLook) {
         finish_next_step_on_look();
       } else {
         after_step_choice();
       }
-      return StepResult::kDone;
+      return SliceResult::kDone;
     }
     case PlanStep::kNextOnLook: {
-      if (!budget.next_unit()) return StepResult::kMore;
+      if (!budget.next_unit()) return SliceResult::kMore;
       CpuScope cpu(plan_cpu, longest(Unit::kStep));
       if (planner_.begin_next_on_look(pose_.pose(), look_pose_, map_.local().navigable)) {
         plan_step_ = PlanStep::kChooseNextOnLook;
-        return StepResult::kMore;
+        return SliceResult::kMore;
       }
       end_cycle("step done");
       if (phase_ != Phase::kDone) begin_look(now_us_);
-      return StepResult::kDone;
+      return SliceResult::kDone;
     }
     case PlanStep::kValueStart:
     case PlanStep::kValue:
       break;
   }
   if (plan_step_ == PlanStep::kValueStart) {
-    if (!budget.next_unit()) return StepResult::kMore;
+    if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(plan_cpu, longest(Unit::kPlanStart));
     begin_plan();
   }
   while (!planner_.value_done()) {
-    if (!budget.next_unit()) return StepResult::kMore;
+    if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(plan_cpu, longest(Unit::kValue));
     planner_.value_step();
   }
-  if (!budget.next_unit()) return StepResult::kMore;
+  if (!budget.next_unit()) return SliceResult::kMore;
   CpuScope cpu(plan_cpu, longest(Unit::kStep));
   if (start_step_choice()) {
     plan_step_ = PlanStep::kChoose;
-    return StepResult::kMore;
+    return SliceResult::kMore;
   }
-  return StepResult::kDone;
+  return SliceResult::kDone;
 }
 
 bool Mission::process_view(ViewPart part) {

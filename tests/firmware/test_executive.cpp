@@ -49,7 +49,7 @@ class CountingWork final : public BackgroundWork {
  public:
   CountingWork(FakeClock& clock, std::uint64_t units, std::uint64_t unit_us)
       : clock_(clock), units_(units), unit_us_(unit_us) {}
-  StepResult step(SliceBudget& budget) override {
+  SliceResult run_slice(SliceBudget& budget) override {
     ++slices;
     while (done_units < units_ && budget.next_unit()) {
       clock_.advance_us(unit_us_);
@@ -59,9 +59,9 @@ class CountingWork final : public BackgroundWork {
     if (done_units == units_) {
       done_units = 0;  // next job
       ++jobs;
-      return StepResult::kDone;
+      return SliceResult::kDone;
     }
-    return StepResult::kMore;
+    return SliceResult::kMore;
   }
   std::uint64_t done_units = 0;
   std::uint64_t total_units = 0;
@@ -265,9 +265,9 @@ TEST(Executive, CountsABackgroundSliceThatRunsPastItsDeadline) {
   class Greedy final : public BackgroundWork {
    public:
     explicit Greedy(FakeClock& c) : clock(c) {}
-    StepResult step(SliceBudget&) override {
+    SliceResult run_slice(SliceBudget&) override {
       clock.advance_us(9500);  // ignores the budget
-      return StepResult::kMore;
+      return SliceResult::kMore;
     }
     FakeClock& clock;
   } greedy(clock);
@@ -346,7 +346,7 @@ TEST(EstopInTheExecutive, StopsTheBaseWithinOneFrameWhileTheBackgroundUsesEveryF
   class PressingHog final : public BackgroundWork {
    public:
     PressingHog(FakeClock& c, FakeInput& b) : clock(c), button(b) {}
-    StepResult step(SliceBudget& budget) override {
+    SliceResult run_slice(SliceBudget& budget) override {
       while (budget.next_unit()) {
         clock.advance_us(37);
         ++units;
@@ -356,7 +356,7 @@ TEST(EstopInTheExecutive, StopsTheBaseWithinOneFrameWhileTheBackgroundUsesEveryF
           press_at_us = 0;
         }
       }
-      return StepResult::kMore;
+      return SliceResult::kMore;
     }
     FakeClock& clock;
     FakeInput& button;

@@ -43,9 +43,9 @@ class CheckpointWork final : public MissionView, public BackgroundWork {
                  StateSaver& saver, std::uint32_t period_us)
       : base_(base), clock_(clock), state_(state), saver_(saver), period_us_(period_us) {}
   void start(std::uint64_t now_us) { next_cycle_us_ = now_us + period_us_; }
-  StepResult step(SliceBudget& budget) override {
+  SliceResult run_slice(SliceBudget& budget) override {
     if (submit_pending_ && saver_.submit(state_)) submit_pending_ = false;
-    if (clock_.now_us() < next_cycle_us_ || !budget.next_unit()) return StepResult::kMore;
+    if (clock_.now_us() < next_cycle_us_ || !budget.next_unit()) return SliceResult::kMore;
     next_cycle_us_ += period_us_;
     ++state_.cycle;
     ++cycles_this_run_;
@@ -54,7 +54,7 @@ class CheckpointWork final : public MissionView, public BackgroundWork {
     line.appendf("checkpoint x_m=%.3f", static_cast<double>(state_.pose.x_m));
     state_.add_log(state_.cycle, line.view());
     submit_pending_ = !saver_.submit(state_);
-    return StepResult::kDone;
+    return SliceResult::kDone;
   }
   const char* state_name() const override { return "checkpoint"; }
   boticelli::core::Pose2 pose() const override {

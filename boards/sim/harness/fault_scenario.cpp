@@ -223,9 +223,9 @@ class StandIn final : public fw::Task,
     const double lag_ms = static_cast<double>(now_us_ - frame.timestamp_us) * 1e-3;
     if (lag_ms > worst_lag_ms_) worst_lag_ms_ = lag_ms;
   }
-  fw::StepResult step(fw::SliceBudget& budget) override {
+  fw::SliceResult run_slice(fw::SliceBudget& budget) override {
     if (saver_ == nullptr || now_us_ < next_save_us_ || !budget.next_unit()) {
-      return fw::StepResult::kMore;
+      return fw::SliceResult::kMore;
     }
     next_save_us_ = now_us_ + 500000U;
     ++state_.cycle;
@@ -233,7 +233,7 @@ class StandIn final : public fw::Task,
     state_.pose = {static_cast<float>(o.x_m), static_cast<float>(o.y_m),
                    static_cast<float>(o.yaw_rad)};
     (void)saver_->submit(state_);  // no writer thread on the sim board: saved here
-    return fw::StepResult::kDone;
+    return fw::SliceResult::kDone;
   }
   const char* state_name() const override { return "exercise"; }
   core::Pose2 pose() const override {

@@ -59,17 +59,19 @@ class SliceBudget {
   std::uint32_t units_ = 0;
 };
 
-enum class StepResult : std::uint8_t {
-  kMore,  // the job is not finished; step() is called again in a later slice
+enum class SliceResult : std::uint8_t {
+  kMore,  // the job is not finished; run_slice() is called again in a later slice
   kDone,  // one job (e.g. a mission cycle) finished in this slice
 };
 
-// Resumable long work (ALN training, map extraction, planning) run in the frames' spare time.
-// step() keeps its own progress between calls and must return when the budget says so.
+// Resumable long work (ALN training, map extraction, planning) run in the frames' spare time,
+// a slice per frame. Words: a *slice* is one frame's spare time, a *unit* one bounded piece of
+// work within it (SliceBudget::next_unit), a *step* the robot's straight move (the thesis's).
+// run_slice() keeps its own progress between calls and must return when the budget says so.
 class BackgroundWork {
  public:
   virtual ~BackgroundWork() = default;
-  virtual StepResult step(SliceBudget& budget) = 0;
+  virtual SliceResult run_slice(SliceBudget& budget) = 0;
 
  protected:
   BackgroundWork() = default;

@@ -93,7 +93,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // The mission task's body, every minor frame: PTU scan, frames, driving, holds, trace.
   void control(std::uint64_t now_us);
   // Background slices: stereo per view, Think, Plan.
-  StepResult step(SliceBudget& budget) override;
+  SliceResult run_slice(SliceBudget& budget) override;
   // Camera task: keeps a settled frame when the look wants one.
   void on_frame(const hal::Frame& frame) override { scan_.on_frame(frame); }
   bool wants_frames() const override { return scan_.wants_frames(); }
@@ -168,8 +168,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // The pair aimed at the target's estimate (or its unconfirmed candidate) after the scan.
   [[nodiscard]] AimedPair aim_at_target() const;
   void add_target_fix(const stereo::TargetFix& fix, std::uint32_t view);
-  StepResult step_think(SliceBudget& budget);
-  StepResult step_plan(SliceBudget& budget);
+  SliceResult think_slice(SliceBudget& budget);
+  SliceResult plan_slice(SliceBudget& budget);
   void begin_think();
   void after_think();
   void begin_plan();
