@@ -1,0 +1,96 @@
+// Tests of the PoseKeeper: the mission frame anchored against the base's odometry.
+#include <cmath>
+
+#include "algo/core/angles.h"
+#include "algo/core/geometry.h"
+#include "firmware/mission/localize/pose_keeper.h"
+#include "firmware_fakes.h"
+
+#include "CppUTest/TestHarness.h"
+
+using boticelli::core::kPi;
+using boticelli::core::Pose2;
+using boticelli::firmware::mission::PoseKeeper;
+using boticelli::test::FakeBase;
+
+namespace {
+
+constexpr double kTol = 1e-5;
+
+void set_odometry(FakeBase& base, double x_m, double y_m, double yaw_rad) {
+  base.odometry_value.x_m = x_m;
+  base.odometry_value.y_m = y_m;
+  base.odometry_value.yaw_rad = yaw_rad;
+}
+
+void check_pose(const Pose2& expected, const Pose2& actual) {
+  DOUBLES_EQUAL(expected.x_m, actual.x_m, kTol);
+  DOUBLES_EQUAL(expected.y_m, actual.y_m, kTol);
+  DOUBLES_EQUAL(expected.yaw_rad, actual.yaw_rad, kTol);
+}
+
+}  // namespace
+
+TEST_GROUP(PoseKeeper) {
+  FakeBase base;
+  PoseKeeper keeper{base};
+};
+
+TEST(PoseKeeper, ANewMissionAnchoredAtTheOdometrysOriginReadsTheOdometryAsItIs) {
+  keeper.anchor({});
+  set_odometry(base, 1.5, -0.5, 0.7);
+  check_pose({1.5F, -0.5F, 0.7F}, keeper.pose());
+}
+
+TEST(PoseKeeper, AnchoredAtASavedPoseThePoseFollowsTheOdometryComposedOntoIt) {
+  keeper.anchor({1.0F, 2.0F, kPi<float> / 2.0F});
+  // 1 m forward and 0.3 rad to the left in the odometry: 1 m along the saved heading (+y).
+  set_odometry(base, 1.0, 0.0, 0.3);
+  check_pose({1.0F, 3.0F, kPi<float> / 2.0F + 0.3F}, keeper.pose());
+  // 1 m to the odometry's left: along −x in the mission frame.
+  set_odometry(base, 0.0, 1.0, 0.0);
+  check_pose({0.0F, 2.0F, kPi<float> / 2.0F}, keeper.pose());
+}
+
+TEST(PoseKeeper, AnchoringWhileTheOdometryIsAwayFromItsOriginPutsTheRobotAtTheAnchorNow) {
+  // The base reports a pose already (it was ready before the mission started).
+  set_odometry(base, 2.0, -1.0, 0.5);
+  keeper.anchor({1.0F, 2.0F, kPi<float> / 2.0F});
+  check_pose({1.0F, 2.0F, kPi<float> / 2.0F}, keeper.pose());
+  // 1 m forward along the odometry's heading is 1 m forward along the anchor's; a turn in
+  // place turns it by as much.
+  set_odometry(base, 2.0 + std::cos(0.5), -1.0 + std::sin(0.5), 0.5 - 0.25);
+  check_pose({1.0F, 3.0F, kPi<float> / 2.0F - 0.25F}, keeper.pose());
+}
+
+TEST(PoseKeeper, AResumedMissionCarriesOnInTheSavedFrameWhileTheOdometryRestartsAtZero) {
+  // The first run: a new mission, the robot drives to where the state is saved.
+  keeper.anchor({});
+  set_odometry(base, 1.0, 1.0, kPi<double> / 4.0);
+  const Pose2 saved = keeper.pose();
+  // The second run: a fresh base whose odometry starts at zero, anchored at the saved pose.
+  FakeBase restarted;
+  PoseKeeper resumed{restarted};
+  resumed.anchor(saved);
+  check_pose(saved, resumed.pose());
+  // Half a metre forward goes on along the saved heading, in the first run's frame.
+  set_odometry(restarted, 0.5, 0.0, 0.0);
+  const float d = 0.5F / std::sqrt(2.0F);
+  check_pose({1.0F + d, 1.0F + d, kPi<float> / 4.0F}, resumed.pose());
+}
+
+TEST(PoseKeeper, TheMissionFramesOriginInTheWorldInvertsTheAnchor) {
+  // The mission frame's origin lies 1 m behind the robot's start, turned by a quarter turn.
+  keeper.anchor({1.0F, 0.0F, kPi<float> / 2.0F});
+  // The odometry's origin stands at the world's origin: the frame's origin is the anchor's
+  // inverse, (0, 1) and turned back by a quarter turn.
+  check_pose({0.0F, 1.0F, -kPi<float> / 2.0F}, keeper.frame_origin_in_world({}));
+  // Anywhere: the robot's world pose is its mission pose seen from the frame's origin, and
+  // its odometry seen from the odometry's origin.
+  set_odometry(base, 0.8, -0.4, 1.1);
+  const Pose2 odometry_origin{3.0F, -2.0F, 0.6F};
+  const Pose2 via_mission =
+      boticelli::core::compose(keeper.frame_origin_in_world(odometry_origin), keeper.pose());
+  const Pose2 via_odometry = boticelli::core::compose(odometry_origin, {0.8F, -0.4F, 1.1F});
+  check_pose(via_odometry, via_mission);
+}

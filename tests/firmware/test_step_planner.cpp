@@ -1,0 +1,192 @@
+// Tests of the StepPlanner: the step's outcome on hand-made polygons and maps (turning round,
+// no safe step, backing off along the breadcrumbs, giving up, the next step on the same look).
+#include <cstddef>
+
+#include "algo/core/geometry.h"
+#include "algo/mapping/map_points.h"
+#include "algo/mapping/star_polygon.h"
+#include "algo/planning/planner.h"
+#include "firmware/common/board_config.h"
+#include "firmware/mission/drive/breadcrumbs.h"
+#include "firmware/mission/params/mission_params.h"
+#include "firmware/mission/plan/step_planner.h"
+
+#include "CppUTest/TestHarness.h"
+
+using boticelli::core::Point2;
+using boticelli::core::Pose2;
+using boticelli::core::to_robot;
+using boticelli::firmware::BoardConfig;
+using boticelli::mapping::GlobalMap;
+using boticelli::mapping::StarPolygon;
+using boticelli::planning::StepKind;
+using namespace boticelli::firmware::mission;
+
+namespace {
+
+StarPolygon disc(float radius_m) {
+  StarPolygon p;
+  p.fill(radius_m);
+  return p;
+}
+
+}  // namespace
+
+TEST_GROUP(StepPlanner) {
+  const MissionParams params = make_mission_params(BoardConfig{});
+  StepPlanner planner{params};
+  GlobalMap map;
+  Breadcrumbs crumbs;
+  const StarPolygon look_disc = disc(1.0F);  // the look's navigable polygon: a 1 m disc
+  const Pose2 origin{};
+
+  void setup() override {
+    planner.clear();
+  }
+
+  void choose() {
+    while (!planner.choice_done()) planner.choose_heading();
+  }
+  // One cycle's step from `here` on the look taken at `look` (something left to explore).
+  StepOutcome cycle(const Pose2& here, const Pose2& look) {
+    CHECK(planner.begin_choice(here, look_disc, true, false) == StepOutcome::kChoosing);
+    choose();
+    return planner.end_choice(here, look, look_disc, crumbs);
+  }
+  // A cycle with no safe step: the look was taken 5 m away, so no step from here lies in it.
+  StepOutcome failed_cycle() {
+    return cycle(origin, {5.0F, 0.0F, 0.0F});
+  }
+  // A cycle whose step lies in the look's polygon: the look was taken where the robot stands.
+  StepOutcome safe_cycle() {
+    return cycle(origin, origin);
+  }
+};
+
+TEST(StepPlanner, NothingToExploreAndNoGoalTurnsRoundThenEndsOnlyWithinHalfAMetreOfTheTurn) {
+  CHECK(planner.begin_choice(origin, look_disc, false, false) == StepOutcome::kTurnRound);
+  planner.turned_round_at({0.0F, 0.0F});
+  CHECK(planner.begin_choice({0.3F, 0.2F, 1.0F}, look_disc, false, false) ==
+        StepOutcome::kNothingLeft);
+  // Elsewhere the sector behind the robot has not been looked at yet.
+  CHECK(planner.begin_choice({0.6F, 0.0F, 0.0F}, look_disc, false, false) ==
+        StepOutcome::kTurnRound);
+  // Something to explore, or a goal: the step is chosen, turned round or not.
+  CHECK(planner.begin_choice(origin, look_disc, true, false) == StepOutcome::kChoosing);
+  CHECK(planner.begin_choice(origin, look_disc, false, true) == StepOutcome::kChoosing);
+  // A new run has not turned round anywhere.
+  planner.clear();
+  CHECK(planner.begin_choice(origin, look_disc, false, false) == StepOutcome::kTurnRound);
+}
+
+TEST(StepPlanner, AStepInsideTheLooksNavigablePolygonIsAMoveOfAtMostOneActionsLength) {
+  CHECK(safe_cycle() == StepOutcome::kMove);
+  CHECK(planner.decision().kind == StepKind::kMove);
+  const float d = boticelli::core::distance_m({0.0F, 0.0F}, planner.target());
+  CHECK(d >= params.step.min_step_m);
+  CHECK(d <= params.value.step_m + 1e-5F);
+  CHECK_FALSE(planner.gave_up());
+}
+
+TEST(StepPlanner, AChosenStepLeavingTheLooksPolygonIsNoSafeStepAndThePlaceCountsAsVisited) {
+  // The robot stands 0.8 m from where the look was taken, near its polygon's edge; an
+  // exploration point ahead draws the step out of the polygon (the chooser cuts the step to
+  // the polygon as if it were seen from here).
+  (void)map.exploration().push_back({1.6F, 0.0F});
+  planner.start_value(map, nullptr, {0.0F, 0.0F}, 1);
+  CHECK(planner.value().sources().visited.empty());
+  const Pose2 here{0.8F, 0.0F, 0.0F};
+  CHECK(planner.begin_choice(here, look_disc, true, false) == StepOutcome::kChoosing);
+  choose();
+  CHECK(planner.end_choice(here, origin, look_disc, crumbs) == StepOutcome::kNoSafeStep);
+  // The step the chooser found does leave the look's polygon.
+  CHECK(planner.decision().kind == StepKind::kMove);
+  CHECK_FALSE(look_disc.contains(to_robot(origin, planner.target())));
+  // The place is on the trail the next value iteration is repelled by.
+  planner.start_value(map, nullptr, {0.8F, 0.0F}, 2);
+  CHECK_EQUAL(1U, planner.value().sources().visited.size());
+  DOUBLES_EQUAL(0.8, planner.value().sources().visited[0].x_m, 1e-6);
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  planner.start_value(map, nullptr, {0.0F, 0.0F}, 3);
+  CHECK_EQUAL(2U, planner.value().sources().visited.size());
+}
+
+TEST(StepPlanner, BacksOffAlongItsBreadcrumbsFromTheSecondCycleWithoutASafeStep) {
+  crumbs.step_started({-1.0F, 0.5F});
+  // The first such cycle looks again on the spot.
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  // The second backs off to where the last step began.
+  CHECK(failed_cycle() == StepOutcome::kBackOff);
+  CHECK(planner.decision().kind == StepKind::kMove);
+  DOUBLES_EQUAL(-1.0, planner.target().x_m, 1e-6);
+  DOUBLES_EQUAL(0.5, planner.target().y_m, 1e-6);
+  CHECK_FALSE(planner.gave_up());
+}
+
+TEST(StepPlanner, WithNoBreadcrumbLeftTheSecondCycleWithoutASafeStepLooksAgain) {
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+}
+
+TEST(StepPlanner, GivesUpAfterMaxFailedCyclesInARowAndDoesNotBackOffOnTheLast) {
+  for (int i = 0; i < 8; ++i) crumbs.step_started({-1.0F - static_cast<float>(i), 0.0F});
+  CHECK_EQUAL(4U, params.max_failed_cycles);
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  CHECK_FALSE(planner.gave_up());
+  CHECK(failed_cycle() == StepOutcome::kBackOff);
+  CHECK_FALSE(planner.gave_up());
+  CHECK(failed_cycle() == StepOutcome::kBackOff);
+  CHECK_FALSE(planner.gave_up());
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  CHECK_TRUE(planner.gave_up());
+  // A new run starts counting afresh.
+  planner.clear();
+  CHECK_FALSE(planner.gave_up());
+}
+
+TEST(StepPlanner, ASafeMoveResetsTheCountOfCyclesWithoutASafeStep) {
+  crumbs.step_started({-1.0F, 0.0F});
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  CHECK(safe_cycle() == StepOutcome::kMove);
+  // The next failure is the first in a row again: a fresh look, not a back-off.
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  CHECK(failed_cycle() == StepOutcome::kBackOff);
+  CHECK(safe_cycle() == StepOutcome::kMove);
+  CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
+  CHECK(failed_cycle() == StepOutcome::kBackOff);
+  CHECK(failed_cycle() == StepOutcome::kBackOff);
+  CHECK_FALSE(planner.gave_up());
+}
+
+TEST(StepPlanner, WithinTheStandOffOfTheGoalTheRobotIsAtTheGoal) {
+  const Point2 goal{0.5F, 0.0F};
+  planner.start_value(map, &goal, {0.0F, 0.0F}, 1);
+  CHECK(planner.begin_choice(origin, look_disc, false, true) == StepOutcome::kChoosing);
+  CHECK_TRUE(planner.choice_done());
+  CHECK(planner.end_choice(origin, origin, look_disc, crumbs) == StepOutcome::kAtGoal);
+}
+
+TEST(StepPlanner, AnotherStepOnTheSameLookIsRefusedWhenTheRobotStandsOutsideItsPolygon) {
+  CHECK_FALSE(planner.begin_next_on_look({1.5F, 0.0F, 0.0F}, origin, look_disc));
+  // A look taken elsewhere, its polygon seen from there.
+  CHECK_FALSE(planner.begin_next_on_look(origin, {0.0F, 2.0F, 1.0F}, look_disc));
+}
+
+TEST(StepPlanner, AnotherStepOnTheSameLookStaysInsideTheLooksPolygonSeenFromWhereTheRobotIs) {
+  // The robot took a step to near the polygon's edge; an exploration point ahead draws it on.
+  (void)map.exploration().push_back({1.6F, 0.0F});
+  planner.start_value(map, nullptr, {0.0F, 0.0F}, 1);
+  const Pose2 here{0.8F, 0.0F, 0.3F};
+  CHECK_TRUE(planner.begin_next_on_look(here, origin, look_disc));
+  choose();
+  CHECK(planner.end_next_on_look() == StepOutcome::kMove);
+  CHECK(planner.target().x_m > here.x_m);  // on towards the exploration point
+  CHECK(look_disc.contains(to_robot(origin, planner.target())));
+}
+
+TEST(StepPlanner, AnotherStepOnTheSameLookIsNoSafeStepWhenThePolygonLeavesNoRoom) {
+  const StarPolygon tiny = disc(0.04F);  // less than the shortest step in every direction
+  CHECK_TRUE(planner.begin_next_on_look(origin, origin, tiny));
+  choose();
+  CHECK(planner.end_next_on_look() == StepOutcome::kNoSafeStep);
+}
