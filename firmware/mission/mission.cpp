@@ -456,7 +456,7 @@ SliceResult Mission::run_slice(SliceBudget& budget) {
   if (snapshot_step_ != SnapshotStep::kIdle) {
     if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(nullptr, longest(Unit::kSnapshot));
-    snapshot_step();
+    snapshot_unit();
     return SliceResult::kMore;
   }
   if (phase_ == Phase::kDone) return SliceResult::kMore;
@@ -488,7 +488,7 @@ SliceResult Mission::think_slice(SliceBudget& budget) {
   while (!map_.done()) {
     if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(think_cpu, longest(Unit::kModel));
-    map_.step();
+    map_.run_unit();
   }
   if (!budget.next_unit()) return SliceResult::kMore;
   CpuScope cpu(think_cpu, longest(Unit::kMap));
@@ -539,7 +539,7 @@ SliceResult Mission::plan_slice(SliceBudget& budget) {
   while (!planner_.value_done()) {
     if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(plan_cpu, longest(Unit::kValue));
-    planner_.value_step();
+    planner_.value_unit();
   }
   if (!budget.next_unit()) return SliceResult::kMore;
   CpuScope cpu(plan_cpu, longest(Unit::kStep));
@@ -645,7 +645,7 @@ void Mission::finish_next_step_on_look() {
 }
 
 // One unit of the cycle's picture: set it up (the first), then a panel or a band of rows.
-void Mission::snapshot_step() {
+void Mission::snapshot_unit() {
   if (snapshot_step_ == SnapshotStep::kPending) {
     SnapshotInputs in;
     in.cycle = static_cast<std::uint32_t>(state_.cycle);
@@ -671,7 +671,7 @@ void Mission::snapshot_step() {
     snapshot_step_ = SnapshotStep::kWriting;
     return;
   }
-  if (!snapshots_->step()) return;
+  if (!snapshots_->run_unit()) return;
   snapshot_step_ = SnapshotStep::kIdle;
   if (!snapshots_->ok()) {
     TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
@@ -681,7 +681,7 @@ void Mission::snapshot_step() {
 }
 
 void Mission::finish_saving() {
-  while (snapshot_step_ != SnapshotStep::kIdle) snapshot_step();  // the last cycle's picture
+  while (snapshot_step_ != SnapshotStep::kIdle) snapshot_unit();  // the last cycle's picture
   if (saver_ == nullptr) return;
   // Where the base came to rest, not where the last cycle ended: it may still have rolled a
   // few millimetres after its step was done, or been stopped mid-drive.

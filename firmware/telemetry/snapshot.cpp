@@ -229,7 +229,7 @@ void SnapshotWriter::begin(const SnapshotFrame& frame) {
 #endif
 }
 
-bool SnapshotWriter::step() {
+bool SnapshotWriter::run_unit() {
   switch (stage_) {
     case Stage::kIdle:
       return true;
@@ -279,7 +279,7 @@ bool SnapshotWriter::step() {
 
 bool SnapshotWriter::write(const SnapshotFrame& frame, char* error, std::size_t error_size) {
   begin(frame);
-  while (!step()) {
+  while (!run_unit()) {
   }
   if (!ok_) std::snprintf(error, error_size, "%s", error_);
   return ok_;

@@ -284,7 +284,7 @@ TEST(AlnTrain, SlicedTrainingEqualsOneShotTraining) {
     CHECK(g_trainer3.start(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
     std::size_t steps = 0;
     std::size_t budget = 1;
-    while (!g_trainer3.step(budget)) {
+    while (!g_trainer3.run_unit(budget)) {
       budget = budget * 3 % 997 + 1;  // uneven slices, some of them a single sample
       ++steps;
     }
@@ -343,7 +343,7 @@ TEST(AlnTrain, ARestartTrainsAfreshWithTheNextSeedAndTheLeastLossOfAllStartsIsRe
   set_room_ranges(g_model3b);
   CHECK(g_trainer3.start(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
   std::size_t budget = 1;
-  while (!g_trainer3.step(budget)) budget = budget * 3 % 997 + 1;
+  while (!g_trainer3.run_unit(budget)) budget = budget * 3 % 997 + 1;
   CHECK(same_model(g_model3, g_model3b));
   LONGS_EQUAL(with.passes, g_trainer3.stats().passes);
 }
@@ -670,7 +670,7 @@ struct PrunedPieceScene {
     cfg.check_pruning = check_pruning;
     trainer.configure(cfg);
     CHECK(trainer.start_from(aln::SampleSet<double, 1>(samples.data(), samples.size()), model));
-    while (!trainer.step(64)) {
+    while (!trainer.run_unit(64)) {
     }
   }
 
@@ -753,7 +753,7 @@ TEST(AlnTrain, AWarmStartKeepsTheLastFitsPiecesSoRefitsAloneReachEpsilon) {
   CHECK(g_trainer3.train(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
   CHECK(g_trainer3.stats().rms > 1.5 * cfg.epsilon);
   CHECK(g_trainer3.start_from(aln::SampleSet<float, 3>(g_samples3, n), g_model3b));
-  while (!g_trainer3.step(997)) {
+  while (!g_trainer3.run_unit(997)) {
   }
   CHECK(g_trainer3.stats().rms <= cfg.epsilon);
   CHECK(g_model3b.piece_count() >= 2);
@@ -780,7 +780,7 @@ TEST(AlnTrain, AWarmStartClampsTheWeightsIntoTheirBoundsAndRefusesTooManyPieces)
   g_trainer3.configure(cfg);
   CHECK(g_trainer3.start_from(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
   CHECK(g_model3.pieces_within_bounds());
-  while (!g_trainer3.step(500)) {
+  while (!g_trainer3.run_unit(500)) {
   }
   CHECK(g_model3.pieces_within_bounds());
   CHECK(g_model3.piece_count() <= pieces);
@@ -844,7 +844,7 @@ TEST(AlnTrain, CoarseToFineSplitsOnEveryKthSampleThenRefitsOnAllWithoutSplitting
   set_room_ranges(g_model3b);
   CHECK(g_trainer3.start(all, g_model3b));
   std::size_t budget = 1;
-  while (!g_trainer3.step(budget)) budget = budget * 3 % 997 + 1;
+  while (!g_trainer3.run_unit(budget)) budget = budget * 3 % 997 + 1;
   CHECK(same_model(g_model3, g_model3b));
 }
 
@@ -938,7 +938,7 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
   bool done = false;
   CHECK_NO_ALLOCATION({
     CHECK(g_trainer3.start(aln::SampleSet<float, 3>(g_samples3, n), g_model3));
-    while (!done) done = g_trainer3.step(500);
+    while (!done) done = g_trainer3.run_unit(500);
   });
   CHECK(g_model3.piece_count() > 1);
   // A wall step whose Tukey training ends on a pruned model that fits worse than before
@@ -954,7 +954,7 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
     bool finished = false;
     CHECK_NO_ALLOCATION({
       CHECK(warm ? g_trainer2.start_from(set, g_model2) : g_trainer2.start(set, g_model2));
-      while (!finished) finished = g_trainer2.step(500);
+      while (!finished) finished = g_trainer2.run_unit(500);
     });
   };
   train_wall_step(false);
@@ -991,7 +991,7 @@ TEST(AlnTrain, TrainingStepsDoNotAllocate) {
 TEST(AlnTrain, AnEmptySampleSetIsRefused) {
   g_trainer3.configure(aln::TrainerConfig{});
   CHECK_FALSE(g_trainer3.start(aln::SampleSet<float, 3>(), g_model3));
-  CHECK(g_trainer3.step(10));
+  CHECK(g_trainer3.run_unit(10));
 }
 
 TEST_GROUP(ConstrainedLsq){};

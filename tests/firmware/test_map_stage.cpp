@@ -58,7 +58,7 @@ TEST_GROUP(MapStage) {
   // A look at `pose` with no readings, fused with `candidate` (or nullptr).
   void look_at(const Pose2& pose, const Eigen::Vector3f* candidate) {
     stage->begin(params.model, *readings, pose);
-    while (!stage->done()) stage->step();
+    while (!stage->done()) stage->run_unit();
     stage->fuse(pose, fuse, candidate);
   }
 };

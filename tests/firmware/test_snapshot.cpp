@@ -246,7 +246,7 @@ TEST(SnapshotWriter, WrittenInStepsThePictureIsTheSameAndNoFileShowsBeforeTheLas
   g_writer.begin(synthetic_frame(4));
   CHECK(g_writer.busy());
   std::size_t steps = 1;
-  while (!g_writer.step()) {
+  while (!g_writer.run_unit()) {
     ++steps;
     // Until the last step at most the temporary file exists.
     for (const std::string& name : list_dir(dir)) CHECK(name != "cycle-000004.png");

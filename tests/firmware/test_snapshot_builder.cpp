@@ -119,7 +119,7 @@ TEST_GROUP(SnapshotBuilder) {
   void draw(const SnapshotInputs& in) {
     CHECK_TRUE_TEXT(g_writer.open(dir.c_str(), error, sizeof error), error);
     begin_snapshot(in, g_writer);
-    while (!g_writer.step()) {
+    while (!g_writer.run_unit()) {
     }
     CHECK_TRUE_TEXT(g_writer.ok(), g_writer.error());
   }

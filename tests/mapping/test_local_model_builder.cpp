@@ -361,7 +361,7 @@ TEST(LocalModelBuilder, SteppingInSmallSlicesGivesTheSamePolygonAsOneShot) {
   params.visits_per_unit = 333;
   g_other.start(params, g_look.features.span(), g_look.obstacles.span(), g_look.free.span());
   std::size_t units = 0;
-  while (!g_other.step()) ++units;
+  while (!g_other.run_unit()) ++units;
   CHECK(units > reference.stats().units);  // it did take more, smaller units
   const mapping::LocalMap& a = reference.map();
   const mapping::LocalMap& c = g_other.map();
@@ -379,7 +379,7 @@ TEST(LocalModelBuilder, StartingAndSteppingDoNotAllocate) {
   const mapping::LocalModelParams params = make_params();
   CHECK_NO_ALLOCATION({
     g_other.start(params, g_look.features.span(), g_look.obstacles.span(), g_look.free.span());
-    while (!g_other.step()) {
+    while (!g_other.run_unit()) {
     }
   });
   CHECK(g_other.done());

@@ -106,7 +106,7 @@ struct TestWorld {
 
   planning::StepDecision plan() {
     value.start(vi_params, reward_params, sources(), {pose.x_m, pose.y_m});
-    while (!value.step(4096)) {
+    while (!value.run_unit(4096)) {
     }
     return planning::choose_step(value, navigable, pose, step_params);
   }
@@ -284,7 +284,7 @@ TEST(Planner, TheStepChooserTakesOneActionPerUnitAndEndsOnTheWholeDecision) {
   w.goal = {2.5F, 0.0F};
   w.observe();
   w.value.start(w.vi_params, w.reward_params, w.sources(), {w.pose.x_m, w.pose.y_m});
-  while (!w.value.step(4096)) {
+  while (!w.value.run_unit(4096)) {
   }
   planning::StepChooser chooser;
   chooser.start(w.value, w.navigable, w.pose, w.step_params);
@@ -292,7 +292,7 @@ TEST(Planner, TheStepChooserTakesOneActionPerUnitAndEndsOnTheWholeDecision) {
   float best_q = -1e30F;
   while (!chooser.done()) {
     ++units;
-    (void)chooser.step();
+    (void)chooser.run_unit();
     // The running best never gets worse as more actions are evaluated.
     if (chooser.decision().kind == planning::StepKind::kMove) {
       CHECK(chooser.decision().q_value >= best_q);
@@ -300,7 +300,7 @@ TEST(Planner, TheStepChooserTakesOneActionPerUnitAndEndsOnTheWholeDecision) {
     }
   }
   CHECK_EQUAL(planning::kActionCount, units);
-  CHECK(chooser.step());  // done stays done
+  CHECK(chooser.run_unit());  // done stays done
   const planning::StepDecision& d = chooser.decision();
   CHECK(d.kind == planning::StepKind::kMove);
   // With the wall ahead the best move goes round it, not into it.
@@ -322,7 +322,7 @@ TEST(Planner, SixteenStepHeadingsFindAWayBetweenTheEightActions) {
   w.has_goal = true;
   w.goal = {2.5F * std::cos(kWay_rad), 2.5F * std::sin(kWay_rad)};
   w.value.start(w.vi_params, w.reward_params, w.sources(), {w.pose.x_m, w.pose.y_m});
-  while (!w.value.step(4096)) {
+  while (!w.value.run_unit(4096)) {
   }
   mapping::StarPolygon nav(360);
   nav.fill(0.02F);
@@ -342,7 +342,7 @@ TEST(Planner, SixteenStepHeadingsFindAWayBetweenTheEightActions) {
   std::size_t units = 0;
   while (!chooser.done()) {
     ++units;
-    (void)chooser.step();
+    (void)chooser.run_unit();
   }
   CHECK_EQUAL(16U, units);
 }
@@ -360,10 +360,10 @@ TEST(Planner, SlicedValueIterationEqualsOneShot) {
   sliced.start(p, planning::RewardParams{}, s, {0.0F, 0.0F});
   whole.start(p, planning::RewardParams{}, s, {0.0F, 0.0F});
   int slices = 0;
-  while (!sliced.step(37)) {
+  while (!sliced.run_unit(37)) {
     ++slices;
   }
-  CHECK_TRUE(whole.step(1000000000));
+  CHECK_TRUE(whole.run_unit(1000000000));
   CHECK_TRUE(slices > 20);
   LONGS_EQUAL(6, whole.sweeps_done());
   for (float x = -3.0F; x <= 3.0F; x += 0.5F) {

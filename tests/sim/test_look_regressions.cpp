@@ -62,7 +62,7 @@ const mapping::LocalMap* replay(const char* name, const mission::MissionParams& 
   look.end_look(params.limits);
   features_kept = look.readings().features.size();
   stage.begin(params.model, look.readings(), boticelli::core::Pose2{});
-  while (!stage.done()) stage.step();
+  while (!stage.done()) stage.run_unit();
   return &stage.local();
 }
 

@@ -191,7 +191,7 @@ struct BestRound {
   std::size_t iteration = 0;
 };
 
-// Trains pass by pass (the trainer's resumable step(), one pass per call) and keeps the
+// Trains pass by pass (the trainer's resumable run_unit(), one pass per call) and keeps the
 // model with the lowest RMS seen at the end of any split round, in g_best. The trainer
 // returns the model of its last round, which under the per-piece rule is not always its
 // best one (a round of many simultaneous splits can end worse than the round before).
@@ -213,7 +213,7 @@ BestRound train_keeping_best(const std::vector<AlnSample>& samples, bool trimmed
     g_snapshot_previous = g_snapshot;
     g_snapshot = g_model;
     const std::size_t round = g_trainer.stats().iterations;
-    (void)g_trainer.step(samples.size());
+    (void)g_trainer.run_unit(samples.size());
     if (g_trainer.stats().iterations != round || g_trainer.done()) {
       // The round ended on the model evaluated in this pass, or (if the last refit made
       // it worse) on the one of the pass before; with hinge splits this pass is the one

@@ -411,7 +411,7 @@ void refit(const RoomSpec& spec, const SyntheticRoom& room, const evidence::RayS
   g_warm = g_model;
   t0 = cpu_ns();
   if (g_trainer.start_from(set, g_warm)) {
-    while (!g_trainer.step(samples.size())) {
+    while (!g_trainer.run_unit(samples.size())) {
     }
   }
   const double warm_ms = ms_since(t0);

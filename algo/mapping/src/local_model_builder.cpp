@@ -98,7 +98,7 @@ void LocalModelBuilder::add_free_samples(const evidence::Reading& reading) {
   }
 }
 
-bool LocalModelBuilder::step() {
+bool LocalModelBuilder::run_unit() {
   ++stats_.units;
   switch (phase_) {
     case Phase::kIdle:
@@ -140,7 +140,7 @@ bool LocalModelBuilder::step() {
       return false;
     }
     case Phase::kTrain:
-      if (trainer_.step(params_.visits_per_unit)) {
+      if (trainer_.run_unit(params_.visits_per_unit)) {
         stats_.pieces = model_.piece_count();
         stats_.rms = trainer_.stats().rms;
         phase_ = Phase::kGuard;

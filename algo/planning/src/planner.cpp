@@ -44,7 +44,7 @@ StepDecision choose_step(const ValueIteration& value, const mapping::StarPolygon
                          const core::Pose2& pose, const StepParams& params) {
   StepChooser chooser;
   chooser.start(value, navigable, pose, params);
-  while (!chooser.step()) {
+  while (!chooser.run_unit()) {
   }
   return chooser.decision();
 }
@@ -67,7 +67,7 @@ void StepChooser::start(const ValueIteration& value, const mapping::StarPolygon&
   }
 }
 
-bool StepChooser::step() {
+bool StepChooser::run_unit() {
   if (done()) return true;
   const std::size_t a = next_action_++;
   const ValueIteration& value = *value_;

@@ -207,7 +207,7 @@ void ValueIteration::begin_fit() {
   phase_ = Phase::kFit;
 }
 
-bool ValueIteration::step(std::size_t budget) {
+bool ValueIteration::run_unit(std::size_t budget) {
   std::size_t left = std::max<std::size_t>(budget, 1);
   while (left > 0 && phase_ != Phase::kDone && phase_ != Phase::kIdle) {
     std::size_t used = 0;
@@ -223,7 +223,7 @@ bool ValueIteration::step(std::size_t budget) {
         break;
       case Phase::kFit: {
         const std::uint64_t before = trainer_.stats().sample_visits;
-        const bool fitted = trainer_.step(left);
+        const bool fitted = trainer_.run_unit(left);
         used = static_cast<std::size_t>(trainer_.stats().sample_visits - before);
         if (fitted) {
           // The trainer restarts from one piece each sweep and now and then lands in a

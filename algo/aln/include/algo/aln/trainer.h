@@ -41,7 +41,7 @@ namespace boticelli::aln {
 // could lower by pushing its samples out of the weights' window: a refit is kept only if it
 // lowers that loss, a round's splits are undone unless they lower it, so the model returned
 // has the least loss of all models training evaluated.
-// Resumable: step(budget) visits at most about `budget` samples and returns; the sequence of
+// Resumable: run_unit(budget) visits at most about `budget` samples and returns; the sequence of
 // operations does not depend on the budgets, so sliced training equals one-shot training.
 // All working memory is inside the object (no per-sample memory, so the sample count is
 // unbounded): make it static. For N = 3 about 1.3 KB per piece (330 KB for 256) with
@@ -99,7 +99,7 @@ class Trainer {
     return begin_first_pass();
   }
   // Advances by about max_sample_visits samples (at least one). True when training is done.
-  bool step(std::size_t max_sample_visits) {
+  bool run_unit(std::size_t max_sample_visits) {
     if (stats_.done || model_ == nullptr) return true;
     std::size_t budget = std::max<std::size_t>(max_sample_visits, 1);
     while (budget > 0 && !stats_.done) {
@@ -114,10 +114,10 @@ class Trainer {
     return stats_.done;
   }
 
-  // One-shot training: start() and step() to completion.
+  // One-shot training: start() and run_unit() to completion.
   bool train(SampleSet<Scalar, N> samples, Model& model) {
     if (!start(samples, model)) return false;
-    while (!step(std::numeric_limits<std::size_t>::max() / 2)) {
+    while (!run_unit(std::numeric_limits<std::size_t>::max() / 2)) {
     }
     return true;
   }

@@ -115,7 +115,7 @@ struct LocalModelStats {
 // the bottom-row floor points of walks whose bottom row showed no floor, used only with
 // close_blocked_rays (see there), as is `prior`. The spans and the prior's polygon must stay
 // valid until done().
-// step() does one bounded unit of work; nothing allocates. Make the object static (MBs).
+// run_unit() does one bounded unit of work; nothing allocates. Make the object static (MBs).
 class LocalModelBuilder {
  public:
   LocalModelBuilder() = default;
@@ -128,10 +128,10 @@ class LocalModelBuilder {
              std::span<const float> floor_free_near_m = {},
              std::span<const evidence::Reading> floor_blocked = {}, PriorLook prior = {});
   // One unit of work; true when the local map is ready.
-  bool step();
+  bool run_unit();
   // Runs to the end (tests, benchmarks).
   void run() {
-    while (!step()) {
+    while (!run_unit()) {
     }
   }
   [[nodiscard]] bool done() const { return phase_ == Phase::kDone; }

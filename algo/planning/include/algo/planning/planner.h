@@ -63,7 +63,7 @@ class StepChooser {
   void start(const ValueIteration& value, const mapping::StarPolygon& navigable,
              const core::Pose2& pose, const StepParams& params);
   // Evaluates the next heading; true once every one has been (decision() is then final).
-  bool step();
+  bool run_unit();
   [[nodiscard]] bool done() const { return next_action_ >= headings_; }
   [[nodiscard]] const StepDecision& decision() const { return best_; }
 

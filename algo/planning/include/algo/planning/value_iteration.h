@@ -45,7 +45,7 @@ float action_heading_rad(std::size_t action);
 // values can flow around walls into parts not yet seen); each sweep computes the Bellman
 // targets y_i = max_a (r(s_i, a) + γ V(s'_ia)) over the actions whose straight move keeps
 // clear (Eq 5.8), then refits the ALN V to {(s_i, y_i)} (resumable trainer). Rewards at the
-// arrival states are computed once per plan. Resumable: step(budget) does a bounded slice.
+// arrival states are computed once per plan. Resumable: run_unit(budget) does one bounded unit.
 class ValueIteration {
  public:
   ValueIteration() = default;
@@ -57,7 +57,7 @@ class ValueIteration {
              const RewardSources& sources, core::Point2 centre);
   // Does about `budget` units of work (one unit: a state-action's reward, a state's
   // Bellman target, or a sample visit of the ALN trainer). True when the plan is done.
-  bool step(std::size_t budget);
+  bool run_unit(std::size_t budget);
   [[nodiscard]] bool done() const { return phase_ == Phase::kDone; }
 
   // V(s) [reward] of the last completed fit (0 before the first).

@@ -181,7 +181,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // Starts a move in the Drive phase (the mission task begins it in its next frame).
   void drive(Move move);
   void write_trace(std::uint64_t now_us);
-  void snapshot_step();
+  void snapshot_unit();
   double& longest(Unit unit) { return longest_s_[static_cast<std::size_t>(unit)]; }
 
   hal::Hal& hal_;

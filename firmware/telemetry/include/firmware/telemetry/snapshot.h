@@ -114,12 +114,12 @@ class SnapshotWriter {
 
   // The same in bounded steps, for a background slice: begin() takes the frame (its spans and
   // the fields' contexts must stay valid and unchanged until the picture is done), then each
-  // step() draws one panel or encodes kBandRows rows; it returns true when the picture is
+  // run_unit() draws one panel or encodes kBandRows rows; it returns true when the picture is
   // written or has failed (ok(), error()). A begin() while busy abandons the picture before.
   static constexpr int kBandRows = 96;
   static constexpr int kFieldBandRows = 10;  // field rows sampled per step
   void begin(const SnapshotFrame& frame);
-  bool step();
+  bool run_unit();
   [[nodiscard]] bool busy() const { return stage_ != Stage::kIdle; }
   [[nodiscard]] bool ok() const { return ok_; }
   [[nodiscard]] const char* error() const { return error_; }

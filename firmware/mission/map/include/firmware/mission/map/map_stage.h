@@ -33,7 +33,7 @@ class MapStage {
   void begin(const mapping::LocalModelParams& params, const LookReadings& readings,
              const core::Pose2& look_pose);
   // One unit of the local model; done() when the polygon and the points are ready.
-  void step() { (void)builder_.step(); }
+  void run_unit() { (void)builder_.run_unit(); }
   [[nodiscard]] bool done() const { return builder_.done(); }
   // The look's map points merged into the global lists; known exploration points this look
   // saw marked explored; a lone target sighting (`candidate`, or nullptr) given an

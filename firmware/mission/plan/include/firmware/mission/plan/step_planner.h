@@ -41,14 +41,14 @@ class StepPlanner {
   void start_value(const mapping::GlobalMap& map, const core::Point2* goal, core::Point2 centre,
                    std::uint32_t seed);
   [[nodiscard]] bool value_done() const { return value_.done(); }
-  void value_step() { (void)value_.step(params_.vi_work_per_unit); }
+  void value_unit() { (void)value_.run_unit(params_.vi_work_per_unit); }
 
   // After the value iteration: kChoosing, or kTurnRound / kNothingLeft when there is nothing
   // to explore and no goal.
   StepOutcome begin_choice(const core::Pose2& here, const mapping::StarPolygon& navigable,
                            bool has_exploration, bool has_goal);
   // One heading of the choice per call, until choice_done().
-  void choose_heading() { (void)chooser_.step(); }
+  void choose_heading() { (void)chooser_.run_unit(); }
   [[nodiscard]] bool choice_done() const { return chooser_.done(); }
   // The chosen step: kAtGoal, kMove when the whole step lies in the look's navigable polygon
   // (seen from `look_pose`), else the place counts as visited once more and the robot backs off
