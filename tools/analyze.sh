@@ -66,7 +66,7 @@ cppcheck --quiet --error-exitcode=1 --inline-suppr --std=c++20 --language=c++ \
   -I algo/core/include -I algo/aln/include -I algo/image/include -I algo/stereo/include \
   -I algo/evidence/include -I algo/fusion/include -I algo/mapping/include \
   -I algo/planning/include -I hal/include -I hal/linux/include -I hal/linux/codec/include \
-  -I hal/sim/include -I firmware/include \
+  -I hal/sim/include $(find firmware -type d -name include -printf '-I %p ') \
   "${files[@]}" || status=1
 [ "$status" = 0 ] && echo "analyze: no findings"
 exit "$status"

@@ -1,5 +1,5 @@
 // Tests of the test fakes FakeClock and FakeSerialPort (the HAL mocks are exercised where they
-// test production code, e.g. tests/firmware/test_safety_mocks.cpp).
+// test production code, e.g. tests/firmware/safety/test_safety_mocks.cpp).
 #include <cstdint>
 #include <cstring>
 #include <string>

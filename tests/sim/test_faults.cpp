@@ -1,7 +1,8 @@
 // One test per (device, fault type) pair on the sim board: the fault injected at the HAL
 // boundary, the firmware's device tasks, e-stop latch, console and state saver around a
-// stand-in mission; each run is checked against its expectation (boards/sim/harness/fault_scenario.h)
-// and for zero heap allocations from the first frame to the last.
+// stand-in mission; each run is checked against its expectation
+// (boards/sim/harness/fault_scenario.h) and for zero heap allocations from the first frame to the
+// last.
 #include <unistd.h>
 
 #include <cstdio>

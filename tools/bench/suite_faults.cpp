@@ -1,8 +1,8 @@
 // Benchmark suite "faults": every (device, fault type) pair on the sim board, first around a
-// stand-in mission (boards/sim/harness/fault_scenario.h: stop latency, console, recovery), then in a
-// whole mission (the firmware binary with --faults, the MISSION line's result and reason).
-// With RELIABILITY_DOC=FILE it writes the table between the file's table markers
-// (docs/reliability.md is made this way, never by hand).
+// stand-in mission (boards/sim/harness/fault_scenario.h: stop latency, console, recovery), then in
+// a whole mission (the firmware binary with --faults, the MISSION line's result and reason). With
+// RELIABILITY_DOC=FILE it writes the table between the file's table markers (docs/reliability.md is
+// made this way, never by hand).
 #include <sys/stat.h>
 #include <unistd.h>
 
