@@ -1,5 +1,5 @@
-// Options: the firmware's command line (`boticelli --help`, man page boticelli(8)), parsed without allocation or
-// exceptions.
+// Options: the firmware's command line (`boticelli --help`, man page boticelli(8)), parsed without
+// allocation or exceptions.
 #pragma once
 
 #include <cstdint>
