@@ -1,10 +1,24 @@
 #!/usr/bin/env bash
-# Runs the .deb's maintainer scripts against a scratch root (DPKG_ROOT, with deb-systemd-helper's
-# real bookkeeping): the first installation enables the units, an upgrade keeps an
-# administrator's disable, remove and purge leave nothing enabled.
+# Checks the .deb's maintainer scripts. postinst never starts or restarts a unit (installing
+# or upgrading must not set the robot driving). Then runs them against a scratch root
+# (DPKG_ROOT, with deb-systemd-helper's real bookkeeping): the first installation enables the
+# units, an upgrade keeps an administrator's disable, remove and purge leave nothing enabled.
 #   maintainer_scripts.sh PACKAGING_DIR
 set -euo pipefail
 pkg=$1
+
+# The start is read from the script itself: under DPKG_ROOT (below) and on a machine without
+# a running systemd its systemd calls are skipped, so running it cannot show one. Comments
+# and quoted text (messages to the operator) are left out; any tool that starts a unit
+# counts, and so does `enable --now`.
+starts=$(sed -e 's/#.*//' -e 's/"[^"]*"//g' -e "s/'[^']*'//g" "$pkg/postinst" |
+  grep -nE '(deb-systemd-invoke|systemctl|invoke-rc\.d|service)\b.*(\b(start|restart|try-restart|reload-or-restart|try-reload-or-restart|condrestart)\b|--now)' ||
+  true)
+if [ -n "$starts" ]; then
+  printf '%s\n' "$starts"
+  echo "FAIL: postinst starts or restarts a unit: installing or upgrading would set the robot off"
+  exit 1
+fi
 if ! command -v deb-systemd-helper >/dev/null 2>&1 || ! command -v systemctl >/dev/null 2>&1; then
   echo "SKIPPED: deb-systemd-helper or systemctl is not installed (init-system-helpers, systemd)"
   exit 0
@@ -42,4 +56,5 @@ sh "$pkg/prerm" remove
 sh "$pkg/postrm" remove
 sh "$pkg/postrm" purge
 enabled boticelli-can0.service && fail "purge left boticelli-can0.service enabled"
-echo "maintainer scripts: enable on first install, admin's disable kept on upgrade, purge clean"
+echo "maintainer scripts: nothing started, enable on first install, admin's disable kept on" \
+  "upgrade, purge clean"
