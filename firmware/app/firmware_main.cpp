@@ -110,6 +110,10 @@ bool apply_config(const Options& options, Board& board, char* error, std::size_t
 
 int firmware_main(int argc, const char* const* argv, Board& board, const MainHooks* hooks) {
   const double wall_start_s = wall_seconds();
+  // Output to a closed pipe (`boticelli | head`, a log reader gone) must not kill the robot
+  // with the base driving and no final save: with SIGPIPE ignored such a write fails with
+  // EPIPE instead, which the stdio console (a port fault) and the printf()s here tolerate.
+  std::signal(SIGPIPE, SIG_IGN);
   const BoardInfo& info = board.info();
   Options options;
   ServiceLog& slog = service_log();

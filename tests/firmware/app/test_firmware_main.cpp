@@ -1,11 +1,13 @@
 // Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console
 // quit, --state/--resume.
 #include <fcntl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <functional>
 #include <memory>
 #include <string>
@@ -240,6 +242,60 @@ TEST(FirmwareMain, RefusesToResumeFromACorruptState) {
   CHECK_EQUAL(kExitUsage, r.exit_code);
   STRCMP_CONTAINS("boticelli: cannot resume:", r.err.c_str());
   CHECK(r.out.find("MISSION") == std::string::npos);
+}
+
+namespace {
+// Runs firmware_main in a forked child whose stdout is a pipe nobody reads any more (read
+// end closed) and SIGPIPE at its default action, as `boticelli ... | head -1` after head
+// ended. The child's wait status, or -1 when the child did not end within 60 s.
+int run_with_stdout_a_closed_pipe(const std::vector<const char*>& args) {
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t child = fork();
+  if (child < 0) return -1;
+  if (child == 0) {
+    int fds[2];
+    if (pipe(fds) != 0) _exit(100);
+    close(fds[0]);
+    dup2(fds[1], STDOUT_FILENO);
+    close(fds[1]);
+    const int null_fd = open("/dev/null", O_WRONLY);
+    if (null_fd >= 0) dup2(null_fd, STDERR_FILENO);
+    signal(SIGPIPE, SIG_DFL);
+    std::vector<const char*> argv{"boticelli"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    auto board = std::make_unique<FakeBoard>();
+    const int code = firmware_main(static_cast<int>(argv.size()), argv.data(), *board);
+    std::fflush(stdout);
+    _exit(code);
+  }
+  for (int i = 0; i < 6000; ++i) {
+    int status = 0;
+    if (waitpid(child, &status, WNOHANG) == child) return status;
+    timespec ms10{0, 10000000L};
+    nanosleep(&ms10, nullptr);
+  }
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  return -1;
+}
+}  // namespace
+
+TEST(FirmwareMain, OutputToAClosedPipeDoesNotKillItAndTheMissionEndsWithItsSave) {
+  const int status =
+      run_with_stdout_a_closed_pipe({"--state", dir.c_str(), "--max-cycles", "1", "--seed", "4"});
+  CHECK_TEXT(status != -1, "the child did not end (fork under an emulator?)");
+  CHECK_FALSE_TEXT(WIFSIGNALED(status) && WTERMSIG(status) == SIGPIPE, "killed by SIGPIPE");
+  CHECK(WIFEXITED(status));
+  CHECK_EQUAL(kExitNotFound, WEXITSTATUS(status));
+  // The orderly end ran: the state was saved with the mission's end in its log.
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK_TRUE_TEXT(store.load(state, error, sizeof error) == LoadResult::kLoaded, error);
+  CHECK_EQUAL(4U, state.seed);
+  CHECK_EQUAL(1U, state.log.size());
 }
 
 namespace {
