@@ -145,7 +145,12 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   // Mission state: fresh, or resumed from --state DIR.
   StateStore* store = nullptr;
   if (options.state_dir != nullptr) {
-    if (!g_store.open(options.state_dir, error, sizeof error)) return fail(error, "");
+    if (!g_store.open(options.state_dir, error, sizeof error)) {
+      // A directory that must not be used (not a directory, another owner, writable by
+      // others) is the operator's to fix: the usage code, which the unit does not restart on.
+      const int code = fail(error, "");
+      return g_store.refused() ? kExitUsage : code;
+    }
     store = &g_store;
   }
   g_state.clear();

@@ -59,10 +59,22 @@ bool write_file_atomically(const char* dir, const char* name, std::string_view d
     std::snprintf(error, error_size, "save interrupted (test crash hook)");
     return true;
   };
+  // The temporary file is always a new file of our own: a stale one (left by a crash) is
+  // unlinked first — unlink removes a symlink itself, never its target — and it is then
+  // created with O_EXCL | O_NOFOLLOW, so whatever appears at that name in between (a
+  // symlink, another file) makes the save fail instead of being written through. This
+  // rather than O_TMPFILE + linkat: O_TMPFILE depends on the file system (and is missing
+  // on some), linkat cannot replace a name either (a named temporary and the rename are
+  // still needed), and the save keeps the steps the crash hook and the tests know.
   const int fault = injected(StorageCall::kCreate);
   if (fault != 0) errno = fault;
-  const int fd =
-      fault != 0 ? -1 : ::open(tmp_path.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
+  if (fault == 0 && ::unlink(tmp_path.data()) != 0 && errno != ENOENT) {
+    set_error(error, error_size, "cannot remove the stale", tmp_path.data());
+    return false;
+  }
+  const int fd = fault != 0 ? -1
+                            : ::open(tmp_path.data(),
+                                     O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0640);
   if (fd < 0) {
     set_error(error, error_size, "cannot create", tmp_path.data());
     return false;

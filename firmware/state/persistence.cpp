@@ -300,7 +300,12 @@ void set_error(char* error, std::size_t size, const char* what, const char* path
 }
 }  // namespace
 
+bool state_dir_mode_is_safe(unsigned mode) {
+  return (mode & (S_IWGRP | S_IWOTH)) == 0;
+}
+
 bool StateStore::open(const char* dir, char* error, std::size_t error_size) {
+  refused_ = false;
   const int n1 = std::snprintf(dir_.data(), dir_.size(), "%s", dir);
   const int n2 = std::snprintf(path_.data(), path_.size(), "%s/%s", dir, kFileName);
   const int n3 = std::snprintf(parameters_path_.data(), parameters_path_.size(), "%s/%s", dir,
@@ -320,6 +325,29 @@ bool StateStore::open(const char* dir, char* error, std::size_t error_size) {
   if (::stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
     std::snprintf(error, error_size, "state path %s is not a directory", dir);
     dir_[0] = '\0';
+    refused_ = true;
+    return false;
+  }
+  // Anyone else who can write in the directory can put a file or a symlink where the state
+  // goes, or swap the saved mission: refuse it (the operator fixes the directory).
+  const uid_t user = ::geteuid();
+  if (st.st_uid != user) {
+    std::snprintf(error, error_size,
+                  "state directory %s refused: owned by uid %u, not by this user (uid %u)", dir,
+                  static_cast<unsigned>(st.st_uid), static_cast<unsigned>(user));
+    dir_[0] = '\0';
+    refused_ = true;
+    return false;
+  }
+  if (!state_dir_mode_is_safe(static_cast<unsigned>(st.st_mode))) {
+    std::snprintf(error, error_size,
+                  "state directory %s refused: writable by %s (mode %04o; chmod go-w %s)", dir,
+                  (st.st_mode & S_IWGRP) != 0 && (st.st_mode & S_IWOTH) != 0 ? "group and others"
+                  : (st.st_mode & S_IWGRP) != 0                              ? "its group"
+                                                                             : "others",
+                  static_cast<unsigned>(st.st_mode & 07777), dir);
+    dir_[0] = '\0';
+    refused_ = true;
     return false;
   }
   return true;

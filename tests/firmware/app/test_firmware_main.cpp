@@ -1,6 +1,7 @@
 // Tests of firmware_main on a fake board (lockstep fake clock): exit codes, MISSION line, console
 // quit, --state/--resume.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -242,6 +243,19 @@ TEST(FirmwareMain, RefusesToResumeFromACorruptState) {
   CHECK_EQUAL(kExitUsage, r.exit_code);
   STRCMP_CONTAINS("boticelli: cannot resume:", r.err.c_str());
   CHECK(r.out.find("MISSION") == std::string::npos);
+}
+
+TEST(FirmwareMain, AStateDirectoryOthersMayWriteInStopsTheStartWithTheUsageCode) {
+  CHECK_EQUAL(0, chmod(dir.c_str(), 0777));
+  const Run r = run_firmware({"--state", dir.c_str(), "--resume"});
+  // The operator must fix the directory; a restart cannot (the unit does not restart on 2).
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+  STRCMP_CONTAINS(("boticelli: state directory " + dir +
+                   " refused: writable by group and others (mode 0777; chmod go-w ")
+                      .c_str(),
+                  r.err.c_str());
+  CHECK(r.out.find("MISSION") == std::string::npos);
+  CHECK_EQUAL(0, chmod(dir.c_str(), 0700));
 }
 
 namespace {

@@ -1,11 +1,13 @@
 // Tests of the rpi4 systemd unit against the firmware: which exit codes it restarts on, and that
 // a hung firmware is restarted by systemd well before the hardware watchdog resets the board.
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 
 #include "board_config.h"  // boards/rpi4: the hardware watchdog's timeout
 #include "firmware/app/firmware_main.h"
+#include "firmware/state/persistence.h"
 
 #include "CppUTest/TestHarness.h"
 
@@ -100,4 +102,24 @@ TEST(ServiceUnit, AHungFirmwareIsRestartedWellInsideTheHardwareWatchdogTimeout) 
   }
   // The firmware kicks every 100 ms: several kicks fit in systemd's interval.
   CHECK(watchdog_s >= 1.0);
+}
+
+// The firmware refuses a state directory its group or others may write in; the one systemd
+// makes for the unit (StateDirectory=, owned by User=, StateDirectoryMode=, 0755 when not
+// set) must pass, or the service would never start.
+TEST(ServiceUnit, TheStateDirectorySystemdMakesIsOneTheFirmwareAccepts) {
+  const auto keys = service_keys();
+  CHECK_TEXT(keys.count("StateDirectory") == 1 && keys.count("ExecStart") == 1,
+             "no StateDirectory or ExecStart");
+  if (keys.count("StateDirectory") == 0 || keys.count("ExecStart") == 0) return;
+  const std::string mode_text =
+      keys.count("StateDirectoryMode") != 0 ? keys.at("StateDirectoryMode") : "0755";
+  char* end = nullptr;
+  const unsigned long mode = std::strtoul(mode_text.c_str(), &end, 8);
+  CHECK_TEXT(end != mode_text.c_str() && *end == '\0' && mode <= 07777, mode_text.c_str());
+  CHECK_TEXT(boticelli::firmware::state_dir_mode_is_safe(static_cast<unsigned>(mode)),
+             mode_text.c_str());
+  // The directory is the --state of ExecStart.
+  STRCMP_CONTAINS(("--state /var/lib/" + keys.at("StateDirectory")).c_str(),
+                  keys.at("ExecStart").c_str());
 }

@@ -65,7 +65,10 @@ void make_state(std::uint64_t cycle, MissionState& s) {
 }
 
 void remove_dir(const std::string& dir) {
-  for (const char* name : {"/mission.state", "/mission.state.tmp"}) unlink((dir + name).c_str());
+  for (const char* name :
+       {"/mission.state", "/mission.state.tmp", "/parameters.conf", "/parameters.conf.tmp"}) {
+    unlink((dir + name).c_str());
+  }
   rmdir(dir.c_str());
 }
 
@@ -232,6 +235,86 @@ TEST(Persistence, SavesAtomicallyAndLoadsBack) {
   CHECK(stat((dir + "/mission.state.tmp").c_str(), &st) != 0);  // no temporary left behind
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
   CHECK(g_a == g_b);
+}
+
+TEST(Persistence, ASymlinkedTemporaryFileIsReplacedNotWrittenThrough) {
+  // Someone who could write in the directory left mission.state.tmp pointing elsewhere.
+  const std::string outside_dir = temp_dir("outside");
+  const std::string outside = outside_dir + "/precious";
+  write_file(outside, "do not touch\n");
+  CHECK_EQUAL(0, symlink(outside.c_str(), (dir + "/mission.state.tmp").c_str()));
+  CHECK_EQUAL(0, symlink(outside.c_str(), (dir + "/parameters.conf.tmp").c_str()));
+  CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
+  make_state(12, g_a);
+  CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  CHECK_TRUE_TEXT(g_store.save_parameters("telemetry_ms = 250\n", error, sizeof error), error);
+  STRCMP_EQUAL("do not touch\n", read_file(outside).c_str());
+  struct stat st {};
+  CHECK_EQUAL(0, lstat((dir + "/mission.state").c_str(), &st));
+  CHECK(S_ISREG(st.st_mode));  // a file of its own, not the symlink renamed into place
+  CHECK_EQUAL(0, lstat((dir + "/parameters.conf").c_str(), &st));
+  CHECK(S_ISREG(st.st_mode));
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+  CHECK(lstat((dir + "/mission.state.tmp").c_str(), &st) != 0);
+  unlink(outside.c_str());
+  rmdir(outside_dir.c_str());
+}
+
+TEST(Persistence, AStaleTemporaryFileLeftByACrashDoesNotBlockASave) {
+  write_file(dir + "/mission.state.tmp", "half a state from a killed run");
+  write_file(dir + "/parameters.conf.tmp", "half");
+  CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
+  make_state(5, g_a);
+  CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  CHECK_TRUE_TEXT(g_store.save_parameters("telemetry_ms = 250\n", error, sizeof error), error);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+  STRCMP_EQUAL("telemetry_ms = 250\n", read_file(dir + "/parameters.conf").c_str());
+  struct stat st {};
+  CHECK(stat((dir + "/mission.state.tmp").c_str(), &st) != 0);
+  CHECK(stat((dir + "/parameters.conf.tmp").c_str(), &st) != 0);
+}
+
+TEST(Persistence, ADirectoryOthersMayWriteInIsRefusedWithTheReason) {
+  CHECK_EQUAL(0, chmod(dir.c_str(), 0777));
+  CHECK_FALSE(g_store.open(dir.c_str(), error, sizeof error));
+  CHECK(g_store.refused());
+  CHECK_FALSE(g_store.is_open());
+  STRCMP_CONTAINS("refused: writable by group and others (mode 0777", error);
+  CHECK_EQUAL(0, chmod(dir.c_str(), 0770));
+  CHECK_FALSE(g_store.open(dir.c_str(), error, sizeof error));
+  STRCMP_CONTAINS("refused: writable by its group (mode 0770", error);
+  CHECK_EQUAL(0, chmod(dir.c_str(), 0757));
+  CHECK_FALSE(g_store.open(dir.c_str(), error, sizeof error));
+  STRCMP_CONTAINS("refused: writable by others (mode 0757", error);
+  // What mkdir with the usual umasks and systemd's StateDirectoryMode (0755 by default,
+  // 0750 in the unit) give is accepted.
+  for (const mode_t mode : {mode_t{0700}, mode_t{0750}, mode_t{0755}}) {
+    CHECK_EQUAL(0, chmod(dir.c_str(), mode));
+    CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
+    CHECK_FALSE(g_store.refused());
+  }
+  // A directory it creates itself is accepted too, whatever the umask.
+  const std::string created = dir + "/new";
+  const mode_t old_umask = umask(0);
+  const bool opened = g_store.open(created.c_str(), error, sizeof error);
+  umask(old_umask);
+  CHECK_TRUE_TEXT(opened, error);
+  rmdir(created.c_str());
+}
+
+TEST(Persistence, ADirectoryOfAnotherUserIsRefused) {
+  if (geteuid() != 0) {
+    UT_PRINT("not root: cannot give the directory to another user; owner check not run");
+    return;
+  }
+  CHECK_EQUAL(0, chown(dir.c_str(), 54321, static_cast<gid_t>(-1)));
+  CHECK_FALSE(g_store.open(dir.c_str(), error, sizeof error));
+  CHECK(g_store.refused());
+  STRCMP_CONTAINS("refused: owned by uid 54321, not by this user (uid 0)", error);
+  CHECK_EQUAL(0, chown(dir.c_str(), 0, static_cast<gid_t>(-1)));
+  CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
 }
 
 TEST(Persistence, ReportsACorruptOrTruncatedFileAndDoesNotLoadIt) {

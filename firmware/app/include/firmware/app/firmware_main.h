@@ -7,9 +7,10 @@ namespace boticelli::firmware {
 
 // Exit codes: 0 the target was found (or --help/--version), 1 a failure (board, device or
 // state directory could not be set up: a restart may help), 2 a usage error, a bad
-// configuration or a saved state that cannot be loaded (a restart cannot help: the service
-// unit does not restart on it), 3 the mission ended without finding the target
-// (result=not_found or aborted, e.g. stopped by a signal, the console or --max-cycles).
+// configuration, a refused state directory (not a directory, another owner, writable by
+// others: StateStore::refused) or a saved state that cannot be loaded (a restart cannot
+// help: the service unit does not restart on it), 3 the mission ended without finding the
+// target (result=not_found or aborted, e.g. stopped by a signal, the console or --max-cycles).
 inline constexpr int kExitFound = 0;
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;

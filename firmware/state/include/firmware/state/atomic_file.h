@@ -32,7 +32,9 @@ inline constexpr std::size_t kAtomicWriteChunkBytes = std::size_t{16} * 1024;
 
 // Replaces `dir`/`name` with `data`: writes `dir`/`name`.tmp, fsyncs it, renames it over
 // `dir`/`name` and fsyncs `dir`, so after a crash or power cut at any point the file holds
-// either its previous content or `data`, never a mix. No allocation (the paths are built on
+// either its previous content or `data`, never a mix. The temporary file is always created
+// anew (a stale one, or a symlink at its name, is unlinked first; then O_EXCL | O_NOFOLLOW),
+// so nothing outside `dir` is ever written through it. No allocation (the paths are built on
 // the stack), so it may run on any thread; it blocks in fsync, so never on the executive's
 // cyclic path. False with a one-line reason in `error` (the old file is then untouched).
 bool write_file_atomically(const char* dir, const char* name, std::string_view data, char* error,

@@ -28,6 +28,11 @@ std::size_t encode_state(const MissionState& state, char* out, std::size_t capac
 // Parses a whole file. On failure `out` is cleared, `error` says what was wrong.
 bool decode_state(std::string_view file, MissionState& out, const char** error);
 
+// A state directory's permission bits (st_mode) are safe when neither its group nor others
+// may write in it: no one but its owner can then put a file or a symlink where the state or
+// its temporary file goes. (The systemd unit's StateDirectoryMode must pass.)
+bool state_dir_mode_is_safe(unsigned mode);
+
 enum class LoadResult : std::uint8_t { kLoaded, kMissing, kCorrupt, kIoError };
 
 // The state directory. save() is atomic (write_file_atomically): it writes
@@ -43,8 +48,12 @@ class StateStore {
   StateStore(const StateStore&) = delete;
   StateStore& operator=(const StateStore&) = delete;
 
-  // Uses `dir`, creating it (one level) when missing. False with a reason otherwise.
+  // Uses `dir`, creating it (one level, mode 0750) when missing. False with a reason
+  // otherwise; refused() then tells a directory that is there but must not be used (not a
+  // directory, not owned by this process's user, or writable by its group or others: see
+  // state_dir_mode_is_safe) from one that could not be created.
   bool open(const char* dir, char* error, std::size_t error_size);
+  bool refused() const { return refused_; }
   bool save(const MissionState& state, char* error, std::size_t error_size);
   // Replaces `parameters.conf` with `text` (the console's `param save`), atomically.
   bool save_parameters(std::string_view text, char* error, std::size_t error_size);
@@ -73,6 +82,7 @@ class StateStore {
   std::array<char, 512> parameters_path_{};
   std::array<char, kMaxStateFileBytes> buffer_{};
   std::uint64_t saves_ = 0;
+  bool refused_ = false;
   SaveCrashHook crash_hook_ = nullptr;
   void* crash_context_ = nullptr;
 };
