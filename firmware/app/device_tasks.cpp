@@ -116,7 +116,7 @@ void WatchdogTask::run(std::uint64_t) {
   }
   if (!healthy) {
     pattern_ = LedPattern::kFault;
-  } else if (safety_ != nullptr && safety_->engaged()) {
+  } else if (safety_ != nullptr && safety_->holds()) {
     pattern_ = LedPattern::kEstop;
   } else if (view_ != nullptr && view_->target().status == TargetStatus::kConfirmed) {
     pattern_ = LedPattern::kTargetFound;

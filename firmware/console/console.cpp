@@ -15,16 +15,18 @@ static_assert(LogRing::kLines == 64, "the `log show N` error message names the r
 
 const Console::Command Console::kCommands[] = {
     {"help", "", "list the commands", &Console::cmd_help},
-    {"status", "", "state, e-stop, pause, health, cycles, uptime", &Console::cmd_status},
+    {"status", "", "state, e-stop, pause, what it waits for, health, cycles, uptime",
+     &Console::cmd_status},
     {"stats", "[reset]", "executive timing per task, frame jitter, background use",
      &Console::cmd_stats},
     {"pose", "", "robot pose in the world frame", &Console::cmd_pose},
     {"model", "", "the occupancy ALN in the text format", &Console::cmd_model},
     {"map", "", "navigation polygon and point list sizes", &Console::cmd_map},
     {"pause", "", "pause the background work (mission)", &Console::cmd_pause},
-    {"resume", "", "resume the background work", &Console::cmd_resume},
+    {"resume", "", "after pause or clear-estop: the background work and the base go on",
+     &Console::cmd_resume},
     {"estop", "", "stop the base now and latch the e-stop", &Console::cmd_estop},
-    {"clear-estop", "", "release the e-stop latch when no input is active",
+    {"clear-estop", "", "reset the e-stop latch when no input is active (then resume)",
      &Console::cmd_clear_estop},
     {"get", "[NAME]", "show one or every parameter", &Console::cmd_get},
     {"set", "NAME VALUE", "set a parameter (range checked)", &Console::cmd_set},
@@ -269,8 +271,9 @@ void Console::cmd_status(const Words& w) {
   if (!no_args(w)) return reply_error("status takes no arguments");
   const FrameStats& f = executive_.frame_stats();
   const MapCounts m = view_.map_counts();
-  reply_.appendf("status state=%s estop=%s paused=%d healthy=%d", view_.state_name(),
-                 stop_cause_name(safety_.cause()), executive_.background_paused() ? 1 : 0,
+  const bool paused = executive_.background_paused();
+  reply_.appendf("status state=%s estop=%s paused=%d waits_for=%s healthy=%d", view_.state_name(),
+                 stop_cause_name(safety_.cause()), paused ? 1 : 0, awaited_command(safety_, paused),
                  robot_healthy() ? 1 : 0);
   append_unhealthy(reply_);
   reply_.appendf(" cycles=%llu pieces=%u features=%u obstacle_points=%u exploration_points=%u",
@@ -401,6 +404,8 @@ void Console::cmd_pause(const Words& w) {
 
 void Console::cmd_resume(const Words& w) {
   if (!no_args(w)) return reply_error("resume takes no arguments");
+  // After an e-stop's reset the base goes on only now; refused while the latch is engaged.
+  if (const char* why = safety_.resume(); why != nullptr) return reply_error(why);
   executive_.set_background_paused(false);
   emit("OK\r\n");
 }
@@ -651,14 +656,21 @@ void Console::check_executive(std::uint64_t now_us) {
     seen_background_overruns_ = f.background_overruns;
     next_overrun_log_us_ = now_us + 1000000U;
   }
-  // The e-stop latch: which input stopped the base (an e-stop is not a fault of a task).
+  // The e-stop latch: which input stopped the base (an e-stop is not a fault of a task), and
+  // what the operator must type next.
   if (safety_.cause() != logged_cause_) {
     if (safety_.cause() == StopCause::kNone) {
-      log(LogLevel::kInfo, "e-stop released (was %s)", stop_cause_name(logged_cause_));
+      log(LogLevel::kInfo, "e-stop cleared (was %s), base stopped until resume",
+          stop_cause_name(logged_cause_));
     } else {
-      log(LogLevel::kWarn, "e-stop engaged: %s (base stopped)", stop_cause_name(safety_.cause()));
+      log(LogLevel::kWarn, "e-stop engaged: %s (base stopped), latched until clear-estop",
+          stop_cause_name(safety_.cause()));
     }
     logged_cause_ = safety_.cause();
+  }
+  if (safety_.awaiting_resume() != logged_awaiting_resume_) {
+    if (!safety_.awaiting_resume()) log(LogLevel::kInfo, "resumed after the e-stop: base released");
+    logged_awaiting_resume_ = safety_.awaiting_resume();
   }
   // Each task's health on its own line, with the device's reason: which device failed and
   // why, not only that something did.
@@ -725,11 +737,12 @@ void Console::send_telemetry(std::uint64_t now_us) {
   TextBuffer<256> line;
   line.appendf(
       "TLM t_s=%.2f state=%s cycles=%llu pan_rad=%.3f features=%u pieces=%u x_m=%.3f y_m=%.3f "
-      "yaw_rad=%.3f estop=%s target=%s\r\n",
+      "yaw_rad=%.3f estop=%s waits_for=%s target=%s\r\n",
       static_cast<double>(now_us - start_us_) * 1e-6, view_.state_name(),
       static_cast<unsigned long long>(view_.cycles()), static_cast<double>(view_.pan_rad()),
       view_.features(), view_.pieces(), static_cast<double>(p.x_m), static_cast<double>(p.y_m),
       static_cast<double>(p.yaw_rad), stop_cause_name(safety_.cause()),
+      awaited_command(safety_, executive_.background_paused()),
       target_status_name(view_.target().status));
   if (!line.truncated()) emit_unsolicited(line.view());
 }

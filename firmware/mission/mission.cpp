@@ -112,7 +112,6 @@ Mission::Mission(const MissionContext& c)
       trace_(c.trace),
       snapshots_(c.snapshots),
       params_(make_mission_params(c.config)),
-      release_(params_.release_hold_us),
       pose_(c.hal.base),
       scan_(params_),
       look_(params_.rig, params_.stereo, params_.model.close_blocked_rays),
@@ -217,7 +216,7 @@ void Mission::abort_with(const char* why, const char* device_error) {
 // ---------------------------------------------------------------- control (mission task)
 
 bool Mission::hold_needed() {
-  return safety_.engaged() || executive_.background_paused();
+  return safety_.holds() || executive_.background_paused();
 }
 
 void Mission::control(std::uint64_t now_us) {
@@ -237,7 +236,6 @@ void Mission::control(std::uint64_t now_us) {
     held_phase_ = phase_;
     phase_ = Phase::kHold;
     scan_.stop_frames();
-    release_.restart();
     if (driver_.busy()) driver_.abort("held");
   }
   switch (phase_) {
@@ -274,12 +272,9 @@ void Mission::control_hold(std::uint64_t now_us) {
     const hal::Odometry o = hal_.base.odometry();
     (void)driver_.update(pose_.pose(), o.v_m_s, o.omega_rad_s, now_us);
   }
-  if (safety_.engaged()) {
-    // A button stop is cleared once the button has been released for a while; a console
-    // stop waits for the console's `clear-estop`.
-    (void)release_.update(safety_, hal_.estop, now_us);
-    return;
-  }
+  // Latched, or reset and waiting for the console's `resume`: only the operator ends it (a
+  // released button or a line that comes back does not).
+  if (safety_.holds()) return;
   if (executive_.background_paused()) return;
   if (hal_.base.health() != hal::BaseHealth::kReady) return;
   // Carry on. An interrupted step is not resumed blind: the robot looks again first.

@@ -37,7 +37,7 @@ void Safety::poll() {
     engage(StopCause::kButton);
   } else if (bumper) {
     engage(StopCause::kBumper);
-  } else if (engaged() && base_.health() != hal::BaseHealth::kStopped) {
+  } else if (holds() && base_.health() != hal::BaseHealth::kStopped) {
     base_.stop();  // something resumed the base behind the latch's back
   }
 }
@@ -46,9 +46,23 @@ const char* Safety::clear() {
   if (estop_.read()) return "e-stop button still pressed";
   if (bumper_.read()) return "bumper still in contact";
   if (!engaged()) return nullptr;
-  if (!base_.resume()) return "base cannot resume";
   cause_ = StopCause::kNone;
+  awaiting_resume_ = true;  // the base stays stopped: a reset restarts nothing
   return nullptr;
+}
+
+const char* Safety::resume() {
+  if (engaged()) return "e-stop latched: clear-estop first";
+  if (!awaiting_resume_) return nullptr;
+  if (!base_.resume()) return "base cannot resume";
+  awaiting_resume_ = false;
+  return nullptr;
+}
+
+const char* awaited_command(const Safety& safety, bool background_paused) {
+  if (safety.engaged()) return "clear-estop";
+  if (safety.awaiting_resume() || background_paused) return "resume";
+  return "none";
 }
 
 }  // namespace boticelli::firmware

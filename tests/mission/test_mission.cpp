@@ -2,7 +2,9 @@
 // anything, checked against the world's geometry from the trace, and is deterministic.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <cstdio>
 #include <cstdlib>
@@ -50,10 +52,11 @@ std::string slurp(const std::string& path) {
 }
 
 // Runs firmware_main on the sim board with stdout captured; checks the trace against the
-// world's colliders with the robot's disc (not the simulator's own contact counter).
+// world's colliders with the robot's disc (not the simulator's own contact counter). The
+// console's stdin is at its end, or `console_in` (a pipe's read end the test types into).
 MissionRun run_mission(const char* world, const char* seed, float odometry_noise = 0.0F,
                        const boticelli::firmware::MainHooks* hooks = nullptr,
-                       const std::vector<const char*>& extra = {}) {
+                       const std::vector<const char*>& extra = {}, int console_in = -1) {
   char dir_template[] = "/tmp/boticelli-mission-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
   MissionRun run;
@@ -78,7 +81,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   FILE* f = std::fopen(out.c_str(), "w");
   FILE* null_in = std::fopen("/dev/null", "r");
   dup2(fileno(f), 1);
-  dup2(fileno(null_in), 0);
+  dup2(console_in >= 0 ? console_in : fileno(null_in), 0);
   run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(argv.size()), argv.data(),
                                                      g_board, hooks);
   run.final_pose = g_board.robot_pose();
@@ -312,64 +315,109 @@ TEST(MissionRooms, WithNothingLeftToExploreTheRobotTurnsRoundAndLooksOnceMoreBef
   CHECK(std::hypot(looks.back().x_m - turn.x_m, looks.back().y_m - turn.y_m) < 0.5);
 }
 
-// Presses the e-stop the first time the base drives forward, holds it 3 s of simulated time,
-// and records what the base did meanwhile.
+// Presses the e-stop the first time the base drives forward and releases it 3 s of simulated
+// time later; the operator types `clear-estop` 5 s after the release and `resume` 2 s after
+// that (into the console's stdin, a pipe). Records what the base did meanwhile.
 struct EstopScript {
-  int phase = 0;  // 0 waiting for a drive, 1 pressed, 2 released
+  enum Phase { kWaiting, kPressed, kReleased, kCleared, kResumed };
+  Phase phase = kWaiting;
+  int console_fd = -1;  // the write end of the console's stdin
   std::uint64_t pressed_us = 0;
+  std::uint64_t released_us = 0;
+  std::uint64_t cleared_us = 0;
+  std::uint64_t resumed_us = 0;
   int frames_to_stop = -1;  // frames after the press until the base reported stopped
   int frames = 0;
   boticelli::core::Pose2 settled{};  // true pose 1 s after the press
-  float moved_while_held_m = -1.0F;  // from 1 s after the press to the release
   bool settled_taken = false;
+  // Farthest from the settled pose (m + rad) while pressed, after the release until the
+  // reset, and after the reset until the resume.
+  float moved_while_pressed_m = -1.0F;
+  float moved_after_release_m = -1.0F;
+  float moved_after_reset_m = -1.0F;
+  bool stopped_until_resume = true;  // the base reported stopped at every frame before it
 };
 
 void on_frame_estop(void* context) {
   auto* e = static_cast<EstopScript*>(context);
   sim::SimWorld& w = g_board.sim();
   const std::uint64_t now = w.now_us();
-  if (e->phase == 0) {
+  if (e->phase == EstopScript::kWaiting) {
     if (w.odometry().v_m_s > 0.1F && w.base_health() == boticelli::hal::BaseHealth::kReady) {
       w.set_estop_pressed(true);
       e->pressed_us = now;
-      e->phase = 1;
+      e->phase = EstopScript::kPressed;
     }
     return;
   }
-  if (e->phase != 1) return;
+  if (e->phase == EstopScript::kResumed) return;
   ++e->frames;
-  if (e->frames_to_stop < 0 && w.base_health() == boticelli::hal::BaseHealth::kStopped) {
-    e->frames_to_stop = e->frames;
-  }
+  const bool stopped = w.base_health() == boticelli::hal::BaseHealth::kStopped;
+  if (e->frames_to_stop < 0 && stopped) e->frames_to_stop = e->frames;
+  if (e->frames_to_stop >= 0 && !stopped) e->stopped_until_resume = false;
   const boticelli::core::Pose2 p = w.true_pose();
   if (!e->settled_taken && now >= e->pressed_us + 1000000U) {
     e->settled = p;
     e->settled_taken = true;
   }
-  if (now >= e->pressed_us + 3000000U) {
-    e->moved_while_held_m = std::hypot(p.x_m - e->settled.x_m, p.y_m - e->settled.y_m) +
-                            std::fabs(p.yaw_rad - e->settled.yaw_rad);
+  if (e->settled_taken) {
+    const float moved = std::hypot(p.x_m - e->settled.x_m, p.y_m - e->settled.y_m) +
+                        std::fabs(p.yaw_rad - e->settled.yaw_rad);
+    float& farthest = e->phase == EstopScript::kPressed    ? e->moved_while_pressed_m
+                      : e->phase == EstopScript::kReleased ? e->moved_after_release_m
+                                                           : e->moved_after_reset_m;
+    farthest = std::max(farthest, moved);
+  }
+  const auto type = [e](const char* text) {
+    CHECK(write(e->console_fd, text, std::strlen(text)) == static_cast<ssize_t>(std::strlen(text)));
+  };
+  if (e->phase == EstopScript::kPressed && now >= e->pressed_us + 3000000U) {
     w.set_estop_pressed(false);
-    e->phase = 2;
+    e->released_us = now;
+    e->phase = EstopScript::kReleased;
+  } else if (e->phase == EstopScript::kReleased && now >= e->released_us + 5000000U) {
+    type("clear-estop\r");
+    e->cleared_us = now;
+    e->phase = EstopScript::kCleared;
+  } else if (e->phase == EstopScript::kCleared && now >= e->cleared_us + 2000000U) {
+    type("resume\r");
+    e->resumed_us = now;
+    e->phase = EstopScript::kResumed;
   }
 }
 
-TEST(MissionEstop, PressedMidDriveTheBaseStopsWithinAFrameAndTheMissionCarriesOnAfterRelease) {
+TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndResume) {
+  int console[2] = {-1, -1};
+  CHECK(pipe(console) == 0);
   EstopScript e;
+  e.console_fd = console[1];
   boticelli::firmware::MainHooks hooks;
   hooks.after_frame = on_frame_estop;
   hooks.context = &e;
-  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks);
-  CHECK_EQUAL(2, e.phase);
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks, {}, console[0]);
+  close(console[0]);
+  close(console[1]);
+  CHECK_EQUAL(EstopScript::kResumed, e.phase);
   CHECK_TEXT(e.frames_to_stop >= 1 && e.frames_to_stop <= 1, "the base stops within one frame");
-  DOUBLES_EQUAL(0.0, e.moved_while_held_m, 1e-6);
-  // The trace shows the hold, then more driving, and the mission ends found.
+  // Not a millimetre while pressed, in the 5 s after the release (no reset) and in the 2 s
+  // after the reset (no resume); the base stopped all along.
+  DOUBLES_EQUAL(0.0, e.moved_while_pressed_m, 1e-6);
+  DOUBLES_EQUAL(0.0, e.moved_after_release_m, 1e-6);
+  DOUBLES_EQUAL(0.0, e.moved_after_reset_m, 1e-6);
+  CHECK(e.stopped_until_resume);
+  // The trace: held from the press to the resume, then more driving; the mission ends found.
   bool held = false;
   bool drove_after = false;
   for (const sim::TraceRow& row : r.trace) {
-    if (row.t_s * 1e6 < static_cast<double>(e.pressed_us)) continue;
-    held = held || std::string(row.state) == "hold";
-    drove_after = drove_after || (held && std::string(row.state) == "drive");
+    const double t_us = row.t_s * 1e6;
+    if (t_us < static_cast<double>(e.pressed_us) + 50000.0) continue;
+    const bool hold = std::string(row.state) == "hold";
+    if (t_us < static_cast<double>(e.resumed_us)) {
+      CHECK_TEXT(hold, ("not held at t_s=" + std::to_string(row.t_s)).c_str());
+    }
+    held = held || hold;
+    drove_after = drove_after ||
+                  (t_us > static_cast<double>(e.resumed_us) && std::string(row.state) == "drive");
   }
   CHECK(held);
   CHECK(drove_after);

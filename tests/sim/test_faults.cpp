@@ -77,10 +77,11 @@ TEST_GROUP(Faults) {
     std::snprintf(
         summary, sizeof summary,
         "%s %s: moving_before=%d stop_latency_ms=%.1f stayed_stopped=%d "
-        "moving_after=%d says_expected=%d healthy_after=%d collisions=%u "
-        "state_loadable=%d\n--- console ---\n",
+        "held_until_reset=%d held_until_resume=%d moving_after=%d says_expected=%d "
+        "healthy_after=%d collisions=%u state_loadable=%d\n--- console ---\n",
         boticelli::hal::sim::fault_device_name(device), boticelli::hal::sim::fault_type_name(type),
         g_result.moving_before ? 1 : 0, g_result.stop_latency_ms, g_result.stayed_stopped ? 1 : 0,
+        g_result.held_until_reset ? 1 : 0, g_result.held_until_resume ? 1 : 0,
         g_result.moving_after ? 1 : 0, g_result.says_expected ? 1 : 0,
         g_result.healthy_after ? 1 : 0, g_result.collisions, g_result.state_loadable ? 1 : 0);
     CHECK_TEXT(g_result.passed, (std::string(summary) + g_result.console.data()).c_str());
@@ -128,9 +129,10 @@ FAULT_PAIR_MORE(TheRightAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kA
                 kIntermittent)
 FAULT_PAIR_MORE(ACanBusOffStopsTheBaseWithinAFrame, kCan, kOff)
 FAULT_PAIR_MORE(ACanBusGoingOffNowAndThenStopsTheBaseAtTheFirstTime, kCan, kIntermittent)
-FAULT_PAIR_MORE(ABrokenEstopLineStopsTheBaseAndTheRobotCarriesOnWhenItIsBack, kEstop, kOff)
-FAULT_PAIR_MORE(AStuckEstopStopsTheBaseAndTheRobotCarriesOnAfterTheRelease, kEstop, kStuck)
-FAULT_PAIR_MORE(AChatteringEstopKeepsTheBaseStoppedUntilItIsQuiet, kEstop, kIntermittent)
+FAULT_PAIR_MORE(ABrokenEstopLineStopsTheBaseUntilClearEstopAndResumeAfterItIsBack, kEstop, kOff)
+FAULT_PAIR_MORE(AStuckEstopStopsTheBaseUntilClearEstopAndResumeAfterTheRelease, kEstop, kStuck)
+FAULT_PAIR_MORE(AChatteringEstopStopsTheBaseUntilClearEstopAndResumeAfterItIsQuiet, kEstop,
+                kIntermittent)
 FAULT_PAIR_MORE(ABrokenBumperLineStopsTheBaseForGood, kBumper, kOff)
 FAULT_PAIR_MORE(AStuckBumperStopsTheBaseForGood, kBumper, kStuck)
 FAULT_PAIR_MORE(AChatteringBumperStopsTheBaseForGood, kBumper, kIntermittent)

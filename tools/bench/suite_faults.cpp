@@ -45,6 +45,12 @@ struct MissionOutcome {
   long long collisions = -1;
   bool state_loadable = false;
   double cpu_s = 0.0;
+  // With an operator reset: the telemetry lines `clear-estop` and `resume` were typed after
+  // (empty when not typed), and whether they showed the mission still held.
+  std::string reset_seen;
+  std::string resume_seen;
+  bool held_until_reset = false;
+  bool held_until_resume = false;
 };
 
 // The MISSION line's fields: result=WORD ... reason="TEXT".
@@ -62,7 +68,7 @@ void parse_mission(const std::string& out, MissionOutcome& m) {
 }
 
 MissionOutcome run_mission(const std::string& firmware, const std::string& world,
-                           FaultDevice device, FaultType type) {
+                           FaultDevice device, FaultType type, bool operator_reset) {
   MissionOutcome m;
   char dir_template[] = "/tmp/boticelli-faults-XXXXXX";
   const char* dir = ::mkdtemp(dir_template);
@@ -77,10 +83,26 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
   const std::string out = std::string(dir) + "/out.txt";
   const std::string err = std::string(dir) + "/err.txt";
   bool timed_out = false;
+  // The operator: `clear-estop` kMissionResetAfterS after the fault's end, `resume` once the
+  // telemetry says the mission waits for it (a telemetry line a second).
+  const double reset_s = boards::sim::kMissionFaultStartS + boards::sim::kMissionFaultS +
+                         boards::sim::kMissionResetAfterS;
+  std::vector<ConsoleInput> input = {{reset_s, "", "clear-estop\r", ""},
+                                     {reset_s, "waits_for=resume", "resume\r", ""}};
   (void)run_firmware({firmware, "--world", world, "--seed", "1", "--max-cycles", "1", "--faults",
                       plan, "--state", dir, "--console", "stdio"},
-                     out, err, 600.0, timed_out, m.cpu_s);
+                     out, err, 600.0, timed_out, m.cpu_s, operator_reset ? &input : nullptr);
   parse_mission(read_file(out), m);
+  if (operator_reset) {
+    m.reset_seen = input[0].seen;
+    m.resume_seen = input[1].seen;
+    const auto held = [](const std::string& line, const char* waits_for) {
+      return line.find("state=hold ") != std::string::npos &&
+             line.find(waits_for) != std::string::npos;
+    };
+    m.held_until_reset = held(m.reset_seen, "waits_for=clear-estop ");
+    m.held_until_resume = held(m.resume_seen, "waits_for=resume ");
+  }
   char error[256] = "";
   m.state_loadable = g_store.open(dir, error, sizeof error) &&
                      g_store.load(g_state, error, sizeof error) == firmware::LoadResult::kLoaded;
@@ -104,7 +126,28 @@ std::string expected_text(const FaultExpectation& e) {
   std::string s =
       e.stops_base ? "base stopped within a frame, stays stopped; " : "base keeps moving; ";
   s += "console: `" + std::string(e.console_says) + "`; ";
-  s += e.recovers ? "healthy and moving again after it" : "stays stopped (no restart by itself)";
+  if (e.operator_reset) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "after it still stopped until `clear-estop` (typed %.1f s later) and after "
+                  "that until `resume` (%.1f s later); then ",
+                  boards::sim::FaultScenarioConfig{}.after_s,
+                  static_cast<double>(boards::sim::kResetToResumeUs) * 1e-6);
+    s += buf;
+  }
+  s += e.recovers ? "healthy and moving again" : "stays stopped (no restart by itself)";
+  if (e.recovers && !e.operator_reset) s += " after it";
+  return s;
+}
+
+// The telemetry line's `t_s=`, `state=` and `waits_for=` fields.
+std::string telemetry_fields(const std::string& line) {
+  std::string s;
+  for (const char* key : {"t_s=", "state=", "waits_for="}) {
+    const std::size_t at = line.find(key);
+    if (at == std::string::npos) continue;
+    s += (s.empty() ? "" : " ") + line.substr(at, line.find(' ', at) - at);
+  }
   return s;
 }
 
@@ -119,6 +162,10 @@ std::string seen_text(const FaultExpectation& e, const FaultScenarioResult& r) {
   }
   s += buf;
   s += r.says_expected ? "console said it; " : "console did NOT say it; ";
+  if (e.operator_reset) {
+    s += r.held_until_reset ? "at rest until clear-estop" : "MOVED before clear-estop";
+    s += r.held_until_resume ? " and until resume; " : ", MOVED before resume; ";
+  }
   s += r.healthy_after ? "healthy after" : "unhealthy after";
   s += r.moving_after ? ", moving" : ", at rest";
   if (e.stops_base || r.watchdog_expirations > 0) {
@@ -191,12 +238,13 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
         ::unlink((std::string(dir) + "/mission.state").c_str());
         ::rmdir(dir);
       }
-      const MissionOutcome m = run_mission(firmware, world, device, type);
+      const MissionOutcome m = run_mission(firmware, world, device, type, e.operator_reset);
       // The MISSION line counts bumper contacts: a faulted bumper line's are not the world's
       // (the stand-in's run checks the simulator's own count, which stays 0).
       const bool contacts_ok = m.collisions == 0 || device == FaultDevice::kBumper;
-      const bool mission_ok =
-          m.ran && contacts_ok && m.state_loadable && (m.result == "aborted") == e.mission_aborts;
+      const bool reset_ok = !e.operator_reset || (m.held_until_reset && m.held_until_resume);
+      const bool mission_ok = m.ran && contacts_ok && m.state_loadable && reset_ok &&
+                              (m.result == "aborted") == e.mission_aborts;
       const bool ok = ran && g_result.passed && mission_ok;
       passed += ok ? 1 : 0;
       JsonLine(kSuite, "pair")
@@ -214,6 +262,8 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
           .text("mission_reason", m.reason.c_str())
           .integer("mission_collisions", m.collisions)
           .flag("mission_state_loadable", m.state_loadable)
+          .text("mission_clear_estop_after", m.reset_seen.c_str())
+          .text("mission_resume_after", m.resume_seen.c_str())
           .num("mission_cpu_s", m.cpu_s)
           .flag("passed", ok)
           .emit();
@@ -227,7 +277,14 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
                 : device == FaultDevice::kBumper ? " (collisions=" + std::to_string(m.collisions) +
                                                        ": the faulted bumper's contacts)"
                                                  : ", COLLISIONS=" + std::to_string(m.collisions)) +
-               (m.state_loadable ? "" : ", state file NOT loadable")) +
+               (m.state_loadable ? "" : ", state file NOT loadable") +
+               (!e.operator_reset ? ""
+                : m.reset_seen.empty()
+                    ? "; clear-estop NOT typed (no telemetry line for it)"
+                    : "; clear-estop typed after `" + telemetry_fields(m.reset_seen) + "`" +
+                          (m.resume_seen.empty()
+                               ? ", resume NOT typed (the mission never waited for it)"
+                               : ", resume after `" + telemetry_fields(m.resume_seen) + "`"))) +
           " | " + (ok ? "ok" : "**FAILED**") + " |\n";
     }
   }

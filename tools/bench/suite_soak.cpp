@@ -129,6 +129,7 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
       .integer("ended_unsafe", r.ended_unsafe)
       .text("first_unsafe", r.first_unsafe)
       .integer("stop_violations", static_cast<std::int64_t>(r.stop_violations))
+      .integer("operator_resets", r.operator_resets)
       .integer("collisions", r.collisions)
       .integer("allocations_after_init", static_cast<std::int64_t>(g_allocations.load()))
       .integer("saves", static_cast<std::int64_t>(r.saves))

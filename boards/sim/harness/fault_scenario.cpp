@@ -14,7 +14,6 @@
 #include "firmware/telemetry/mission_view.h"
 #include "firmware/common/parameters.h"
 #include "firmware/state/persistence.h"
-#include "firmware/safety/button_release.h"
 #include "firmware/safety/safety.h"
 #include "firmware/app/runtime.h"
 #include "firmware/app/service_notify.h"
@@ -42,6 +41,9 @@ constexpr const char* kFrameTimeout =
 constexpr const char* kBaseAbort =
     "aborted at its next step: base stopped by itself, with the driver's reason";
 constexpr const char* kCarriesOn = "carries on";
+constexpr const char* kHoldsUntilReset =
+    "holds until the operator's clear-estop and resume (typed 2 s after the line is back), "
+    "then carries on";
 constexpr ExpectationRow kExpectations[] = {
     {FaultDevice::kCamera,
      FaultType::kOff,
@@ -112,16 +114,13 @@ constexpr ExpectationRow kExpectations[] = {
      {true, "base unhealthy: base: CAN bus-off", false, kBaseAbort, true}},
     {FaultDevice::kEstop,
      FaultType::kOff,
-     {true, "e-stop engaged: button (base stopped)", true,
-      "holds; carries on 0.5 s after the line is back"}},
+     {true, "e-stop engaged: button (base stopped)", true, kHoldsUntilReset, false, true}},
     {FaultDevice::kEstop,
      FaultType::kStuck,
-     {true, "e-stop engaged: button (base stopped)", true,
-      "holds; carries on 0.5 s after the release"}},
+     {true, "e-stop engaged: button (base stopped)", true, kHoldsUntilReset, false, true}},
     {FaultDevice::kEstop,
      FaultType::kIntermittent,
-     {true, "e-stop engaged: button (base stopped)", true,
-      "holds; carries on 0.5 s after the last release"}},
+     {true, "e-stop engaged: button (base stopped)", true, kHoldsUntilReset, false, true}},
     {FaultDevice::kBumper,
      FaultType::kOff,
      {true, "e-stop engaged: bumper (base stopped)", false, "aborted: bumper contact", true}},
@@ -172,6 +171,7 @@ class CapturePort final : public hal::SerialPort {
     return static_cast<std::ptrdiff_t>(size);
   }
   void feed(std::string_view text) {
+    if (in_pos_ == in_len_) in_pos_ = in_len_ = 0;  // all read: room again
     for (const char c : text) {
       if (in_len_ < in_.size()) in_[in_len_++] = c;
     }
@@ -191,8 +191,8 @@ class CapturePort final : public hal::SerialPort {
 };
 
 // In the mission's place: keeps the base turning in place (no contact possible) and the PTU
-// scanning, takes frames, clears a button stop 0.5 s after the release (as the mission
-// does), and saves a state every half second.
+// scanning, takes frames, and saves a state every half second. Like the mission it holds while
+// the e-stop latch does (engaged, or reset and waiting for the console's `resume`).
 class StandIn final : public fw::Task,
                       public fw::MissionView,
                       public fw::FrameConsumer,
@@ -206,11 +206,8 @@ class StandIn final : public fw::Task,
 
   void run(std::uint64_t now_us) override {
     now_us_ = now_us;
-    if (safety_.engaged()) {
-      (void)release_.update(safety_, hal_.estop, now_us);
-    } else {
-      release_.restart();
-      if (hal_.base.health() == hal::BaseHealth::kReady) hal_.base.set_velocity(0.0F, 0.4F);
+    if (!safety_.holds() && hal_.base.health() == hal::BaseHealth::kReady) {
+      hal_.base.set_velocity(0.0F, 0.4F);
     }
     const hal::PanTiltState ptu = hal_.pan_tilt.state();
     if (!ptu.moving && !ptu.fault) {
@@ -253,7 +250,6 @@ class StandIn final : public fw::Task,
   fw::MissionState& state_;
   fw::StateSaver* saver_;
   std::uint64_t now_us_ = 0;
-  fw::ButtonRelease release_;  // the mission's rule for a button stop's release
   std::uint64_t next_save_us_ = 0;
   std::uint64_t frames_ = 0;
   std::uint64_t ptu_moves_ = 0;
@@ -372,6 +368,7 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   bool stopped_seen = false;
   bool broke_stop = false;
   bool after_seen = false;
+  bool moved_after_end = false;
   std::uint64_t failing_since_us = 0;
   std::uint64_t frames_at_end = 0;
   std::uint64_t moves_at_end = 0;
@@ -430,6 +427,26 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
       frames_at_end = rig.stand_in.frames();
       moves_at_end = rig.stand_in.ptu_moves();
     }
+    moved_after_end = moved_after_end || !at_rest;
+  }
+  if (expected.operator_reset) {
+    // The operator, once the line has been back for after_s: `clear-estop`, and 0.5 s later
+    // `resume`. The base must not move before the resume.
+    out.held_until_reset = !moved_after_end;
+    const auto run_for = [&](std::uint64_t us) {
+      bool moved = false;
+      const std::uint64_t until = hal.clock.now_us() + us;
+      while (hal.clock.now_us() < until) {
+        rig.runtime.executive.run_frame();
+        ++out.frames;
+        moved = moved || !wheels_at_rest(sim);
+      }
+      return moved;
+    };
+    rig.port.feed("clear-estop\r");
+    out.held_until_resume = !run_for(kResetToResumeUs);
+    rig.port.feed("resume\r");
+    (void)run_for(kResetToResumeUs);
   }
   rig.port.feed("status\r");
   rig.runtime.executive.run_frame();
@@ -467,6 +484,7 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   } else {
     ok = ok && out.moving_before && !stopped_seen;  // nothing made a stop necessary
   }
+  if (expected.operator_reset) ok = ok && out.held_until_reset && out.held_until_resume;
   if (expected.recovers) {
     ok = ok && out.healthy_after && out.moving_after;
   } else {
@@ -491,7 +509,12 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
   constexpr std::uint64_t kSettleUs = 1500000;
   std::uint32_t ended_seen = 0;
   std::uint64_t check_at_us = 0;  // a quiet check is due then (0: none)
-  std::uint64_t line_active_since_us = 0;
+  std::uint64_t must_rest_since_us = 0;
+  // The operator: after a stop line was active, the wheels stay at rest until they have typed
+  // `clear-estop` and `resume`, which they do kOperatorUs after the line's last fault ended.
+  constexpr std::uint64_t kOperatorUs = 500000;
+  bool reset_due = false;
+  std::uint64_t reset_at_us = 0;
   if (config.loop_started != nullptr) config.loop_started(config.context);
   while (hal.clock.now_us() < end_us) {
     rig.runtime.executive.run_frame();
@@ -499,21 +522,37 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
     const std::uint64_t now = hal.clock.now_us();
     bool any_active = false;
     bool line_active = false;
+    bool line_fault = false;
     for (std::size_t d = 0; d < hal::sim::kFaultDeviceCount; ++d) {
       FaultType type = FaultType::kOff;
       const auto device = static_cast<FaultDevice>(d);
-      if (faults.active(device, type)) any_active = true;
-      if ((device == FaultDevice::kEstop || device == FaultDevice::kBumper) &&
-          faults.failing(device, type)) {
-        line_active = true;
+      const bool active = faults.active(device, type);
+      if (active) any_active = true;
+      if (device == FaultDevice::kEstop || device == FaultDevice::kBumper) {
+        line_fault = line_fault || active;
+        if (faults.failing(device, type)) line_active = true;
       }
     }
-    // The e-stop or bumper line active: the wheels at rest after one frame's grace.
-    if (line_active) {
-      if (line_active_since_us == 0) line_active_since_us = now;
-      if (now - line_active_since_us > 10000U && !wheels_at_rest(sim)) ++out.stop_violations;
+    if (line_active) reset_due = true;
+    // The e-stop or bumper line active, or not yet reset and resumed by the operator: the
+    // wheels at rest after one frame's grace.
+    if (line_active || reset_due) {
+      if (must_rest_since_us == 0) must_rest_since_us = now;
+      if (now - must_rest_since_us > 10000U && !wheels_at_rest(sim)) ++out.stop_violations;
     } else {
-      line_active_since_us = 0;
+      must_rest_since_us = 0;
+    }
+    if (reset_due && !line_fault) {
+      if (reset_at_us == 0) {
+        reset_at_us = now + kOperatorUs;
+      } else if (now >= reset_at_us) {
+        rig.port.feed("clear-estop\rresume\r");
+        ++out.operator_resets;
+        reset_due = false;
+        reset_at_us = 0;
+      }
+    } else {
+      reset_at_us = 0;
     }
     if (faults.ended() != ended_seen) {
       ended_seen = faults.ended();

@@ -31,11 +31,19 @@ struct FaultExpectation {
   // bench's mission column), and whether it then ends aborted (else it carries on).
   const char* mission = "";
   bool mission_aborts = false;
+  // Latched (the e-stop): after the fault the stand-in stays stopped until the operator's
+  // `clear-estop` (typed after_s after the fault's end), and still after it until `resume`
+  // (kResetToResumeUs later); `recovers` then speaks of kResetToResumeUs after the resume. The
+  // whole mission likewise waits for both (the bench types them, kMissionResetAfterS after the
+  // fault's end).
+  bool operator_reset = false;
 };
+inline constexpr std::uint64_t kResetToResumeUs = 500000;
 // The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the
 // mission's 3 s frame timeout, shorter than its 8 s PTU move timeout).
 inline constexpr double kMissionFaultStartS = 5.0;
 inline constexpr double kMissionFaultS = 5.0;
+inline constexpr double kMissionResetAfterS = 2.0;
 const FaultExpectation& expectation(hal::sim::FaultDevice device, hal::sim::FaultType type);
 
 struct FaultScenarioConfig {
@@ -63,6 +71,10 @@ struct FaultScenarioResult {
   double stop_latency_ms = -1.0;
   bool stayed_stopped = false;
   bool moving_after = false;  // turning again by the end of the run
+  // With an operator reset: at rest from the fault's end until `clear-estop`, and from
+  // `clear-estop` until `resume`.
+  bool held_until_reset = false;
+  bool held_until_resume = false;
   // The console: the LOG lines of the run (truncated to the buffer), health afterwards.
   std::array<char, 16384> console{};
   bool says_expected = false;  // console_says appeared
@@ -85,7 +97,8 @@ struct FaultScenarioResult {
 };
 
 // A long run under a plan of many faults (generate_fault_plan): the same rig, judged after
-// each fault has ended and nothing else is active for 1.5 s.
+// each fault has ended and nothing else is active for 1.5 s. An operator resets the e-stop
+// latch after each e-stop fault.
 struct FaultSoakResult {
   bool ran = false;
   char error[256] = "";
@@ -93,11 +106,14 @@ struct FaultSoakResult {
   std::uint64_t frames = 0;
   std::uint32_t faults_started = 0;
   std::uint32_t faults_ended = 0;
-  std::uint32_t quiet_checks = 0;     // moments with no fault active, 1.5 s after one ended
-  std::uint32_t ended_safe = 0;       // ... where everything was healthy and moving again
-  std::uint32_t ended_unsafe = 0;     // ... where something was not
-  char first_unsafe[200] = "";        // what, the first time
-  std::uint64_t stop_violations = 0;  // frames moving while the e-stop or bumper line was active
+  std::uint32_t quiet_checks = 0;  // moments with no fault active, 1.5 s after one ended
+  std::uint32_t ended_safe = 0;    // ... where everything was healthy and moving again
+  std::uint32_t ended_unsafe = 0;  // ... where something was not
+  char first_unsafe[200] = "";     // what, the first time
+  // Frames moving while the e-stop or bumper line was active, or after it before the operator's
+  // reset (`clear-estop` and `resume`, typed 0.5 s after the line's fault ended).
+  std::uint64_t stop_violations = 0;
+  std::uint32_t operator_resets = 0;
   std::uint32_t collisions = 0;
   std::uint64_t saves = 0;
   std::uint64_t save_failures = 0;

@@ -391,6 +391,75 @@ TEST(FirmwareMain, ASighupStopsInAnOrderlyWayWithTheBaseStoppedAndTheMissionLine
 }
 
 namespace {
+// The e-stop pressed 0.5 s into the first look and released at 1 s; the operator asks for the
+// status at 6 s, types `clear-estop` at 6.1 s, asks again at 7 s, types `resume` at 7.1 s and
+// asks once more at 7.3 s (board time).
+struct EstopOperator {
+  FakeBoard* board = nullptr;
+  int step = 0;
+  bool stopped_at_7_s = false;  // the base still stopped after the reset, before resume
+};
+void estop_operator(void* context) {
+  auto* o = static_cast<EstopOperator*>(context);
+  FakeBoard& b = *o->board;
+  constexpr std::uint64_t kAtUs[] = {500000, 1000000, 6000000, 6100000, 7000000, 7100000, 7300000};
+  if (o->step >= 7 || b.clock.now_us() < kAtUs[o->step]) return;
+  switch (o->step++) {
+    case 0:
+      b.estop.level = true;
+      break;
+    case 1:
+      b.estop.level = false;
+      break;
+    case 2:
+    case 4:
+    case 6:
+      b.console.feed("status\r");
+      break;
+    case 3:
+      b.console.feed("clear-estop\r");
+      break;
+    case 5:
+      o->stopped_at_7_s = b.base.health() == boticelli::hal::BaseHealth::kStopped;
+      b.console.feed("resume\r");
+      break;
+  }
+}
+}  // namespace
+
+TEST(FirmwareMain, AReleasedEstopHoldsTheMissionUntilClearEstopAndThenResume) {
+  static EstopOperator op;
+  op = EstopOperator{};
+  static MainHooks hooks;
+  hooks.after_frame = estop_operator;
+  hooks.context = &op;
+  std::string console_output;
+  const Run r = run_firmware({"--max-cycles", "1"}, [&](FakeBoard& b) {
+    op.board = &b;
+    b.hooks = &hooks;
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  CHECK_EQUAL(7, op.step);
+  // Five seconds after the release the mission still holds, waiting for the reset; after it,
+  // for resume; only then it goes on.
+  const std::size_t held =
+      console_output.find("status state=hold estop=button paused=0 waits_for=clear-estop ");
+  CHECK_TEXT(held != std::string::npos, console_output.c_str());
+  const std::size_t reset =
+      console_output.find("status state=hold estop=none paused=0 waits_for=resume ", held);
+  CHECK_TEXT(reset != std::string::npos, console_output.c_str());
+  CHECK(op.stopped_at_7_s);
+  const std::size_t resumed =
+      console_output.find("LOG info resumed after the e-stop: base released", reset);
+  CHECK_TEXT(resumed != std::string::npos, console_output.c_str());
+  CHECK_TEXT(console_output.find("status state=look estop=none paused=0 waits_for=none ",
+                                 resumed) != std::string::npos,
+             console_output.c_str());
+  // The look goes on where it was held (the fake camera never delivers: its frame timeout).
+  STRCMP_CONTAINS("MISSION result=aborted cycles=0", last_line(r.out).c_str());
+}
+
+namespace {
 void write_text(const std::string& path, const char* text) {
   FILE* f = std::fopen(path.c_str(), "wb");
   CHECK(f != nullptr);

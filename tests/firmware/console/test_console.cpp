@@ -322,7 +322,7 @@ TEST(Console, ReportsTheTargetEstimateOnceTheMissionHasOne) {
   CHECK_EQUAL("OK", command("set telemetry_ms 100").at(0));
   port.clear_written();
   service(10);
-  STRCMP_CONTAINS("estop=none target=confirmed", port.written().c_str());
+  STRCMP_CONTAINS("estop=none waits_for=none target=confirmed", port.written().c_str());
 }
 
 TEST(Console, ShowsExecutiveTimingPerTask) {
@@ -433,22 +433,49 @@ TEST(Console, PausesAndResumesTheBackgroundWork) {
   CHECK_FALSE(exec.background_paused());
 }
 
-TEST(Console, EstopStopsTheBaseAndClearEstopReleasesIt) {
+TEST(Console, EstopStopsTheBaseAndOnlyClearEstopThenResumeStartItAgain) {
   auto reply = command("estop");
   CHECK_EQUAL("OK", reply.at(0));
-  // The latch's change is logged, with the input that stopped the base.
+  // The latch's change is logged, with the input that stopped the base and what to type.
   CHECK_EQUAL(2U, reply.size());
-  STRCMP_CONTAINS("LOG warn e-stop engaged: console (base stopped)", reply.back().c_str());
+  STRCMP_EQUAL("LOG warn e-stop engaged: console (base stopped), latched until clear-estop",
+               reply.back().c_str());
   CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
   CHECK(safety.cause() == StopCause::kConsole);
+  STRCMP_CONTAINS("estop=console paused=0 waits_for=clear-estop ", command("status").at(0).c_str());
+  // Resume before the reset is refused and changes nothing.
+  STRCMP_EQUAL("ERR e-stop latched: clear-estop first", command("resume").at(0).c_str());
+  CHECK(safety.engaged());
   button.level = true;
   STRCMP_EQUAL("ERR e-stop button still pressed", command("clear-estop").at(0).c_str());
   CHECK(safety.engaged());
   button.level = false;
+  // The reset: the latch released, the base still stopped until resume.
   reply = command("clear-estop");
   CHECK_EQUAL("OK", reply.at(0));
-  STRCMP_CONTAINS("LOG info e-stop released (was console)", reply.back().c_str());
+  STRCMP_EQUAL("LOG info e-stop cleared (was console), base stopped until resume",
+               reply.back().c_str());
   CHECK_FALSE(safety.engaged());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  STRCMP_CONTAINS("estop=none paused=0 waits_for=resume ", command("status").at(0).c_str());
+  // The restart.
+  reply = command("resume");
+  CHECK_EQUAL("OK", reply.at(0));
+  STRCMP_EQUAL("LOG info resumed after the e-stop: base released", reply.back().c_str());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kReady);
+  CHECK_FALSE(safety.holds());
+  STRCMP_CONTAINS("estop=none paused=0 waits_for=none ", command("status").at(0).c_str());
+}
+
+TEST(Console, ResumeAfterTheResetAlsoEndsAPause) {
+  CHECK_EQUAL("OK", command("pause").back());
+  STRCMP_CONTAINS("paused=1 waits_for=resume ", command("status").at(0).c_str());
+  CHECK_EQUAL("OK", command("estop").at(0));
+  CHECK_EQUAL("OK", command("clear-estop").at(0));
+  CHECK(exec.background_paused());
+  CHECK_EQUAL("OK", command("resume").at(0));
+  CHECK_FALSE(exec.background_paused());
+  CHECK_FALSE(safety.holds());
 }
 
 TEST(Console, GetsAndSetsParametersWithinTheirRange) {
@@ -613,7 +640,7 @@ TEST(Console, SendsTelemetryAtTheConfiguredPeriod) {
   STRCMP_CONTAINS("TLM t_s=", out[0].c_str());
   STRCMP_CONTAINS(
       "state=look cycles=4 pan_rad=0.500 features=321 pieces=17 x_m=1.250 y_m=-0.500 "
-      "yaw_rad=0.750 estop=none target=none",
+      "yaw_rad=0.750 estop=none waits_for=none target=none",
       out[0].c_str());
   CHECK_EQUAL("OK", command("set telemetry_ms 0").at(0));
   port.clear_written();

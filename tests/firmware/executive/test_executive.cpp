@@ -377,6 +377,7 @@ TEST(EstopInTheExecutive, StopsTheBaseWithinOneFrameWhileTheBackgroundUsesEveryF
     CHECK(base.stopped_at_us - hog.pressed_at_us <= ExecutiveConfig{}.frame_us);
     button.level = false;
     CHECK(safety.clear() == nullptr);
+    CHECK(safety.resume() == nullptr);
   }
   CHECK(hog.units > 1000U);
 }

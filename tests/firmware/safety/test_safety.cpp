@@ -1,14 +1,11 @@
-// Tests of the safety part: the e-stop latch (Safety) and the rule that ends a held mission
-// after a button stop (ButtonRelease).
-#include <cstdint>
-
-#include "firmware/safety/button_release.h"
+// Tests of the safety part: the e-stop latch (Safety), which only the operator's `clear-estop`
+// (the reset) and then `resume` (the restart) release.
 #include "firmware/safety/safety.h"
 #include "firmware_fakes.h"
 
 #include "CppUTest/TestHarness.h"
 
-using boticelli::firmware::ButtonRelease;
+using boticelli::firmware::awaited_command;
 using boticelli::firmware::Safety;
 using boticelli::firmware::StopCause;
 using boticelli::test::FakeBase;
@@ -48,14 +45,119 @@ TEST(Safety, StaysLatchedUntilClearedAndRefusesToClearWhileAnInputIsActive) {
   CHECK(safety.engaged());
   bumper.level = false;
   safety.poll();
-  CHECK(safety.engaged());
-  base.refuse_resume = true;
-  STRCMP_EQUAL("base cannot resume", safety.clear());
-  CHECK(safety.engaged());
-  base.refuse_resume = false;
+  CHECK(safety.engaged());  // the bumper let go: still latched
+  button.level = true;      // and the button pressed meanwhile
+  safety.poll();
+  STRCMP_EQUAL("e-stop button still pressed", safety.clear());
+  CHECK(safety.cause() == StopCause::kBumper);
+  button.level = false;
+  safety.poll();
   CHECK(safety.clear() == nullptr);
   CHECK_FALSE(safety.engaged());
+}
+
+TEST(Safety, AReleasedButtonNeverClearsTheLatch) {
+  button.level = true;
+  safety.poll();
+  button.level = false;
+  // An hour of 10 ms frames with the button up (or a line that came back): still latched.
+  for (int frame = 0; frame < 360000; ++frame) safety.poll();
+  CHECK(safety.engaged());
+  CHECK(safety.cause() == StopCause::kButton);
+  CHECK(safety.holds());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK_EQUAL(1U, safety.engagements());
+}
+
+TEST(Safety, AChatteringButtonKeepsTheLatchEngagedThroughEveryRelease) {
+  for (int frame = 0; frame < 1000; ++frame) {
+    button.level = frame % 7 < 2;  // pressed two frames in seven
+    safety.poll();
+    CHECK(safety.engaged());
+    CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  }
+  CHECK_EQUAL(1U, safety.engagements());
+}
+
+TEST(Safety, AfterTheResetTheBaseStaysStoppedUntilResume) {
+  button.level = true;
+  safety.poll();
+  button.level = false;
+  safety.poll();
+  CHECK(safety.clear() == nullptr);  // the reset
+  CHECK_FALSE(safety.engaged());
+  CHECK(safety.cause() == StopCause::kNone);
+  CHECK(safety.awaiting_resume());
+  CHECK(safety.holds());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);  // restarts nothing
+  for (int frame = 0; frame < 1000; ++frame) safety.poll();
+  CHECK(safety.holds());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK(safety.resume() == nullptr);  // the restart
+  CHECK_FALSE(safety.holds());
   CHECK(base.health() == boticelli::hal::BaseHealth::kReady);
+  safety.poll();
+  CHECK(base.health() == boticelli::hal::BaseHealth::kReady);
+}
+
+TEST(Safety, ABaseResumedBehindItsBackAfterTheResetIsStoppedAgainAtTheNextPoll) {
+  safety.engage(StopCause::kConsole);
+  CHECK(safety.clear() == nullptr);
+  CHECK(base.resume());  // something other than `resume` restarts the base
+  safety.poll();
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK(safety.awaiting_resume());
+}
+
+TEST(Safety, ResumeIsRefusedWhileTheLatchIsEngagedAndDoesNotCountAsTheRestartAfterIt) {
+  button.level = true;
+  safety.poll();
+  button.level = false;
+  safety.poll();
+  STRCMP_EQUAL("e-stop latched: clear-estop first", safety.resume());
+  CHECK(safety.engaged());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+  CHECK(safety.clear() == nullptr);
+  CHECK(safety.holds());  // the refused resume before the reset does not count
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+}
+
+TEST(Safety, ABaseThatCannotResumeKeepsTheRobotWaitingForResume) {
+  safety.engage(StopCause::kConsole);
+  CHECK(safety.clear() == nullptr);
+  base.refuse_resume = true;
+  STRCMP_EQUAL("base cannot resume", safety.resume());
+  CHECK(safety.awaiting_resume());
+  base.refuse_resume = false;
+  CHECK(safety.resume() == nullptr);
+  CHECK_FALSE(safety.holds());
+}
+
+TEST(Safety, APressAfterTheResetLatchesAgainAndNeedsAnotherReset) {
+  safety.engage(StopCause::kConsole);
+  CHECK(safety.clear() == nullptr);
+  button.press();
+  safety.poll();
+  CHECK(safety.cause() == StopCause::kButton);
+  STRCMP_EQUAL("e-stop latched: clear-estop first", safety.resume());
+  button.level = false;
+  safety.poll();
+  CHECK(safety.clear() == nullptr);
+  CHECK(safety.resume() == nullptr);
+  CHECK_FALSE(safety.holds());
+  CHECK(base.health() == boticelli::hal::BaseHealth::kReady);
+}
+
+TEST(Safety, NamesWhatTheOperatorMustTypeNext) {
+  STRCMP_EQUAL("none", awaited_command(safety, false));
+  STRCMP_EQUAL("resume", awaited_command(safety, true));  // paused
+  safety.engage(StopCause::kButton);
+  STRCMP_EQUAL("clear-estop", awaited_command(safety, false));
+  STRCMP_EQUAL("clear-estop", awaited_command(safety, true));
+  CHECK(safety.clear() == nullptr);
+  STRCMP_EQUAL("resume", awaited_command(safety, false));
+  CHECK(safety.resume() == nullptr);
+  STRCMP_EQUAL("none", awaited_command(safety, false));
 }
 
 TEST(Safety, ABumperReleasedAndHitAgainBetweenTwoPollsCountsAsASecondCollision) {
@@ -99,75 +201,4 @@ TEST(Safety, EngagingALatchThatIsAlreadyEngagedStopsTheBaseAgainAndKeepsTheFirst
   CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
   CHECK(safety.cause() == StopCause::kButton);
   CHECK_EQUAL(2, base.stops);
-}
-
-TEST_GROUP(ButtonRelease) {
-  FakeInput button, bumper;
-  FakeBase base;
-  Safety safety{button, bumper, base};
-  ButtonRelease release{500000};
-
-  // Presses the button and polls: the latch engages for the button.
-  void press() {
-    button.level = true;
-    safety.poll();
-    release.restart();  // the mission's hold begins
-  }
-  // One frame of the hold at `now_us`; true when it cleared the latch.
-  bool frame(std::uint64_t now_us) {
-    safety.poll();
-    return safety.engaged() && release.update(safety, button, now_us);
-  }
-};
-
-TEST(ButtonRelease, ClearsAButtonStopOnceTheButtonStayedReleasedForTheHoldTime) {
-  press();
-  CHECK_FALSE(frame(1000000));  // still held
-  button.level = false;
-  CHECK_FALSE(frame(1010000));  // released: the wait starts
-  CHECK_FALSE(frame(1500000));  // 0.49 s
-  CHECK(frame(1510000));        // 0.5 s
-  CHECK_FALSE(safety.engaged());
-}
-
-TEST(ButtonRelease, APressDuringTheWaitStartsItAgain) {
-  press();
-  button.level = false;
-  CHECK_FALSE(frame(1000000));
-  button.level = true;  // pressed again 0.3 s later ...
-  CHECK_FALSE(frame(1300000));
-  button.level = false;  // ... and released
-  CHECK_FALSE(frame(1310000));
-  CHECK_FALSE(frame(1600000));  // 0.6 s after the first release, 0.29 s after the second
-  CHECK(safety.engaged());
-  CHECK(frame(1810000));
-}
-
-TEST(ButtonRelease, ANewHoldDoesNotCountAReleaseSeenInTheLastOne) {
-  press();
-  button.level = false;
-  CHECK_FALSE(frame(1000000));
-  CHECK(frame(1500000));  // the first hold ends after its release
-  // A tap shorter than a frame: the latch engages by the edge, the button already up.
-  button.edge = true;
-  safety.poll();
-  CHECK(safety.engaged());
-  release.restart();            // the new hold begins
-  CHECK_FALSE(frame(3000000));  // its wait starts now, not at the first hold's release
-  CHECK_FALSE(frame(3400000));
-  CHECK(safety.engaged());
-  CHECK(frame(3500000));
-}
-
-TEST(ButtonRelease, LeavesAConsoleOrBumperStopToItsOwnClear) {
-  safety.engage(StopCause::kConsole);
-  release.restart();
-  CHECK_FALSE(frame(1000000));
-  CHECK_FALSE(frame(2000000));
-  CHECK(safety.engaged());
-  bumper.level = true;
-  safety.poll();
-  bumper.level = false;
-  CHECK_FALSE(frame(3000000));
-  CHECK(safety.engaged());
 }

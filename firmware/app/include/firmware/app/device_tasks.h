@@ -24,13 +24,14 @@ class EstopTask final : public Task {
   Safety& safety_;
 };
 
-// Services the base; unhealthy when it stopped by itself (fault, lost link), not by the e-stop.
+// Services the base; unhealthy when it stopped by itself (fault, lost link), not by the e-stop
+// latch (engaged, or reset and waiting for `resume`).
 class BaseTask final : public Task {
  public:
   BaseTask(hal::Base& base, const Safety& safety) : base_(base), safety_(safety) {}
   void run(std::uint64_t) override { base_.update(); }
   bool healthy() const override {
-    return base_.health() != hal::BaseHealth::kStopped || safety_.engaged();
+    return base_.health() != hal::BaseHealth::kStopped || safety_.holds();
   }
   const char* health_reason() const override {
     const char* why = base_.error();
@@ -118,7 +119,7 @@ class ConsoleTask final : public Task {
 // 100 ms steps, bit i = step i, repeated every second.
 enum class LedPattern : std::uint8_t {
   kFault,        // a task unhealthy (watchdog withheld): double flash, 100 on 100 off 100 on
-  kEstop,        // e-stop latched (button, bumper, console): fast blink, 5 Hz
+  kEstop,        // e-stop latched or waiting for resume: fast blink, 5 Hz
   kTargetFound,  // the target confirmed by two views: steady on
   kOk,           // running, healthy: slow blink, 1 Hz
 };

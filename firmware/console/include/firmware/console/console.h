@@ -174,6 +174,7 @@ class Console {
   std::uint64_t seen_state_failures_ = 0;
   bool storage_healthy_ = true;
   StopCause logged_cause_ = StopCause::kNone;
+  bool logged_awaiting_resume_ = false;
 };
 
 }  // namespace boticelli::firmware

@@ -22,7 +22,6 @@
 #include "firmware/mission/params/mission_params.h"
 #include "firmware/mission/plan/step_planner.h"
 #include "firmware/mission/target/target_tracker.h"
-#include "firmware/safety/button_release.h"
 #include "firmware/safety/safety.h"
 #include "firmware/state/mission_state.h"
 #include "firmware/state/state_saver.h"
@@ -202,7 +201,6 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;
   std::uint64_t next_trace_us_ = 0;
-  ButtonRelease release_;  // a button stop released long enough ends the hold
   bool submit_pending_ = false;
 
   // Pose.
