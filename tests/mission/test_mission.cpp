@@ -400,7 +400,8 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndR
   CHECK_EQUAL(EstopScript::kResumed, e.phase);
   CHECK_TEXT(e.frames_to_stop >= 1 && e.frames_to_stop <= 1, "the base stops within one frame");
   // Not a millimetre while pressed, in the 5 s after the release (no reset) and in the 2 s
-  // after the reset (no resume); the base stopped all along.
+  // after the reset (no resume); the base stopped all along (what tells when the robot would
+  // not move anyway: a held drive is followed by a look).
   DOUBLES_EQUAL(0.0, e.moved_while_pressed_m, 1e-6);
   DOUBLES_EQUAL(0.0, e.moved_after_release_m, 1e-6);
   DOUBLES_EQUAL(0.0, e.moved_after_reset_m, 1e-6);
