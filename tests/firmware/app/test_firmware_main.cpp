@@ -258,6 +258,8 @@ TEST(FirmwareMain, AStateDirectoryOthersMayWriteInStopsTheStartWithTheUsageCode)
   CHECK_EQUAL(0, chmod(dir.c_str(), 0700));
 }
 
+// qemu-user cannot be trusted to fork a process it emulates (the child hangs): native only.
+#ifndef BOTICELLI_TESTS_UNDER_EMULATOR
 namespace {
 // Runs firmware_main in a forked child whose stdout is a pipe nobody reads any more (read
 // end closed) and SIGPIPE at its default action, as `boticelli ... | head -1` after head
@@ -311,6 +313,7 @@ TEST(FirmwareMain, OutputToAClosedPipeDoesNotKillItAndTheMissionEndsWithItsSave)
   CHECK_EQUAL(4U, state.seed);
   CHECK_EQUAL(1U, state.log.size());
 }
+#endif  // BOTICELLI_TESTS_UNDER_EMULATOR
 
 namespace {
 std::string read_all(const std::string& path) {
