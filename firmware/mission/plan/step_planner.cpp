@@ -5,26 +5,6 @@
 
 namespace boticelli::firmware::mission {
 
-const char* step_outcome_name(StepOutcome outcome) {
-  switch (outcome) {
-    case StepOutcome::kChoosing:
-      return "choosing";
-    case StepOutcome::kMove:
-      return "move";
-    case StepOutcome::kTurnRound:
-      return "turn_round";
-    case StepOutcome::kBackOff:
-      return "back_off";
-    case StepOutcome::kAtGoal:
-      return "at_goal";
-    case StepOutcome::kNoSafeStep:
-      return "no_safe_step";
-    case StepOutcome::kNothingLeft:
-      return "nothing_left";
-  }
-  return "unknown";
-}
-
 void StepPlanner::clear() {
   trail_.clear();
   failed_cycles_ = 0;

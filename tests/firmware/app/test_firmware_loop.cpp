@@ -11,6 +11,7 @@
 #include "fake_serial_port.h"
 #include "firmware/console/console.h"
 #include "firmware/app/device_tasks.h"
+#include "firmware/app/runtime.h"
 #include "firmware/executive/executive.h"
 #include "firmware/telemetry/mission_view.h"
 #include "firmware/common/text_buffer.h"
@@ -37,7 +38,7 @@ class IdleTask final : public Task {
 
 // Background work in the mission's place: every `period_us` of board time a checkpoint (the
 // odometry pose and a log line) handed to the StateSaver, as the mission does after a cycle.
-class CheckpointWork final : public MissionView, public BackgroundWork {
+class CheckpointWork final : public MissionView, public BackgroundWork, public FrameConsumer {
  public:
   CheckpointWork(boticelli::hal::Base& base, boticelli::hal::Clock& clock, MissionState& state,
                  StateSaver& saver, std::uint32_t period_us)
@@ -56,6 +57,7 @@ class CheckpointWork final : public MissionView, public BackgroundWork {
     submit_pending_ = !saver_.submit(state_);
     return SliceResult::kDone;
   }
+  void on_frame(const boticelli::hal::Frame&) override {}  // frames are taken and released
   const char* state_name() const override { return "checkpoint"; }
   boticelli::core::Pose2 pose() const override {
     const boticelli::hal::Odometry o = base_.odometry();
@@ -95,8 +97,8 @@ TEST_GROUP(FirmwareLoop) {
 };
 
 namespace {
-// The firmware's device tasks, console and checkpoint saver on fakes, as firmware_main wires
-// them (the mission task idle): for the health and storage reports.
+// The firmware's Runtime (device tasks, console, state saver) on fakes, as firmware_main runs
+// it, with a checkpoint saver in the mission's place (the mission task idle).
 struct LoopRig {
   boticelli::fakes::FakeClock clock{0};
   boticelli::fakes::FakeSerialPort port;
@@ -106,32 +108,22 @@ struct LoopRig {
   FakeInput button, bumper;
   FakeOutput led;
   FakeWatchdog watchdog;
-  ServiceNotifier notifier;
-  Executive exec{clock};
-  Safety safety{button, bumper, base};
-  StateSaver saver{g_loop_store};
-  CheckpointWork mission{base, clock, g_loop_state, saver, 1000000};
+  boticelli::hal::Hal hal{camera, ptu, base, button, bumper, led, port, clock, watchdog};
   ParameterTable parameters;
-  Console console{port, exec, safety, mission, parameters};
-  EstopTask estop_task{safety};
-  BaseTask base_task{base, safety};
-  PanTiltTask ptu_task{ptu};
-  CameraTask camera_task{camera};
-  ConsoleTask console_task{console};
-  WatchdogTask watchdog_task{exec, watchdog, notifier, led};
+  Runtime rt{hal, port, g_loop_store, parameters};
+  // Not started: saves in the background slot, as on the sim board.
+  StateSaver& saver = rt.saver;
+  Executive& exec = rt.executive;
+  CheckpointWork mission{base, clock, g_loop_state, saver, 1000000};
   IdleTask mission_task;
 
-  void start() {
-    Task* tasks[kTaskCount] = {&estop_task,   &base_task,    &ptu_task,     &camera_task,
-                               &mission_task, &console_task, &watchdog_task};
+  Console& console() { return *rt.console; }
+  void start(float telemetry_ms = 0.0F, bool parameter_saver = true) {
     const char* why = "";
-    for (std::size_t i = 0; i < kTaskCount; ++i) {
-      CHECK(exec.add_task(kTaskTable[i], *tasks[i], &why));
-    }
-    exec.set_background(&mission);
-    CHECK(console.register_parameters());
-    console.set_telemetry_ms(0.0F);
-    console.set_parameter_saver(&saver);
+    CHECK(rt.attach({mission_task, mission, mission, mission}, &why));
+    CHECK(console().register_parameters());
+    console().set_telemetry_ms(telemetry_ms);
+    if (parameter_saver) console().set_parameter_saver(&saver);
     CHECK(exec.start(ExecutiveConfig{}, &why));
     mission.start(clock.now_us());
     port.reserve_written(64 * 1024);
@@ -195,53 +187,23 @@ TEST(FirmwareLoop, AnUnhealthyTaskIsLoggedWithItsNameAndReasonAndShownInStatusAn
 }
 
 TEST(FirmwareLoop, RunsTasksConsoleTelemetryAndCheckpointsWithoutAllocating) {
-  boticelli::fakes::FakeClock clock{0};
-  boticelli::fakes::FakeSerialPort port;
-  FakeCamera camera;
-  FakePanTilt ptu;
-  FakeBase base{&clock};
-  FakeInput button, bumper;
-  FakeOutput led;
-  FakeWatchdog watchdog;
-  ServiceNotifier notifier;
   char error[256] = "";
   CHECK(g_loop_store.open(dir.c_str(), error, sizeof error));
   g_loop_state.clear();
+  LoopRig rig;
+  rig.start(250.0F, false);
+  rig.port.feed("status\rstats\rpose\rmap\rmodel\rget\rset telemetry_ms 500\rbogus\r");
 
-  Executive exec{clock};
-  Safety safety{button, bumper, base};
-  StateSaver saver{g_loop_store};  // not started: saves in the background slot, as on sim
-  CheckpointWork mission{base, clock, g_loop_state, saver, 1000000};
-  ParameterTable parameters;
-  Console console{port, exec, safety, mission, parameters};
-  EstopTask estop_task{safety};
-  BaseTask base_task{base, safety};
-  PanTiltTask ptu_task{ptu};
-  CameraTask camera_task{camera};
-  ConsoleTask console_task{console};
-  WatchdogTask watchdog_task{exec, watchdog, notifier, led};
-  IdleTask mission_task;
-  Task* tasks[kTaskCount] = {&estop_task,   &base_task,    &ptu_task,     &camera_task,
-                             &mission_task, &console_task, &watchdog_task};
-  const char* why = "";
-  for (std::size_t i = 0; i < kTaskCount; ++i) CHECK(exec.add_task(kTaskTable[i], *tasks[i], &why));
-  exec.set_background(&mission);
-  CHECK(console.register_parameters());
-  console.set_telemetry_ms(250.0F);
-  CHECK(exec.start(ExecutiveConfig{}, &why));
-  mission.start(clock.now_us());
-  port.feed("status\rstats\rpose\rmap\rmodel\rget\rset telemetry_ms 500\rbogus\r");
+  CHECK_NO_ALLOCATION(rig.frames(350));
 
-  CHECK_NO_ALLOCATION(for (int i = 0; i < 350; ++i) exec.run_frame());
-
-  mission.finish_saving();
-  CHECK_EQUAL(3U, mission.cycles_this_run());
-  CHECK_EQUAL(3U, saver.saved());
-  CHECK_EQUAL(0U, saver.failures());
-  CHECK(watchdog.kicks > 0);
-  CHECK(camera.releases > 0);
-  CHECK(port.written().find("TLM ") != std::string::npos);
-  CHECK(port.written().find("ERR unknown command") != std::string::npos);
+  rig.mission.finish_saving();
+  CHECK_EQUAL(3U, rig.mission.cycles_this_run());
+  CHECK_EQUAL(3U, rig.saver.saved());
+  CHECK_EQUAL(0U, rig.saver.failures());
+  CHECK(rig.watchdog.kicks > 0);
+  CHECK(rig.camera.releases > 0);
+  CHECK(rig.port.written().find("TLM ") != std::string::npos);
+  CHECK(rig.port.written().find("ERR unknown command") != std::string::npos);
   CHECK(g_loop_store.load(g_loop_state, error, sizeof error) == LoadResult::kLoaded);
   CHECK_EQUAL(3U, g_loop_state.cycle);
 }

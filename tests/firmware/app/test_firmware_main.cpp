@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "child_process.h"
 #include "fake_clock.h"
 #include "fake_serial_port.h"
 #include "firmware/app/firmware_main.h"
@@ -285,15 +286,7 @@ int run_with_stdout_a_closed_pipe(const std::vector<const char*>& args) {
     std::fflush(stdout);
     _exit(code);
   }
-  for (int i = 0; i < 6000; ++i) {
-    int status = 0;
-    if (waitpid(child, &status, WNOHANG) == child) return status;
-    timespec ms10{0, 10000000L};
-    nanosleep(&ms10, nullptr);
-  }
-  kill(child, SIGKILL);
-  waitpid(child, nullptr, 0);
-  return -1;
+  return boticelli::test::wait_for_child(child, 60000);
 }
 }  // namespace
 

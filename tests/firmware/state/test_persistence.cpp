@@ -19,6 +19,7 @@
 #include "firmware/state/persistence.h"
 #include "firmware/state/state_saver.h"
 
+#include "child_process.h"
 #include "test_files.h"
 #include "CppUTest/TestHarness.h"
 
@@ -354,15 +355,7 @@ bool fork_works() {
   const pid_t child = fork();
   if (child == 0) _exit(0);
   if (child < 0) return false;
-  for (int i = 0; i < 200; ++i) {
-    int status = 0;
-    if (waitpid(child, &status, WNOHANG) == child) return true;
-    timespec ms10{0, 10000000L};
-    nanosleep(&ms10, nullptr);
-  }
-  kill(child, SIGKILL);
-  waitpid(child, nullptr, 0);
-  return false;
+  return boticelli::test::wait_for_child(child, 2000) != -1;
 }
 }  // namespace
 

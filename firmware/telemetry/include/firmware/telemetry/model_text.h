@@ -43,7 +43,6 @@ class ModelText {
     held_ = false;
     if (pending_) swap();
   }
-  [[nodiscard]] bool held() const { return held_; }
 
  private:
   void swap() {

@@ -26,7 +26,6 @@ enum class StepOutcome : std::uint8_t {
   kNoSafeStep,   // no step lies in the look's polygon: look again (gave_up() after several)
   kNothingLeft,  // nothing left to explore, and the robot already turned round here
 };
-const char* step_outcome_name(StepOutcome outcome);
 
 class StepPlanner {
  public:
