@@ -30,7 +30,8 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::baud("console", "baud", c.console_baud)) &&
          s.add(
              ConfigKey::whole("console", "telemetry_period_ms", c.telemetry_period_ms, 0, 60000)) &&
-         s.add(ConfigKey::whole("watchdog", "timeout_ms", c.watchdog_timeout_ms, 0, 60000));
+         s.add(ConfigKey::whole("watchdog", "timeout_ms", c.watchdog_timeout_ms, 0, 60000)) &&
+         s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner));
 }
 
 }  // namespace boticelli::firmware

@@ -128,7 +128,7 @@ void Mission::start(std::uint64_t now_us) {
   end_reason_.clear();
   cycles_this_run_ = 0;
   planner_.clear();
-  map_.start(state_);
+  map_.start(state_, params_.grid);
   pose_.anchor(state_.pose);
   tracker_.clear();
   if (state_.has_goal) {
@@ -348,6 +348,7 @@ void Mission::control_drive(std::uint64_t now_us) {
     move_ = pending_move_;
     pending_move_ = Move::kNone;
     const core::Pose2 from = pose_.pose();
+    drive_from_ = from;
     if (move_ == Move::kTurnRound) {
       driver_.start_turn(from, core::wrap_pi(from.yaw_rad + core::kPi<float>), now_us);
     } else {
@@ -365,6 +366,9 @@ void Mission::control_drive(std::uint64_t now_us) {
   const bool ok = driver_.status() == DriveStatus::kDone;
   const core::Pose2 here = pose_.pose();
   planner_.visited({here.x_m, here.y_m});
+  // The robot's disc stood everywhere along the move: nothing stands there.
+  map_.swept({drive_from_.x_m, drive_from_.y_m}, {here.x_m, here.y_m}, config_.robot_radius_m,
+             params_.fusion.free_delta);
   if (tracker_.confirmed()) {
     const Eigen::Vector3f& g = tracker_.estimate_m();
     if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
@@ -485,9 +489,19 @@ SliceResult Mission::think_slice(SliceBudget& budget) {
     CpuScope cpu(think_cpu, longest(Unit::kModel));
     map_.run_unit();
   }
-  if (!budget.next_unit()) return SliceResult::kMore;
-  CpuScope cpu(think_cpu, longest(Unit::kMap));
-  after_think();
+  if (think_step_ == ThinkStep::kModel) {
+    if (!budget.next_unit()) return SliceResult::kMore;
+    CpuScope cpu(think_cpu, longest(Unit::kMap));
+    after_think();
+    think_step_ = ThinkStep::kGrid;
+  }
+  // The look into the world memory's grid.
+  while (!map_.grid_done()) {
+    if (!budget.next_unit()) return SliceResult::kMore;
+    CpuScope cpu(think_cpu, longest(Unit::kMap));
+    map_.grid_unit();
+  }
+  phase_ = Phase::kPlan;
   return SliceResult::kMore;
 }
 
@@ -586,14 +600,14 @@ void Mission::after_think() {
   const std::span<char> text = model_text_.back();
   const std::size_t n = aln::write_text(builder.model(), text.data(), text.size());
   if (n > 0 && state_.set_model({text.data(), n})) model_text_.publish(n);
-  phase_ = Phase::kPlan;
+  map_.begin_grid(look_pose_, params_.fusion);
 }
 
 void Mission::begin_plan() {
   plan_step_ = PlanStep::kValue;
   core::Point2 goal{};
   if (tracker_.confirmed()) goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
-  planner_.start_value(map_.global(), tracker_.confirmed() ? &goal : nullptr,
+  planner_.start_value(map_.global(), map_.grid(), tracker_.confirmed() ? &goal : nullptr,
                        {look_pose_.x_m, look_pose_.y_m},
                        static_cast<std::uint32_t>(state_.seed * 7919U + state_.cycle));
 }

@@ -214,14 +214,14 @@ TEST(NavPlanner, ClearanceAndPathCostMatchBruteForceOnRandomMaps) {
         for (int x = -kHalf; x < kHalf; ++x) {
           const std::uint32_t c0 = cost[idx(x, y)];
           if (c0 == kInf) continue;
-          const bool from_ok = free[idx(x, y)] && clear[idx(x, y)] >= 10;
+          const bool from_ok = (free[idx(x, y)] && clear[idx(x, y)] >= 10) || c0 > 20;
           for (int dy = -1; dy <= 1; ++dy) {
             for (int dx = -1; dx <= 1; ++dx) {
               if (dx == 0 && dy == 0) continue;
               const std::size_t j = idx(x + dx, y + dy);
               const bool to_ok = free[j] && clear[j] >= 10;
               const bool occupied = g_map.state({x + dx, y + dy}) == wm::CellState::kOccupied;
-              if (!to_ok && (from_ok || occupied || clear[j] <= clear[idx(x, y)])) continue;
+              if (!to_ok && (from_ok || occupied || clear[j] < clear[idx(x, y)])) continue;
               std::uint32_t step = dx != 0 && dy != 0 ? 14 : 10;
               if (clear[j] < 15) step *= 2;
               if (c0 + step < cost[j]) {
@@ -255,6 +255,7 @@ TEST(NavPlanner, FrontiersAreTheReachableClustersOfFreeCellsBesideUnknownOnes) {
     p.robot_radius_m = 0.05F;
     p.wall_fringe_m = 0.1F;
     p.min_frontier_m = 0.2F;
+    p.wall_reach_m = 100.0F;  // every frontier cell counts whole
     g_nav.start(g_map, {0.01F, 0.01F}, p);
     g_nav.run();
     // Reference: frontier cells by the definition, 8-connected components by union-find.
@@ -272,9 +273,9 @@ TEST(NavPlanner, FrontiersAreTheReachableClustersOfFreeCellsBesideUnknownOnes) {
     for (int y = -kHalf; y < kHalf; ++y) {
       for (int x = -kHalf; x < kHalf; ++x) {
         const Point2 c = g_map.centre_of({x, y});
+        (void)c;
         frontier[id(x, y)] =
-            g_nav.passable(c) && std::isfinite(g_nav.path_m(c)) &&
-            brute_clearance(x, y, kHalf) >= 10 &&
+            g_map.state({x, y}) == wm::CellState::kFree && brute_clearance(x, y, kHalf) >= 10 &&
             (unknown(x - 1, y) || unknown(x + 1, y) || unknown(x, y - 1) || unknown(x, y + 1));
       }
     }
@@ -292,18 +293,26 @@ TEST(NavPlanner, FrontiersAreTheReachableClustersOfFreeCellsBesideUnknownOnes) {
       }
     }
     std::vector<int> size(static_cast<std::size_t>(n * n), 0);
-    for (std::size_t i = 0; i < cells; ++i) {
-      if (frontier[i]) ++size[find(i)];
+    std::vector<bool> reachable(static_cast<std::size_t>(n * n), false);
+    for (int y = -kHalf; y < kHalf; ++y) {
+      for (int x = -kHalf; x < kHalf; ++x) {
+        if (!frontier[id(x, y)]) continue;
+        const std::size_t root = find(id(x, y));
+        ++size[root];
+        const Point2 c = g_map.centre_of({x, y});
+        if (g_nav.passable(c) && std::isfinite(g_nav.path_m(c))) reachable[root] = true;
+      }
     }
     std::vector<int> want;
     for (std::size_t i = 0; i < cells; ++i) {
-      if (size[i] >= 4) want.push_back(size[i]);  // 0.2 m of 5 cm cells
+      if (size[i] >= 4 && reachable[i]) want.push_back(size[i]);  // 0.2 m of 5 cm cells
     }
     std::vector<int> got;
     for (const wm::Frontier& f : g_nav.frontiers()) {
       got.push_back(static_cast<int>(std::lround(f.length_m / 0.05F)));
       CHECK(std::isfinite(f.path_m));
       DOUBLES_EQUAL(f.length_m - f.path_m, f.utility, 1e-4);
+      CHECK(f.length_m > 0.0F);
     }
     std::sort(want.begin(), want.end());
     std::sort(got.begin(), got.end());
@@ -415,4 +424,24 @@ TEST(NavPlanner, ARobotInsideAWallsClearanceFindsItsWayOut) {
   CHECK_FALSE(g_nav.passable({1.0F, 0.7F}));
   CHECK(std::isfinite(g_nav.path_m({2.0F, 0.0F})));
   CHECK(std::isinf(g_nav.path_m({1.0F, 0.78F})));  // never into the wall
+}
+
+TEST(NavPlanner, AFrontierOnOpenFloorFarFromAnyWallCountsLessOfItsLength) {
+  g_map.configure({});
+  for (int iy = -20; iy <= 20; ++iy) {
+    for (int ix = -20; ix <= 20; ++ix) set_cell(ix, iy, wm::CellState::kFree);
+  }
+  set_cell(-60, 0, wm::CellState::kOccupied);  // 3 m from the nearest frontier cell
+  wm::NavParams p;
+  p.wall_reach_m = 1.0F;
+  p.open_floor_weight = 0.25F;
+  g_nav.start(g_map, {0.0F, 0.0F}, p);
+  g_nav.run();
+  LONGS_EQUAL(1, g_nav.frontiers().size());
+  // 160 cells round the 41 × 41 square's edge, all on open floor.
+  DOUBLES_EQUAL(160 * 0.05 * 0.25, g_nav.frontiers()[0].length_m, 1e-3);
+  p.wall_reach_m = 5.0F;  // the one occupied cell is near enough to all of them
+  g_nav.start(g_map, {0.0F, 0.0F}, p);
+  g_nav.run();
+  DOUBLES_EQUAL(160 * 0.05, g_nav.frontiers()[0].length_m, 1e-3);
 }

@@ -55,6 +55,17 @@ void LookFusion::evidence_cells() {
     const Cell c = map_->cell_of(core::to_world(pose_, {e * std::cos(a), e * std::sin(a)}));
     if (c == last) continue;  // neighbouring rays on one cell: one hit a look
     last = c;
+    // The polygon stops short of the surface (the fit's caution, the range error): the floor
+    // between its boundary and the evidence was in view, so it is not left unknown (it would
+    // line every wall with a frontier).
+    const float step = 0.5F * map_->cell_m();
+    Cell filled{kGridCells, kGridCells};
+    for (float r = free_->rho_m(k) + step; r < e - map_->cell_m(); r += step) {
+      const Cell f = map_->cell_of(core::to_world(pose_, {r * std::cos(a), r * std::sin(a)}));
+      if (f == filled || f == c) continue;
+      filled = f;
+      (void)map_->add(f, params_.free_delta);
+    }
     if (map_->add(c, params_.occupied_delta)) ++occupied_cells_;
   }
 }

@@ -47,6 +47,8 @@ void NavPlanner::start(const GridMap& map, core::Point2 robot, const NavParams& 
   robot_clear_ = chamfer_units(params.robot_radius_m, cell);
   margin_clear_ = chamfer_units(params.robot_radius_m + params.clearance_m, cell);
   fringe_clear_ = chamfer_units(params.wall_fringe_m, cell);
+  reach_clear_ = chamfer_units(params.wall_reach_m, cell);
+  escape_cost_ = static_cast<std::uint32_t>(std::ceil(params.robot_radius_m / cell * 10.0F));
   frontiers_.clear();
   path_.clear();
   heap_.clear();
@@ -162,7 +164,8 @@ bool NavPlanner::push(std::uint32_t cost, std::uint32_t index) {
 
 // Dijkstra from the robot's cell. The robot may stand where its disc already touches an
 // occupied cell's clearance (or on a cell no look showed free): from a cell that is not
-// passable the wave goes only to cells farther from any obstacle, so it leads out, never in.
+// passable, within the robot's own disc, the wave goes only to cells no nearer any obstacle,
+// so it leads out, never in.
 void NavPlanner::wave_unit() {
   for (std::size_t n = 0; n < params_.pops_per_unit; ++n) {
     if (heap_.empty()) {
@@ -178,14 +181,15 @@ void NavPlanner::wave_unit() {
     if (cost != cost_[i]) continue;  // a stale entry
     const int x = static_cast<int>(i % kPlanSide);
     const int y = static_cast<int>(i / kPlanSide);
-    const bool from_passable = passable_cell(i);
+    // Leaving a cell that is not passable is allowed only within the robot's own disc.
+    const bool from_passable = passable_cell(i) || cost > escape_cost_;
     for (std::size_t d = 0; d < 8; ++d) {
       const int nx = x + kDx[d];
       const int ny = y + kDy[d];
       if (nx < 0 || nx >= kPlanSide || ny < 0 || ny >= kPlanSide) continue;
       const std::size_t j = idx(nx, ny);
       const bool ok = passable_cell(j) ||
-                      (!from_passable && cell_[j] != kOccupiedCell && clear_[j] > clear_[i]);
+                      (!from_passable && cell_[j] != kOccupiedCell && clear_[j] >= clear_[i]);
       if (!ok) continue;
       std::uint32_t step = kStepCost[d];
       if (clear_[j] < margin_clear_) step *= 2;  // near a wall: keep to the middle
@@ -200,7 +204,7 @@ void NavPlanner::wave_unit() {
 }
 
 bool NavPlanner::is_frontier(std::size_t i) const {
-  if (cost_[i] == kUnreached || !passable_cell(i) || clear_[i] < fringe_clear_) return false;
+  if (cell_[i] != kFreeCell || clear_[i] < fringe_clear_) return false;
   const int x = static_cast<int>(i % kPlanSide);
   const int y = static_cast<int>(i / kPlanSide);
   if (x == 0 || y == 0 || x == kPlanSide - 1 || y == kPlanSide - 1) return false;
@@ -226,12 +230,14 @@ void NavPlanner::grow_cluster(std::size_t seed) {
   mark_[seed] = 1;
   double sx = 0.0;
   double sy = 0.0;
+  float weight = 0.0F;
   for (std::size_t q = 0; q < queue_.size(); ++q) {
     const std::uint32_t i = queue_[q];
     const int x = static_cast<int>(i % kPlanSide);
     const int y = static_cast<int>(i / kPlanSide);
     sx += x;
     sy += y;
+    weight += clear_[i] <= reach_clear_ ? 1.0F : params_.open_floor_weight;
     for (std::size_t d = 0; d < 8; ++d) {
       const int nx = x + kDx[d];
       const int ny = y + kDy[d];
@@ -244,14 +250,17 @@ void NavPlanner::grow_cluster(std::size_t seed) {
   }
   const float cell = map_->cell_m();
   Frontier f;
-  f.length_m = static_cast<float>(queue_.size()) * cell;
-  if (f.length_m < params_.min_frontier_m) return;
+  if (static_cast<float>(queue_.size()) * cell < params_.min_frontier_m) return;
+  f.length_m = weight * cell;
   const auto n = static_cast<double>(queue_.size());
   const float cx = static_cast<float>(sx / n);
   const float cy = static_cast<float>(sy / n);
+  // The goal: the cluster's reachable cell the robot's centre may stand on nearest its centroid
+  // (a doorway's frontier spans the jambs' clearance too; the robot goes through its middle).
   std::uint32_t best = queue_[0];
   float best_d2 = std::numeric_limits<float>::infinity();
   for (const std::uint32_t i : queue_) {
+    if (cost_[i] == kUnreached || !passable_cell(i)) continue;
     const float dx = static_cast<float>(i % kPlanSide) - cx;
     const float dy = static_cast<float>(i / kPlanSide) - cy;
     const float d2 = dx * dx + dy * dy;
@@ -260,6 +269,7 @@ void NavPlanner::grow_cluster(std::size_t seed) {
       best = i;
     }
   }
+  if (!std::isfinite(best_d2)) return;  // no cell of it is reachable
   f.goal = centre(best);
   f.path_m = static_cast<float>(cost_[best]) * 0.1F * cell;
   f.utility = params_.gain_per_m * f.length_m - f.path_m;
@@ -336,6 +346,21 @@ NavChoice NavPlanner::choose(const core::Point2* target, float standoff_m) {
         best = i;
       }
     }
+    if (best_cost == kUnreached) {
+      // No stand-off reachable on what the map knows: as near the target as it allows (the
+      // next look shows more), unless that is where the robot already stands.
+      float best_d = core::distance_m(centre(source_), *target) - params_.goal_reached_m;
+      for (std::size_t i = 0; i < kPlanCells; ++i) {
+        if (cost_[i] == kUnreached || !passable_cell(i)) continue;
+        const float d = core::distance_m(centre(i), *target);
+        if (d < best_d) {
+          best_d = d;
+          best = i;
+          best_cost = cost_[i];
+        }
+      }
+      if (best_cost != kUnreached && !frontiers_.empty()) best_cost = kUnreached;  // explore
+    }
     if (best_cost != kUnreached) {
       trace_path(best);
       choice.kind = NavGoalKind::kTarget;
@@ -360,6 +385,7 @@ NavChoice NavPlanner::choose(const core::Point2* target, float standoff_m) {
           std::size_t i = 0;
           const float d = core::distance_m(p, goal_);
           if (d > best_d || !window_index(p, i) || !is_frontier(i)) continue;
+          if (cost_[i] == kUnreached || !passable_cell(i)) continue;
           best_d = d;
           kept = i;
           still = true;

@@ -5,8 +5,9 @@
 
 namespace boticelli::firmware::mission {
 
-void MapStage::start(const MissionState& state) {
+void MapStage::start(const MissionState& state, const worldmap::GridMapParams& grid) {
   map_.clear();
+  grid_.configure(grid);
   has_prior_look_ = false;  // a resumed mission's first look has none
   for (const core::Point2& p : state.obstacles) (void)map_.obstacles().push_back(p);
   for (const core::Point2& p : state.exploration) (void)map_.exploration().push_back(p);

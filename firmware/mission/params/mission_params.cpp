@@ -89,6 +89,13 @@ MissionParams make_mission_params(const BoardConfig& c) {
   p.settle_us = c.camera_settle_ms * 1000U;
   p.steps_per_look = std::max<std::uint32_t>(c.steps_per_look, 1);
 
+  // World memory and navigation: the grid keeps what looks saw out to the camera's range;
+  // paths keep the robot's radius and margin from occupied cells, as the polygon does.
+  p.thesis_planner = c.thesis_planner;
+  p.fusion.max_range_m = c.max_range_m;
+  p.nav.robot_radius_m = c.robot_radius_m + c.clearance_margin_m;
+  p.nav.min_frontier_m = c.robot_radius_m + c.clearance_margin_m;
+
   // Stereo features show their line of sight free as well as the floor cue's walks. With
   // only the walks (features_show_free = false) the cluttered room's look safety rises from
   // 0.9975 to 0.999, but the corridor is not found in 45 cycles (23 with features): the smaller

@@ -6,13 +6,21 @@
 namespace boticelli::firmware::mission {
 
 void StepPlanner::clear() {
+  nav_.reset();
+  nav_choice_ = {};
   trail_.clear();
   failed_cycles_ = 0;
   turned_round_ = false;
 }
 
-void StepPlanner::start_value(const mapping::GlobalMap& map, const core::Point2* goal,
-                              core::Point2 centre, std::uint32_t seed) {
+void StepPlanner::start_value(const mapping::GlobalMap& map, const worldmap::GridMap& grid,
+                              const core::Point2* goal, core::Point2 centre, std::uint32_t seed) {
+  has_goal_ = goal != nullptr;
+  if (has_goal_) goal_ = *goal;
+  if (!params_.thesis_planner) {
+    nav_.start(grid, centre, params_.nav);
+    return;
+  }
   planning::RewardSources sources;
   sources.obstacles = map.obstacles().span();
   sources.exploration = map.exploration().span();
@@ -27,6 +35,11 @@ void StepPlanner::start_value(const mapping::GlobalMap& map, const core::Point2*
 StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
                                       const mapping::StarPolygon& navigable, bool has_exploration,
                                       bool has_goal) {
+  if (!params_.thesis_planner) {
+    nav_choice_ = nav_.choose(has_goal_ ? &goal_ : nullptr, params_.rewards.goal_standoff_m);
+    has_exploration = nav_choice_.kind == worldmap::NavGoalKind::kFrontier;
+    has_goal = nav_choice_.kind == worldmap::NavGoalKind::kTarget;
+  }
   if (!has_exploration && !has_goal) {
     // Turn round and look once more before giving up: the sector behind the robot is seen
     // only by the image's edges at the PTU's pan limits (or not at all, if the pans and the
@@ -35,14 +48,56 @@ StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
         turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
     return turned_here ? StepOutcome::kNothingLeft : StepOutcome::kTurnRound;
   }
-  chooser_.start(value_, navigable, here, params_.step);
+  if (params_.thesis_planner) chooser_.start(value_, navigable, here, params_.step);
   return StepOutcome::kChoosing;
+}
+
+planning::StepDecision StepPlanner::step_on_path(const core::Pose2& here,
+                                                 const core::Pose2& look_pose,
+                                                 const mapping::StarPolygon& navigable) const {
+  planning::StepDecision d;
+  const std::span<const core::Point2> path = nav_.path();
+  const core::Point2 at{here.x_m, here.y_m};
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    if (core::distance_m(at, path[i]) < core::distance_m(at, path[nearest])) nearest = i;
+  }
+  // The robot's own disc may overlap the clearance of an occupied cell: samples this near it
+  // are the place it stands on, not the way ahead.
+  const float own = params_.nav.robot_radius_m * 0.5F;
+  for (std::size_t j = nearest + 1; j < path.size(); ++j) {
+    const float dist = core::distance_m(at, path[j]);
+    if (dist > params_.nav_step_m) break;
+    if (dist < params_.step.min_step_m) continue;
+    bool clear = true;
+    for (int i = 1; i <= 20 && clear; ++i) {
+      const float t = static_cast<float>(i) / 20.0F;
+      const core::Point2 p{at.x_m + t * (path[j].x_m - at.x_m),
+                           at.y_m + t * (path[j].y_m - at.y_m)};
+      clear = navigable.contains(core::to_robot(look_pose, p)) &&
+              (nav_.passable(p) || core::distance_m(p, at) < own);
+    }
+    if (!clear) continue;
+    d.kind = planning::StepKind::kMove;
+    d.target = path[j];
+    d.distance_m = dist;
+    d.heading_rad = std::atan2(path[j].y_m - at.y_m, path[j].x_m - at.x_m);
+  }
+  return d;
 }
 
 StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& look_pose,
                                     const mapping::StarPolygon& navigable,
                                     Breadcrumbs& breadcrumbs) {
-  decision_ = chooser_.decision();
+  if (params_.thesis_planner) {
+    decision_ = chooser_.decision();
+  } else if (has_goal_ && core::distance_m({here.x_m, here.y_m}, goal_) <=
+                              params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m) {
+    decision_ = {};
+    decision_.kind = planning::StepKind::kAtGoal;
+  } else {
+    decision_ = step_on_path(here, look_pose, navigable);
+  }
   if (decision_.kind == planning::StepKind::kAtGoal) return StepOutcome::kAtGoal;
   if (decision_.kind == planning::StepKind::kMove) {
     // The thesis's consistency check: the whole step must lie in this look's polygon.
@@ -82,6 +137,10 @@ StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& 
 bool StepPlanner::begin_next_on_look(const core::Pose2& here, const core::Pose2& look_pose,
                                      const mapping::StarPolygon& navigable) {
   if (!navigable.contains(core::to_robot(look_pose, {here.x_m, here.y_m}))) return false;
+  if (!params_.thesis_planner) {
+    decision_ = step_on_path(here, look_pose, navigable);
+    return true;
+  }
   from_here_.set_vertex_count(navigable.vertex_count());
   const float reach = params_.value.step_m;
   constexpr int kSamples = 20;
@@ -101,7 +160,7 @@ bool StepPlanner::begin_next_on_look(const core::Pose2& here, const core::Pose2&
 }
 
 StepOutcome StepPlanner::end_next_on_look() {
-  decision_ = chooser_.decision();
+  if (params_.thesis_planner) decision_ = chooser_.decision();
   return decision_.kind == planning::StepKind::kMove ? StepOutcome::kMove
                                                      : StepOutcome::kNoSafeStep;
 }

@@ -67,7 +67,7 @@ TEST(MapStage, StartTakesTheGlobalListsFromTheStateAndSaveGivesThemBack) {
   (void)state->obstacles.push_back({1.0F, 2.0F});
   (void)state->obstacles.push_back({1.5F, 2.0F});
   (void)state->exploration.push_back({-3.0F, 0.5F});
-  stage->start(*state);
+  stage->start(*state, {});
   CHECK_EQUAL(2U, stage->global().obstacles().size());
   CHECK_EQUAL(1U, stage->global().exploration().size());
   DOUBLES_EQUAL(1.5, stage->global().obstacles()[1].x_m, 0.0);
@@ -84,18 +84,18 @@ TEST(MapStage, StartTakesTheGlobalListsFromTheStateAndSaveGivesThemBack) {
 TEST(MapStage, ARestartedMissionHoldsOnlyTheListsOfItsState) {
   (void)state->obstacles.push_back({1.0F, 2.0F});
   (void)state->exploration.push_back({-3.0F, 0.5F});
-  stage->start(*state);
-  stage->start(*state);
+  stage->start(*state, {});
+  stage->start(*state, {});
   CHECK_EQUAL(1U, stage->global().obstacles().size());
   CHECK_EQUAL(1U, stage->global().exploration().size());
   state->clear();
-  stage->start(*state);
+  stage->start(*state, {});
   CHECK_EQUAL(0U, stage->global().obstacles().size());
   CHECK_EQUAL(0U, stage->global().exploration().size());
 }
 
 TEST(MapStage, ALoneSightingGetsAnExplorationPointAtTheStandOffOnTheWayToIt) {
-  stage->start(*state);
+  stage->start(*state, {});
   // The target 3.5 m ahead of a robot at (1, 1) facing +y: the point 0.75 m short of it.
   const Pose2 pose{1.0F, 1.0F, 1.5707964F};
   const Eigen::Vector3f candidate(1.0F, 4.5F, 0.4F);
@@ -109,7 +109,7 @@ TEST(MapStage, ALoneSightingGetsAnExplorationPointAtTheStandOffOnTheWayToIt) {
 }
 
 TEST(MapStage, ASightingWithinTheLookRadiusAndTheStandOffGetsNoPoint) {
-  stage->start(*state);
+  stage->start(*state, {});
   const Pose2 pose{0.0F, 0.0F, 0.0F};
   // Seen from 1.5 m: the robot looked from (about) the stand-off already.
   const Eigen::Vector3f candidate(1.5F, 0.0F, 0.4F);

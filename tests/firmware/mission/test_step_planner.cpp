@@ -30,10 +30,19 @@ StarPolygon disc(float radius_m) {
   return p;
 }
 
+boticelli::worldmap::GridMap g_grid;  // large: static
+
+// The thesis's planner (reward cones and value iteration), which these tests were written for.
+MissionParams thesis_params() {
+  BoardConfig config;
+  config.thesis_planner = true;
+  return make_mission_params(config);
+}
+
 }  // namespace
 
 TEST_GROUP(StepPlanner) {
-  const MissionParams params = make_mission_params(BoardConfig{});
+  const MissionParams params = thesis_params();
   StepPlanner planner{params};
   GlobalMap map;
   Breadcrumbs crumbs;
@@ -93,7 +102,7 @@ TEST(StepPlanner, AChosenStepLeavingTheLooksPolygonIsNoSafeStepAndThePlaceCounts
   // exploration point ahead draws the step out of the polygon (the chooser cuts the step to
   // the polygon as if it were seen from here).
   (void)map.exploration().push_back({1.6F, 0.0F});
-  planner.start_value(map, nullptr, {0.0F, 0.0F}, 1);
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
   CHECK(planner.value().sources().visited.empty());
   const Pose2 here{0.8F, 0.0F, 0.0F};
   CHECK(planner.begin_choice(here, look_disc, true, false) == StepOutcome::kChoosing);
@@ -103,11 +112,11 @@ TEST(StepPlanner, AChosenStepLeavingTheLooksPolygonIsNoSafeStepAndThePlaceCounts
   CHECK(planner.decision().kind == StepKind::kMove);
   CHECK_FALSE(look_disc.contains(to_robot(origin, planner.target())));
   // The place is on the trail the next value iteration is repelled by.
-  planner.start_value(map, nullptr, {0.8F, 0.0F}, 2);
+  planner.start_value(map, g_grid, nullptr, {0.8F, 0.0F}, 2);
   CHECK_EQUAL(1U, planner.value().sources().visited.size());
   DOUBLES_EQUAL(0.8, planner.value().sources().visited[0].x_m, 1e-6);
   CHECK(failed_cycle() == StepOutcome::kNoSafeStep);
-  planner.start_value(map, nullptr, {0.0F, 0.0F}, 3);
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 3);
   CHECK_EQUAL(2U, planner.value().sources().visited.size());
 }
 
@@ -160,7 +169,7 @@ TEST(StepPlanner, ASafeMoveResetsTheCountOfCyclesWithoutASafeStep) {
 
 TEST(StepPlanner, WithinTheStandOffOfTheGoalTheRobotIsAtTheGoal) {
   const Point2 goal{0.5F, 0.0F};
-  planner.start_value(map, &goal, {0.0F, 0.0F}, 1);
+  planner.start_value(map, g_grid, &goal, {0.0F, 0.0F}, 1);
   CHECK(planner.begin_choice(origin, look_disc, false, true) == StepOutcome::kChoosing);
   CHECK_TRUE(planner.choice_done());
   CHECK(planner.end_choice(origin, origin, look_disc, crumbs) == StepOutcome::kAtGoal);
@@ -175,7 +184,7 @@ TEST(StepPlanner, AnotherStepOnTheSameLookIsRefusedWhenTheRobotStandsOutsideItsP
 TEST(StepPlanner, AnotherStepOnTheSameLookStaysInsideTheLooksPolygonSeenFromWhereTheRobotIs) {
   // The robot took a step to near the polygon's edge; an exploration point ahead draws it on.
   (void)map.exploration().push_back({1.6F, 0.0F});
-  planner.start_value(map, nullptr, {0.0F, 0.0F}, 1);
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
   const Pose2 here{0.8F, 0.0F, 0.3F};
   CHECK_TRUE(planner.begin_next_on_look(here, origin, look_disc));
   choose();
@@ -189,4 +198,82 @@ TEST(StepPlanner, AnotherStepOnTheSameLookIsNoSafeStepWhenThePolygonLeavesNoRoom
   CHECK_TRUE(planner.begin_next_on_look(origin, origin, tiny));
   choose();
   CHECK(planner.end_next_on_look() == StepOutcome::kNoSafeStep);
+}
+
+namespace {
+
+// A free square 3 m a side round the origin in the grid, unknown beyond: frontiers all round.
+void free_square() {
+  g_grid.configure({});
+  for (int iy = -30; iy < 30; ++iy) {
+    for (int ix = -30; ix < 30; ++ix) (void)g_grid.add({ix, iy}, -10);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// The frontier planner on the world memory's grid.
+MissionParams frontier_params() {
+  BoardConfig config;
+  config.thesis_planner = false;
+  return make_mission_params(config);
+}
+
+}  // namespace
+
+TEST_GROUP(FrontierStepPlanner) {
+  const MissionParams params = frontier_params();
+  StepPlanner planner{params};
+  GlobalMap map;
+  Breadcrumbs crumbs;
+  const Pose2 origin{};
+
+  void setup() override {
+    planner.clear();
+    free_square();
+  }
+  StepOutcome plan(const Pose2& here, const StarPolygon& navigable, const Point2* goal) {
+    planner.start_value(map, g_grid, goal, {here.x_m, here.y_m}, 1);
+    while (!planner.value_done()) planner.value_unit();
+    const StepOutcome begun = planner.begin_choice(here, navigable, false, false);
+    if (begun != StepOutcome::kChoosing) return begun;
+    CHECK(planner.choice_done());
+    return planner.end_choice(here, here, navigable, crumbs);
+  }
+};
+
+TEST(FrontierStepPlanner, TheStepFollowsThePathToTheFrontierWithinTheLooksPolygon) {
+  CHECK_FALSE(params.thesis_planner);
+  const StarPolygon navigable = disc(0.6F);
+  CHECK(plan(origin, navigable, nullptr) == StepOutcome::kMove);
+  const float d = boticelli::core::distance_m({0.0F, 0.0F}, planner.target());
+  CHECK(d > 0.4F);
+  CHECK(d <= 0.6F);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kFrontier);
+  // The step heads for the goal along the path.
+  const Point2 g = planner.nav_choice().goal;
+  const Point2 t = planner.target();
+  CHECK(t.x_m * g.x_m + t.y_m * g.y_m > 0.0F);
+}
+
+TEST(FrontierStepPlanner, NoPathPointInsideTheLooksPolygonIsNoSafeStep) {
+  CHECK(plan(origin, disc(0.02F), nullptr) == StepOutcome::kNoSafeStep);
+}
+
+TEST(FrontierStepPlanner, WithinTheStandOffOfTheTargetTheRobotIsAtTheGoal) {
+  const Point2 target{0.5F, 0.0F};
+  CHECK(plan(origin, disc(0.6F), &target) == StepOutcome::kAtGoal);
+  const Point2 far{1.3F, 0.0F};
+  CHECK(plan(origin, disc(0.6F), &far) == StepOutcome::kMove);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kTarget);
+  CHECK(planner.target().x_m > 0.3F);
+}
+
+TEST(FrontierStepPlanner, AGridWithNothingReachableTurnsRoundThenEnds) {
+  g_grid.configure({});  // nothing known
+  CHECK(plan(origin, disc(0.6F), nullptr) == StepOutcome::kTurnRound);
+  planner.turned_round_at({0.0F, 0.0F});
+  CHECK(plan(origin, disc(0.6F), nullptr) == StepOutcome::kNothingLeft);
 }

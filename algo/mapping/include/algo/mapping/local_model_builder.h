@@ -139,6 +139,9 @@ class LocalModelBuilder {
   [[nodiscard]] const LocalMap& map() const { return map_; }
   // The farthest free floor seen along each vertex ray [m] (robot frame).
   [[nodiscard]] const StarPolygon& seen_free() const { return seen_free_; }
+  // The nearest evidence of an obstacle along each vertex ray [m] (∞ where none): floor-cue
+  // bases, guard points and features in the robot's height band (robot frame).
+  [[nodiscard]] const StarPolygon& evidence() const { return evidence_; }
   [[nodiscard]] const OccupancyModel& model() const { return model_; }
   // The samples the fit was trained on (seam copies included), valid until the next start().
   [[nodiscard]] std::span<const OccupancySample> samples() const { return samples_.span(); }

@@ -25,13 +25,19 @@ inline constexpr std::size_t kMaxBlacklist = 64;
 struct NavParams {
   float robot_radius_m = 0.30F;  // no path cell is nearer an occupied cell than this [m]
   float clearance_m = 0.15F;     // path cells within robot_radius_m + this cost double [m]
-  // A free cell next to unknown nearer than this to an occupied cell is the unseen strip
-  // between a wall and the floor seen in front of it, not a way into unknown space [m].
-  float wall_fringe_m = 0.45F;
-  float min_frontier_m = 0.3F;  // a frontier cluster shorter than this leads nowhere [m]
+  // A free cell next to unknown nearer than this to an occupied cell is a wall's own unseen
+  // fringe, not a way into unknown space [m].
+  float wall_fringe_m = 0.1F;
+  // A frontier cluster (free cells next to unknown ones, 8-connected) shorter than this leads
+  // nowhere [m]; one with no reachable cell the robot's centre may stand on is left out.
+  float min_frontier_m = 0.3F;
   // A frontier's utility: gain_per_m × its length [m] − its path length [m] (explore_lite's
   // gain and potential scales, with the path's cost in place of the straight distance).
   float gain_per_m = 1.0F;
+  // The target hangs on a wall: a frontier cell farther than wall_reach_m from every occupied
+  // cell (open floor, nothing known to lead on) counts open_floor_weight of its length.
+  float wall_reach_m = 1.5F;
+  float open_floor_weight = 0.25F;
   float hysteresis_m = 1.0F;        // another frontier must beat the goal's utility by this
   float goal_match_m = 0.5F;        // the goal is kept while a frontier cell lies this near it
   float goal_reached_m = 0.4F;      // a frontier goal this near the robot is reached
@@ -45,7 +51,7 @@ struct NavParams {
 
 struct Frontier {
   core::Point2 goal{};    // its reachable cell nearest its centroid (mission frame)
-  float length_m = 0.0F;  // cells × cell side
+  float length_m = 0.0F;  // cells × cell side, open floor weighted (wall_reach_m)
   float path_m = 0.0F;    // path length to `goal`
   float utility = 0.0F;
 };
@@ -130,6 +136,8 @@ class NavPlanner {
   std::uint16_t robot_clear_ = 0;   // robot_radius_m in chamfer units (5 a cell)
   std::uint16_t margin_clear_ = 0;  // robot_radius_m + clearance_m
   std::uint16_t fringe_clear_ = 0;  // wall_fringe_m
+  std::uint16_t reach_clear_ = 0;   // wall_reach_m
+  std::uint32_t escape_cost_ = 0;   // robot_radius_m in path cost (10 a cell)
   std::array<std::uint8_t, kPlanCells> cell_{};
   std::array<std::uint16_t, kPlanCells> clear_{};       // chamfer distance to occupied (5 a cell)
   std::array<std::uint32_t, kPlanCells> cost_{};        // path cost (10 a cell straight)

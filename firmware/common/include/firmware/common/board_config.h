@@ -61,6 +61,10 @@ struct BoardConfig {
   float ground_clearance_m = 0.03F;  // lowest obstacle height the base cannot drive over [m]
   float goal_standoff_m = 0.75F;     // the mission ends this far from the target [m]
   std::uint32_t steps_per_look = 3;  // steps driven on one look's polygon before the next look
+  // Where to go: true (default), the thesis's reward cones and ALN value iteration (ch. 5.5);
+  // false, frontier goals by path cost on the world memory's grid (docs/mission.md: it found
+  // fewer targets on seeds 1-2 of the shipped and test worlds, so it is not the default yet).
+  bool thesis_planner = true;
 };
 
 }  // namespace boticelli::firmware

@@ -141,7 +141,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
 
  private:
   // The Think phase's background work: the local model's set-up, then its units.
-  enum class ThinkStep : std::uint8_t { kBegin, kModel };
+  enum class ThinkStep : std::uint8_t { kBegin, kModel, kGrid };
   // The Plan phase's background work.
   enum class PlanStep : std::uint8_t {
     kValueStart,        // the value iteration set up on the global lists
@@ -194,6 +194,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   SnapshotWriter* snapshots_;
   MissionParams params_;
 
+  core::Pose2 drive_from_{};  // where the move under way began (the swept disc)
   Phase phase_ = Phase::kStart;
   Phase held_phase_ = Phase::kStart;
   Result result_ = Result::kRunning;

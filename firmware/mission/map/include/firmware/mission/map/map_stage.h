@@ -8,6 +8,8 @@
 #include "algo/core/geometry.h"
 #include "algo/mapping/local_model_builder.h"
 #include "algo/mapping/map_points.h"
+#include "algo/worldmap/grid_map.h"
+#include "algo/worldmap/look_fusion.h"
 #include "firmware/mission/look/look_processor.h"
 #include "firmware/state/mission_state.h"
 
@@ -26,8 +28,9 @@ class MapStage {
   MapStage(const MapStage&) = delete;
   MapStage& operator=(const MapStage&) = delete;
 
-  // A mission (re)starts: the global lists as the state holds them, no earlier look.
-  void start(const MissionState& state);
+  // A mission (re)starts: the global lists as the state holds them, an empty grid (the world
+  // memory is rebuilt by the looks after a resume), no earlier look.
+  void start(const MissionState& state, const worldmap::GridMapParams& grid);
   // The local model of a look taken at `look_pose` (mission frame) from its readings; the
   // last look's free polygon, seen from here, is its prior.
   void begin(const mapping::LocalModelParams& params, const LookReadings& readings,
@@ -40,6 +43,18 @@ class MapStage {
   // exploration point at the stand-off; exploration points the robot cannot reach moved clear.
   void fuse(const core::Pose2& look_pose, const FuseParams& params,
             const Eigen::Vector3f* candidate);
+  // The look's free polygon and the evidence backing it into the grid, in units: start, then
+  // grid_unit() until grid_done().
+  void begin_grid(const core::Pose2& look_pose, const worldmap::LookFusionParams& params) {
+    fusion_.start(grid_, look_pose, builder_.map().free, builder_.evidence(), params);
+  }
+  void grid_unit() { (void)fusion_.run_unit(); }
+  [[nodiscard]] bool grid_done() const { return fusion_.done(); }
+  // The robot's disc drove from `from` to `to`: those cells are free.
+  void swept(core::Point2 from, core::Point2 to, float radius_m, int delta) {
+    worldmap::sweep_disc(grid_, from, to, radius_m, delta);
+  }
+  [[nodiscard]] const worldmap::GridMap& grid() const { return grid_; }
   // Copies the global lists into the state (as many as it holds).
   void save(MissionState& state) const;
 
@@ -54,6 +69,8 @@ class MapStage {
   core::Pose2 prior_look_pose_{};
   bool has_prior_look_ = false;
   mapping::GlobalMap map_;
+  worldmap::GridMap grid_;
+  worldmap::LookFusion fusion_;
   core::FixedVector<core::Point2, mapping::kMaxObstaclePoints> cycle_obstacles_;
   core::FixedVector<core::Point2, mapping::kMaxExplorationPoints> cycle_exploration_;
 };

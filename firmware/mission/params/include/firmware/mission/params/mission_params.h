@@ -13,6 +13,9 @@
 #include "algo/planning/value_iteration.h"
 #include "algo/stereo/rig.h"
 #include "algo/stereo/stereo_processor.h"
+#include "algo/worldmap/grid_map.h"
+#include "algo/worldmap/look_fusion.h"
+#include "algo/worldmap/nav_planner.h"
 #include "firmware/common/board_config.h"
 #include "firmware/mission/drive/drive_controller.h"
 #include "firmware/mission/target/target_tracker.h"
@@ -49,6 +52,13 @@ struct MissionParams {
   // next look (a fresh look on the spot first: the fit of one look can leave no room).
   std::size_t back_off_after_failed_cycles = 2;
   std::uint32_t steps_per_look = 3;  // steps on one look's navigable polygon
+  // Where to go (BoardConfig::thesis_planner): frontier goals on the world memory, or the
+  // thesis's reward cones.
+  bool thesis_planner = true;
+  worldmap::GridMapParams grid;
+  worldmap::LookFusionParams fusion;
+  worldmap::NavParams nav;
+  float nav_step_m = 1.0F;  // longest step along the path to a frontier or target goal [m]
 };
 
 // The camera rig the stereo and the sim renderer both use, from the board's declaration.

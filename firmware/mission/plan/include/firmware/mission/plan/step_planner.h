@@ -1,6 +1,8 @@
-// StepPlanner: where the robot moves next (thesis ch. 5.5): value iteration over the global
-// map's reward cones, the step on the value function checked against the look's navigable
-// polygon, and what to do when there is none; each decision an explicit StepOutcome.
+// StepPlanner: where the robot moves next: by default a goal on the world memory's grid (the
+// target's stand-off, else the frontier worth most for its path cost) and the step along the
+// path to it; with MissionParams::thesis_planner value iteration over the global map's reward
+// cones (thesis ch. 5.5) and the step on the value function. Either step is checked against
+// the look's navigable polygon; each decision is an explicit StepOutcome.
 #pragma once
 
 #include <cstddef>
@@ -12,6 +14,8 @@
 #include "algo/planning/planner.h"
 #include "algo/planning/rewards.h"
 #include "algo/planning/value_iteration.h"
+#include "algo/worldmap/grid_map.h"
+#include "algo/worldmap/nav_planner.h"
 #include "firmware/mission/drive/breadcrumbs.h"
 #include "firmware/mission/params/mission_params.h"
 
@@ -33,22 +37,36 @@ class StepPlanner {
   StepPlanner(const StepPlanner&) = delete;
   StepPlanner& operator=(const StepPlanner&) = delete;
 
-  // A run starts: no trail, no failed cycles, not turned round anywhere.
+  // A run starts: no trail, no failed cycles, not turned round anywhere, no goal kept.
   void clear();
-  // Value iteration on the global lists, the trail and the goal (nullptr: none yet) around
-  // `centre` (mission frame), its random states drawn from `seed`.
-  void start_value(const mapping::GlobalMap& map, const core::Point2* goal, core::Point2 centre,
-                   std::uint32_t seed);
-  [[nodiscard]] bool value_done() const { return value_.done(); }
-  void value_unit() { (void)value_.run_unit(params_.vi_work_per_unit); }
+  // The plan's groundwork around `centre` (mission frame; where the robot looked from) with
+  // the target's estimate as the goal (nullptr: none confirmed): the wavefront on `grid`, or
+  // (thesis planner) value iteration on the global lists, the trail and the goal, its random
+  // states drawn from `seed`.
+  void start_value(const mapping::GlobalMap& map, const worldmap::GridMap& grid,
+                   const core::Point2* goal, core::Point2 centre, std::uint32_t seed);
+  [[nodiscard]] bool value_done() const {
+    return params_.thesis_planner ? value_.done() : nav_.done();
+  }
+  void value_unit() {
+    if (params_.thesis_planner) {
+      (void)value_.run_unit(params_.vi_work_per_unit);
+    } else {
+      (void)nav_.run_unit();
+    }
+  }
 
-  // After the value iteration: kChoosing, or kTurnRound / kNothingLeft when there is nothing
-  // to explore and no goal.
+  // After the groundwork: kChoosing, or kTurnRound / kNothingLeft when there is nothing to
+  // explore and no goal (the thesis planner: no exploration points; else no reachable
+  // frontier and no reachable stand-off).
   StepOutcome begin_choice(const core::Pose2& here, const mapping::StarPolygon& navigable,
                            bool has_exploration, bool has_goal);
-  // One heading of the choice per call, until choice_done().
-  void choose_heading() { (void)chooser_.run_unit(); }
-  [[nodiscard]] bool choice_done() const { return chooser_.done(); }
+  // One heading of the choice per call, until choice_done() (the thesis planner; the path's
+  // step is found in end_choice()).
+  void choose_heading() {
+    if (params_.thesis_planner) (void)chooser_.run_unit();
+  }
+  [[nodiscard]] bool choice_done() const { return !params_.thesis_planner || chooser_.done(); }
   // The chosen step: kAtGoal, kMove when the whole step lies in the look's navigable polygon
   // (seen from `look_pose`), else the place counts as visited once more and the robot backs off
   // along its breadcrumbs (kBackOff) from the second such cycle in a row, or looks again
@@ -75,10 +93,25 @@ class StepPlanner {
   [[nodiscard]] const planning::StepDecision& decision() const { return decision_; }
   [[nodiscard]] const core::Point2& target() const { return decision_.target; }
   [[nodiscard]] const planning::ValueIteration& value() const { return value_; }
+  [[nodiscard]] const worldmap::NavPlanner& nav() const { return nav_; }
+  [[nodiscard]] const worldmap::NavChoice& nav_choice() const { return nav_choice_; }
+  // Frontier goals blacklisted so far (they stopped getting nearer).
+  [[nodiscard]] std::size_t blacklisted() const { return nav_.blacklist().size(); }
 
  private:
+  // The step along the nav planner's path from `here`: the farthest path point within
+  // nav_step_m whose straight segment stays in the look's navigable polygon and on passable
+  // cells (kMove), else kNoSafeAction.
+  [[nodiscard]] planning::StepDecision step_on_path(const core::Pose2& here,
+                                                    const core::Pose2& look_pose,
+                                                    const mapping::StarPolygon& navigable) const;
+
   const MissionParams& params_;
   planning::ValueIteration value_;
+  worldmap::NavPlanner nav_;
+  worldmap::NavChoice nav_choice_{};
+  bool has_goal_ = false;  // the target's estimate, for the nav planner
+  core::Point2 goal_{};
   planning::Trail trail_;
   planning::StepChooser chooser_;
   planning::StepDecision decision_{};
