@@ -34,7 +34,8 @@ run_one() {  # BIN OUT WORLD SEED -> writes OUT/NAME-sSEED.{csv,state,line}
   "$bin" --world "$world" --seed "$seed" --max-cycles "$max_cycles" --console stdio \
     --trace "$out/$name.csv" --state "$work" </dev/null >"$work/console.txt" 2>"$work/stderr.txt" ||
     rc=$?
-  cp "$work/mission.state" "$out/$name.state" 2>/dev/null || : >"$out/$name.state"
+  # Both copies of the state (A and B), one after the other.
+  cat "$work/mission.state.a" "$work/mission.state.b" >"$out/$name.state" 2>/dev/null || :
   # The MISSION line without wall_time_s, and the exit code.
   { grep '^MISSION ' "$work/console.txt" | sed 's/ wall_time_s=[^ ]*//' || echo "no MISSION line"
     echo "exit=$rc"; } >"$out/$name.line"

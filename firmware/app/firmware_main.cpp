@@ -164,15 +164,28 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       g_state.seed = options.seed;
       slog.log(LogLevel::kInfo, "%s: starting a new mission", error);
     } else if (loaded != LoadResult::kLoaded) {
-      // Restarting cannot mend the file: the usage code, which the service unit does not
-      // restart on (RestartPreventExitStatus), so an operator looks at it.
+      // No copy of the state loads. Restarting cannot mend the files: the usage code, which
+      // the service unit does not restart on (RestartPreventExitStatus), so an operator
+      // looks at them.
       (void)fail("cannot resume", error);
       return kExitUsage;
     } else {
+      if (g_store.load_warning()[0] != '\0') {
+        // A damaged copy (a bad card, a cut write): the other one costs a save at most.
+        slog.log(LogLevel::kWarn, "state copy damaged: %s", g_store.load_warning());
+      }
       if (!board.place_robot(g_state.pose, error, sizeof error))
         return fail("cannot resume", error);
-      slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.path(),
-               static_cast<unsigned long long>(g_state.cycle));
+      if (g_state.finished()) {
+        slog.log(LogLevel::kWarn,
+                 "the saved mission has ended (%s at cycle %llu: %s): not resumed, the robot "
+                 "stays stopped; start without --resume for a new mission",
+                 mission_end_name(g_state.end), static_cast<unsigned long long>(g_state.cycle),
+                 g_state.end_reason.data());
+      } else {
+        slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.loaded_path(),
+                 static_cast<unsigned long long>(g_state.cycle));
+      }
     }
   } else if (store != nullptr) {
     // A new mission never overwrites a saved one: it is kept as mission.state.1 (older ones
@@ -280,6 +293,14 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   const std::uint64_t start_us = hal.clock.now_us();
   mission.start(start_us);
   console.log(LogLevel::kInfo, "boticelli %s on %s: ready", BOTICELLI_VERSION, info.name);
+  // A mission that ended before this start is not carried on: the firmware stays up with the
+  // robot stopped (console, status, LED) until it is stopped; with --max-cycles there is
+  // nothing to run, so it ends at once.
+  const bool ended_before = mission.ended_before_start();
+  if (ended_before) {
+    console.log(LogLevel::kWarn, "mission already ended (%s: %s): not resumed, robot stopped",
+                mission::result_name(mission.result()), mission.end_reason());
+  }
   notifier.ready();
   if (hooks != nullptr && hooks->loop_started != nullptr) hooks->loop_started(hooks->context);
 
@@ -295,6 +316,13 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     if (console.shutdown_requested()) {
       stop_reason = "console shutdown";
       break;
+    }
+    if (ended_before) {
+      if (options.max_cycles != 0) {
+        stop_reason = "mission already ended";
+        break;
+      }
+      continue;
     }
     if (options.max_cycles != 0 && mission.cycles_this_run() >= options.max_cycles) {
       stop_reason = "max cycles";

@@ -126,6 +126,15 @@ void Mission::start(std::uint64_t now_us) {
   phase_ = Phase::kStart;
   result_ = Result::kRunning;
   end_reason_.clear();
+  ended_before_start_ = state_.finished();
+  if (ended_before_start_) {
+    // A mission that ended for good is not carried on: it stays ended, the base stopped.
+    phase_ = Phase::kDone;
+    result_ = state_.end == MissionEnd::kFound      ? Result::kFound
+              : state_.end == MissionEnd::kNotFound ? Result::kNotFound
+                                                    : Result::kAborted;
+    end_reason_.append(state_.end_reason.data());
+  }
   cycles_this_run_ = 0;
   planner_.clear();
   map_.start(state_, params_.grid);
@@ -187,8 +196,14 @@ float Mission::target_error_m() const {
   return (world - truth_->target_m()).norm();
 }
 
-void Mission::finish(Result result, const char* why) {
+void Mission::finish(Result result, const char* why, Ending ending) {
   if (result_ != Result::kRunning) return;
+  if (ending == Ending::kFinal) {
+    state_.set_end(result == Result::kFound      ? MissionEnd::kFound
+                   : result == Result::kNotFound ? MissionEnd::kNotFound
+                                                 : MissionEnd::kAborted,
+                   why);
+  }
   result_ = result;
   end_reason_.clear();
   end_reason_.append(why);
@@ -202,15 +217,13 @@ void Mission::finish(Result result, const char* why) {
   if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
 }
 
-void Mission::abort(const char* why) {
-  finish(Result::kAborted, why);
-}
-
 void Mission::abort_with(const char* why, const char* device_error) {
-  if (device_error == nullptr || device_error[0] == '\0') return abort(why);
+  if (device_error == nullptr || device_error[0] == '\0') {
+    return finish(Result::kAborted, why, Ending::kResumable);
+  }
   TextBuffer<160> text;
   text.appendf("%s: %s", why, device_error);
-  abort(text.c_str());
+  finish(Result::kAborted, text.c_str(), Ending::kResumable);
 }
 
 // ---------------------------------------------------------------- control (mission task)
@@ -229,7 +242,9 @@ void Mission::control(std::uint64_t now_us) {
     return;
   }
   if (safety_.engaged() && safety_.cause() == StopCause::kBumper) {
-    abort("bumper contact");
+    // The robot touched something its map did not hold: the operator looks before another
+    // mission; a restart does not carry this one on.
+    finish(Result::kAborted, "bumper contact", Ending::kFinal);
     return;
   }
   if (hold_needed() && phase_ != Phase::kHold) {
@@ -332,7 +347,7 @@ void Mission::control_look(std::uint64_t now_us) {
     case ScanEvent::kPtuRefused:
       return abort_with("pan-tilt unit refused a move", hal_.pan_tilt.error());
     case ScanEvent::kPtuTimeout:
-      return abort("pan-tilt move did not complete");
+      return finish(Result::kAborted, "pan-tilt move did not complete", Ending::kResumable);
     case ScanEvent::kNoFrame:
       return abort_with("no camera frame", hal_.camera.error());
   }
@@ -374,7 +389,7 @@ void Mission::control_drive(std::uint64_t now_us) {
     if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
         params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m) {
       end_cycle("at the target");
-      return finish(Result::kFound, "within the stand-off of the target");
+      return finish(Result::kFound, "within the stand-off of the target", Ending::kFinal);
     }
   }
   const Move done = move_;
@@ -620,7 +635,7 @@ bool Mission::start_step_choice() {
       return true;
     case StepOutcome::kNothingLeft:
       end_cycle("nothing left to explore");
-      finish(Result::kNotFound, "nothing left to explore");
+      finish(Result::kNotFound, "nothing left to explore", Ending::kFinal);
       return false;
     default:  // kTurnRound
       drive(Move::kTurnRound);
@@ -633,7 +648,7 @@ void Mission::after_step_choice() {
   switch (planner_.end_choice(here, look_pose_, map_.local().navigable, breadcrumbs_)) {
     case StepOutcome::kAtGoal:
       end_cycle("at the target");
-      return finish(Result::kFound, "within the stand-off of the target");
+      return finish(Result::kFound, "within the stand-off of the target", Ending::kFinal);
     case StepOutcome::kMove:
       steps_this_look_ = 0;
       return drive(Move::kStep);
@@ -643,7 +658,8 @@ void Mission::after_step_choice() {
       break;
   }
   end_cycle("no safe step");
-  if (planner_.gave_up()) return finish(Result::kNotFound, "no safe step in several looks");
+  if (planner_.gave_up())
+    return finish(Result::kNotFound, "no safe step in several looks", Ending::kFinal);
   begin_look(now_us_);
 }
 

@@ -5,6 +5,38 @@
 
 namespace boticelli::firmware {
 
+const char* mission_end_name(MissionEnd end) {
+  switch (end) {
+    case MissionEnd::kRunning:
+      return "running";
+    case MissionEnd::kFound:
+      return "found";
+    case MissionEnd::kNotFound:
+      return "not_found";
+    case MissionEnd::kAborted:
+      return "aborted";
+  }
+  return "running";
+}
+
+namespace {
+// Copies `text` into `out` (NUL-terminated), cut to fit, bytes outside printable ASCII as '?'.
+template <std::size_t N>
+void copy_printable(std::string_view text, std::array<char, N>& out) {
+  const std::size_t n = text.size() < N - 1 ? text.size() : N - 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    out[i] = (c >= 0x20 && c <= 0x7E) ? c : '?';
+  }
+  out[n] = '\0';
+}
+}  // namespace
+
+void MissionState::set_end(MissionEnd how, std::string_view why) {
+  end = how;
+  copy_printable(why, end_reason);
+}
+
 bool MissionState::set_model(std::string_view text) {
   if (text.size() > kMaxModelBytes || text.find('\0') != std::string_view::npos) return false;
   std::memcpy(model.data(), text.data(), text.size());
@@ -20,19 +52,15 @@ void MissionState::add_log(std::uint64_t at_cycle, std::string_view text) {
   }
   MissionLogEntry e;
   e.cycle = at_cycle;
-  const std::size_t n =
-      text.size() < MissionLogEntry::kMaxTextBytes ? text.size() : MissionLogEntry::kMaxTextBytes;
-  for (std::size_t i = 0; i < n; ++i) {
-    const char c = text[i];
-    e.text[i] = (c >= 0x20 && c <= 0x7E) ? c : '?';
-  }
-  e.text[n] = '\0';
+  copy_printable(text, e.text);
   (void)log.push_back(e);
 }
 
 void MissionState::clear() {
   cycle = 0;
   seed = 1;
+  end = MissionEnd::kRunning;
+  end_reason[0] = '\0';
   pose = {};
   has_goal = false;
   goal = {};
@@ -56,6 +84,7 @@ bool same_points(const core::FixedVectorBase<core::Point2>& a,
 }  // namespace
 
 bool operator==(const MissionState& a, const MissionState& b) {
+  if (a.end != b.end || a.end_reason_text() != b.end_reason_text()) return false;
   if (a.cycle != b.cycle || a.seed != b.seed || a.pose.x_m != b.pose.x_m ||
       a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad || a.has_goal != b.has_goal) {
     return false;

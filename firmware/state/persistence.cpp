@@ -161,18 +161,50 @@ bool read_points(Reader& r, const char* name, std::size_t capacity,
   return true;
 }
 
-bool decode_body(Reader& r, MissionState& s) {
-  std::string_view v;
+// The first line (and from version 3 the second): version and sequence number.
+bool decode_header(Reader& r, std::uint64_t& version, std::uint64_t& sequence) {
   std::string_view l;
   if (!r.line(l)) return false;
   if (l.substr(0, 16) != "BOTICELLI-STATE ") return r.fail("not a state file");
   // Version 1 (a goal without its height) is still read: its goal stands on the floor.
-  std::uint64_t version = 0;
+  // Version 2 has no sequence number (0) and no result (running).
   if (!parse_u64(l.substr(16), version) || version < 1 || version > kStateFormatVersion) {
     return r.fail("unsupported state file version");
   }
+  sequence = 0;
+  if (version >= 3) {
+    std::string_view v;
+    if (!r.keyed("sequence", v) || !parse_u64(v, sequence)) return r.fail("bad sequence");
+  }
+  return true;
+}
+
+bool decode_result(std::string_view v, MissionState& s) {
+  const std::string_view name = next_word(v);
+  for (const MissionEnd end :
+       {MissionEnd::kRunning, MissionEnd::kFound, MissionEnd::kNotFound, MissionEnd::kAborted}) {
+    if (name != mission_end_name(end)) continue;
+    if (end == MissionEnd::kRunning && !v.empty()) return false;
+    if (v.size() > MissionLogEntry::kMaxTextBytes) return false;
+    for (const char c : v) {
+      if (c < 0x20 || c > 0x7E) return false;
+    }
+    s.set_end(end, v);
+    return true;
+  }
+  return false;
+}
+
+bool decode_body(Reader& r, MissionState& s, std::uint64_t& sequence) {
+  std::string_view v;
+  std::string_view l;
+  std::uint64_t version = 0;
+  if (!decode_header(r, version, sequence)) return false;
   if (!r.keyed("cycle", v) || !parse_u64(v, s.cycle)) return r.fail("bad cycle");
   if (!r.keyed("seed", v) || !parse_u64(v, s.seed)) return r.fail("bad seed");
+  if (version >= 3 && (!r.keyed("result", v) || !decode_result(v, s))) {
+    return r.fail("bad result");
+  }
   float pose[3];
   if (!r.keyed("pose", v) || !parse_floats(v, pose, 3)) return r.fail("bad pose");
   s.pose = {pose[0], pose[1], pose[2]};
@@ -225,11 +257,19 @@ std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc) {
   return ~crc;
 }
 
-std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity) {
+std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity,
+                         std::uint64_t sequence) {
   Writer w{out, capacity};
-  w.printf("BOTICELLI-STATE %u\n", kStateFormatVersion);
+  w.printf("BOTICELLI-STATE %u\nsequence %llu\n", kStateFormatVersion,
+           static_cast<unsigned long long>(sequence));
   w.printf("cycle %llu\nseed %llu\n", static_cast<unsigned long long>(s.cycle),
            static_cast<unsigned long long>(s.seed));
+  if (s.finished()) {
+    w.printf("result %s%s%s\n", mission_end_name(s.end), s.end_reason[0] != '\0' ? " " : "",
+             s.end_reason.data());
+  } else {
+    w.printf("result running\n");
+  }
   w.printf("pose %.9g %.9g %.9g\n", static_cast<double>(s.pose.x_m),
            static_cast<double>(s.pose.y_m), static_cast<double>(s.pose.yaw_rad));
   if (s.has_goal) {
@@ -254,8 +294,9 @@ std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity)
   return w.overflow ? 0 : w.size;
 }
 
-bool decode_state(std::string_view file, MissionState& out, const char** error) {
-  out.clear();
+namespace {
+// The body of `file` (everything before its checksum line) when the checksum matches.
+bool checked_body(std::string_view file, std::string_view& body, const char** error) {
   // The checksum line is the file's last line; check it before reading anything else.
   constexpr std::size_t kCrcLine = 15;  // "crc32 XXXXXXXX\n"
   if (file.size() < kCrcLine || file.back() != '\n') {
@@ -280,15 +321,38 @@ bool decode_state(std::string_view file, MissionState& out, const char** error) 
     }
     stored = (stored << 4) | d;
   }
-  const std::string_view body = file.substr(0, file.size() - kCrcLine);
+  body = file.substr(0, file.size() - kCrcLine);
   if (crc32(body.data(), body.size()) != stored) {
     *error = "checksum mismatch (corrupt file)";
     return false;
   }
+  return true;
+}
+}  // namespace
+
+bool decode_state(std::string_view file, MissionState& out, const char** error,
+                  std::uint64_t* sequence) {
+  out.clear();
+  std::string_view body;
+  if (!checked_body(file, body, error)) return false;
   Reader r{body};
-  if (!decode_body(r, out) || !r.rest.empty()) {
+  std::uint64_t seq = 0;
+  if (!decode_body(r, out, seq) || !r.rest.empty()) {
     *error = r.error != nullptr ? r.error : "trailing data";
     out.clear();
+    return false;
+  }
+  if (sequence != nullptr) *sequence = seq;
+  return true;
+}
+
+bool peek_state(std::string_view file, std::uint64_t& sequence, const char** error) {
+  std::string_view body;
+  if (!checked_body(file, body, error)) return false;
+  Reader r{body};
+  std::uint64_t version = 0;
+  if (!decode_header(r, version, sequence)) {
+    *error = r.error;
     return false;
   }
   return true;
@@ -306,12 +370,25 @@ bool state_dir_mode_is_safe(unsigned mode) {
 
 bool StateStore::open(const char* dir, char* error, std::size_t error_size) {
   refused_ = false;
+  surveyed_ = false;
+  newest_ = -1;
+  next_sequence_ = 1;
+  copies_written_ = 0;
+  loaded_path_[0] = '\0';
+  warning_[0] = '\0';
   const int n1 = std::snprintf(dir_.data(), dir_.size(), "%s", dir);
-  const int n2 = std::snprintf(path_.data(), path_.size(), "%s/%s", dir, kFileName);
+  const char* names[kCandidates] = {kCopyNames[0], kCopyNames[1], kSingleFileName};
+  bool too_long = n1 < 0;
+  for (int i = 0; i < kCandidates; ++i) {
+    auto& path = paths_[static_cast<std::size_t>(i)];
+    const int n = std::snprintf(path.data(), path.size(), "%s/%s", dir, names[i]);
+    // write_file_atomically() appends ".tmp"; keep_previous() ".N".
+    too_long = too_long || n < 0 || static_cast<std::size_t>(n) + 4 >= path.size();
+  }
   const int n3 = std::snprintf(parameters_path_.data(), parameters_path_.size(), "%s/%s", dir,
                                kParametersFileName);
   // The longest name, with write_file_atomically()'s ".tmp", must fit its 512-byte paths.
-  if (n1 < 0 || n2 < 0 || n3 < 0 || static_cast<std::size_t>(n3) + 4 >= parameters_path_.size()) {
+  if (too_long || n3 < 0 || static_cast<std::size_t>(n3) + 4 >= parameters_path_.size()) {
     dir_[0] = '\0';
     std::snprintf(error, error_size, "state directory path too long");
     return false;
@@ -353,51 +430,163 @@ bool StateStore::open(const char* dir, char* error, std::size_t error_size) {
   return true;
 }
 
-LoadResult StateStore::keep_previous(char* kept, std::size_t kept_size, char* error,
-                                     std::size_t error_size) {
-  struct stat st {};
-  if (::stat(path_.data(), &st) != 0) {
+LoadResult StateStore::read_candidate(int i, std::size_t& size, char* why, std::size_t why_size) {
+  const char* path = paths_[static_cast<std::size_t>(i)].data();
+  size = 0;
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
     if (errno == ENOENT) return LoadResult::kMissing;
-    set_error(error, error_size, "cannot stat", path_.data());
+    std::snprintf(why, why_size, "cannot open: %s", std::strerror(errno));
     return LoadResult::kIoError;
   }
-  // Oldest first: .2 -> .3, .1 -> .2, then the file itself -> .1 (a missing copy is skipped).
+  bool too_big = false;
+  for (;;) {
+    if (size == buffer_.size()) {
+      char extra = 0;
+      const ssize_t n = ::read(fd, &extra, 1);
+      too_big = n > 0;
+      break;
+    }
+    const ssize_t n = ::read(fd, buffer_.data() + size, buffer_.size() - size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      std::snprintf(why, why_size, "cannot read: %s", std::strerror(errno));
+      ::close(fd);
+      return LoadResult::kIoError;
+    }
+    if (n == 0) break;
+    size += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  if (too_big) {
+    std::snprintf(why, why_size, "file larger than any valid state");
+    return LoadResult::kCorrupt;
+  }
+  return LoadResult::kLoaded;
+}
+
+void StateStore::survey() {
+  for (int i = 0; i < kCandidates; ++i) {
+    Copy& c = copies_[static_cast<std::size_t>(i)];
+    c = Copy{};
+    std::size_t size = 0;
+    const LoadResult read = read_candidate(i, size, c.why.data(), c.why.size());
+    if (read == LoadResult::kMissing) continue;
+    c.exists = true;
+    c.io_error = read == LoadResult::kIoError;
+    if (read != LoadResult::kLoaded) continue;
+    const char* why = "";
+    c.valid = peek_state({buffer_.data(), size}, c.sequence, &why);
+    if (!c.valid) std::snprintf(c.why.data(), c.why.size(), "%s", why);
+  }
+  surveyed_ = true;
+  newest_ = -1;
+  std::uint64_t newest_sequence = 0;
+  bool any = false;
+  for (int i = 0; i < kCandidates; ++i) {
+    const Copy& c = copies_[static_cast<std::size_t>(i)];
+    if (!c.valid) continue;
+    if (!any || c.sequence > newest_sequence) newest_sequence = c.sequence;
+    any = true;
+  }
+  next_sequence_ = any ? newest_sequence + 1 : 1;
+  const int best = newest_valid(0);
+  newest_ = best == 0 || best == 1 ? best : -1;
+}
+
+// The first of the highest sequence number wins: the two copies win a tie against the single file.
+int StateStore::newest_valid(int skip_mask) const {
+  int best = -1;
+  for (int i = 0; i < kCandidates; ++i) {
+    const Copy& c = copies_[static_cast<std::size_t>(i)];
+    if (!c.valid || (skip_mask & (1 << i)) != 0) continue;
+    if (best < 0 || c.sequence > copies_[static_cast<std::size_t>(best)].sequence) best = i;
+  }
+  return best;
+}
+
+bool StateStore::sync_dir(char* error, std::size_t error_size) {
+  const int dfd = ::open(dir_.data(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd < 0 || ::fsync(dfd) != 0) {
+    set_error(error, error_size, "cannot sync", dir_.data());
+    if (dfd >= 0) ::close(dfd);
+    return false;
+  }
+  ::close(dfd);
+  return true;
+}
+
+LoadResult StateStore::keep_previous(char* kept, std::size_t kept_size, char* error,
+                                     std::size_t error_size) {
+  survey();
+  int keep = newest_valid(0);
+  for (int i = 0; i < kCandidates && keep < 0; ++i) {
+    if (copies_[static_cast<std::size_t>(i)].exists) keep = i;  // none valid: keep one anyway
+  }
+  if (keep < 0) return LoadResult::kMissing;
+  const char* base = paths_[2].data();  // DIR/mission.state
+  // Oldest first: .2 -> .3, .1 -> .2 (a missing one is skipped), then the copy -> .1.
   std::array<char, 520> from{};
   std::array<char, 520> to{};
   for (int i = kKeptStates - 1; i >= 0; --i) {
     if (i == 0) {
-      std::snprintf(from.data(), from.size(), "%s", path_.data());
+      std::snprintf(from.data(), from.size(), "%s", paths_[static_cast<std::size_t>(keep)].data());
     } else {
-      std::snprintf(from.data(), from.size(), "%s.%d", path_.data(), i);
+      std::snprintf(from.data(), from.size(), "%s.%d", base, i);
     }
-    std::snprintf(to.data(), to.size(), "%s.%d", path_.data(), i + 1);
+    std::snprintf(to.data(), to.size(), "%s.%d", base, i + 1);
     if (::rename(from.data(), to.data()) != 0 && !(errno == ENOENT && i > 0)) {
       set_error(error, error_size, "cannot keep", from.data());
       return LoadResult::kIoError;
     }
   }
-  const int dfd = ::open(dir_.data(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0 || ::fsync(dfd) != 0) {
-    set_error(error, error_size, "cannot sync", dir_.data());
-    if (dfd >= 0) ::close(dfd);
-    return LoadResult::kIoError;
+  // The other copies are older states of the same mission: the kept one supersedes them.
+  for (int i = 0; i < kCandidates; ++i) {
+    if (i == keep || !copies_[static_cast<std::size_t>(i)].exists) continue;
+    if (::unlink(paths_[static_cast<std::size_t>(i)].data()) != 0 && errno != ENOENT) {
+      set_error(error, error_size, "cannot remove", paths_[static_cast<std::size_t>(i)].data());
+      return LoadResult::kIoError;
+    }
   }
-  ::close(dfd);
+  if (!sync_dir(error, error_size)) return LoadResult::kIoError;
+  copies_ = {};
+  surveyed_ = true;
+  newest_ = -1;
+  next_sequence_ = 1;
   std::snprintf(kept, kept_size, "%s", to.data());
   return LoadResult::kLoaded;
 }
 
 bool StateStore::save(const MissionState& state, char* error, std::size_t error_size) {
-  const std::size_t size = encode_state(state, buffer_.data(), buffer_.size());
+  if (!is_open()) {
+    std::snprintf(error, error_size, "no state directory");
+    return false;
+  }
+  if (!surveyed_) survey();
+  const std::size_t size = encode_state(state, buffer_.data(), buffer_.size(), next_sequence_);
   if (size == 0) {
     std::snprintf(error, error_size, "state does not fit the file buffer");
     return false;
   }
-  if (!write_file_atomically(dir_.data(), kFileName, {buffer_.data(), size}, error, error_size,
-                             crash_hook_, crash_context_)) {
+  // The copy that does not hold the newest valid state: the older one, or a damaged one.
+  const int target = newest_ == 0 ? 1 : 0;
+  if (!write_file_atomically(dir_.data(), kCopyNames[target], {buffer_.data(), size}, error,
+                             error_size, crash_hook_, crash_context_)) {
     return false;
   }
+  Copy& c = copies_[static_cast<std::size_t>(target)];
+  c.exists = true;
+  c.valid = true;
+  c.sequence = next_sequence_;
+  newest_ = target;
+  ++next_sequence_;
   ++saves_;
+  ++copies_written_;
+  // A single-file state is a fallback until both copies hold newer states; then it goes.
+  Copy& single = copies_[2];
+  if (single.exists && copies_written_ >= 2) {
+    if (::unlink(paths_[2].data()) == 0 || errno == ENOENT) single = Copy{};
+  }
   return true;
 }
 
@@ -412,45 +601,64 @@ bool StateStore::save_parameters(std::string_view text, char* error, std::size_t
 
 LoadResult StateStore::load(MissionState& out, char* error, std::size_t error_size) {
   out.clear();
-  const int fd = ::open(path_.data(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    if (errno == ENOENT) {
-      std::snprintf(error, error_size, "no saved state in %s", dir_.data());
-      return LoadResult::kMissing;
+  loaded_path_[0] = '\0';
+  warning_[0] = '\0';
+  survey();
+  bool any = false;
+  bool any_corrupt = false;
+  for (const Copy& c : copies_) {
+    any = any || c.exists;
+    any_corrupt = any_corrupt || (c.exists && !c.valid && !c.io_error);
+  }
+  if (!any) {
+    std::snprintf(error, error_size, "no saved state in %s", dir_.data());
+    return LoadResult::kMissing;
+  }
+  // Newest first; a copy whose body does not parse (checksum good) is passed over too.
+  int skip = 0;
+  for (int best = newest_valid(0); best >= 0; best = newest_valid(skip)) {
+    Copy& c = copies_[static_cast<std::size_t>(best)];
+    std::size_t size = 0;
+    const char* why = "";
+    std::uint64_t sequence = 0;
+    if (read_candidate(best, size, c.why.data(), c.why.size()) == LoadResult::kLoaded &&
+        decode_state({buffer_.data(), size}, out, &why, &sequence)) {
+      std::snprintf(loaded_path_.data(), loaded_path_.size(), "%s",
+                    paths_[static_cast<std::size_t>(best)].data());
+      // Name every other copy that exists but could not be used.
+      Writer w{warning_.data(), warning_.size()};
+      for (int i = 0; i < kCandidates; ++i) {
+        const Copy& o = copies_[static_cast<std::size_t>(i)];
+        if (i == best || !o.exists || o.valid) continue;
+        w.printf("%s%s: %s", w.size > 0 ? "; " : "", paths_[static_cast<std::size_t>(i)].data(),
+                 o.why.data());
+      }
+      if (w.size > 0) {
+        w.printf("; loaded %s (sequence %llu) instead", loaded_path_.data(),
+                 static_cast<unsigned long long>(sequence));
+      }
+      newest_ = best == 0 || best == 1 ? best : -1;
+      next_sequence_ = sequence + 1;
+      for (const Copy& o : copies_) {
+        if (o.valid && o.sequence >= next_sequence_) next_sequence_ = o.sequence + 1;
+      }
+      return LoadResult::kLoaded;
     }
-    set_error(error, error_size, "cannot open", path_.data());
-    return LoadResult::kIoError;
+    if (why[0] != '\0') std::snprintf(c.why.data(), c.why.size(), "%s", why);
+    c.valid = false;
+    any_corrupt = true;
+    skip |= 1 << best;
   }
-  std::size_t size = 0;
-  bool too_big = false;
-  for (;;) {
-    if (size == buffer_.size()) {
-      char extra = 0;
-      const ssize_t n = ::read(fd, &extra, 1);
-      too_big = n > 0;
-      break;
-    }
-    const ssize_t n = ::read(fd, buffer_.data() + size, buffer_.size() - size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      set_error(error, error_size, "cannot read", path_.data());
-      ::close(fd);
-      return LoadResult::kIoError;
-    }
-    if (n == 0) break;
-    size += static_cast<std::size_t>(n);
+  // No copy loads: say why for each.
+  Writer w{error, error_size};
+  for (int i = 0; i < kCandidates; ++i) {
+    const Copy& c = copies_[static_cast<std::size_t>(i)];
+    if (!c.exists) continue;
+    w.printf("%s%s: %s", w.size > 0 ? "; " : "", paths_[static_cast<std::size_t>(i)].data(),
+             c.why.data());
   }
-  ::close(fd);
-  if (too_big) {
-    std::snprintf(error, error_size, "%s: file larger than any valid state", path_.data());
-    return LoadResult::kCorrupt;
-  }
-  const char* why = "";
-  if (!decode_state({buffer_.data(), size}, out, &why)) {
-    std::snprintf(error, error_size, "%s: %s", path_.data(), why);
-    return LoadResult::kCorrupt;
-  }
-  return LoadResult::kLoaded;
+  newest_ = -1;
+  return any_corrupt ? LoadResult::kCorrupt : LoadResult::kIoError;
 }
 
 }  // namespace boticelli::firmware

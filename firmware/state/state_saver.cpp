@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 
@@ -120,11 +121,24 @@ bool StateSaver::failing() const {
   return failing_;
 }
 
+std::uint64_t StateSaver::retries() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return retries_;
+}
+
 void StateSaver::run() {
   std::unique_lock<std::mutex> lock(mutex_);
+  const auto work = [this] { return stop_ || has_pending_ || has_parameters_; };
   for (;;) {
-    wake_.wait(lock, [this] { return stop_ || has_pending_ || has_parameters_; });
-    if (!has_pending_ && !has_parameters_ && stop_) break;
+    // After a failed save, wait for new work at most one retry interval, then write the same
+    // state again (a newer state, when one comes, replaces it).
+    bool retry = false;
+    if (retry_due_) {
+      retry = !wake_.wait_for(lock, std::chrono::milliseconds(retry_interval_ms_), work);
+    } else {
+      wake_.wait(lock, work);
+    }
+    if (!retry && !has_pending_ && !has_parameters_ && stop_) break;
     if (has_parameters_) {
       const std::size_t bytes = parameters_pending_bytes_;
       std::memcpy(parameters_writing_.data(), parameters_pending_.data(), bytes);
@@ -137,8 +151,12 @@ void StateSaver::run() {
       if (!has_pending_ && !has_parameters_) idle_.notify_all();
       continue;
     }
-    writing_ = pending_;
-    has_pending_ = false;
+    if (has_pending_) {
+      writing_ = pending_;
+      has_pending_ = false;
+    } else {
+      ++retries_;  // retry: writing_ still holds the state that failed
+    }
     busy_ = true;
     lock.unlock();
     char error[256] = "";
@@ -146,6 +164,7 @@ void StateSaver::run() {
     lock.lock();
     busy_ = false;
     failing_ = !ok;
+    retry_due_ = !ok;
     if (ok) {
       ++saved_;
     } else {

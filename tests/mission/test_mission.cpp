@@ -442,7 +442,14 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   // The pose the first run saved at shutdown (in the mission's frame).
   double saved[3] = {0.0, 0.0, 0.0};
   {
-    std::istringstream state(slurp(dir + "/mission.state"));
+    // The newest of the two copies: the one with the higher sequence number.
+    const std::string a = slurp(dir + "/mission.state.a");
+    const std::string b = slurp(dir + "/mission.state.b");
+    const auto sequence = [](const std::string& f) {
+      const std::size_t at = f.find("\nsequence ");
+      return at == std::string::npos ? -1L : std::atol(f.c_str() + at + 10);
+    };
+    std::istringstream state(sequence(a) > sequence(b) ? a : b);
     std::string line;
     bool found = false;
     while (std::getline(state, line)) {
@@ -482,6 +489,7 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   const std::size_t c = second.mission_line.find("cycles=");
   CHECK(c != std::string::npos);
   CHECK_TEXT(std::atoi(second.mission_line.c_str() + c + 7) > 3, second.mission_line.c_str());
-  std::remove((dir + "/mission.state").c_str());
+  std::remove((dir + "/mission.state.a").c_str());
+  std::remove((dir + "/mission.state.b").c_str());
   rmdir(dir.c_str());
 }

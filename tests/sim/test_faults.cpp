@@ -56,8 +56,10 @@ TEST_GROUP(Faults) {
   }
   void teardown() override {
     board.reset();
-    unlink((dir + "/mission.state").c_str());
-    unlink((dir + "/mission.state.tmp").c_str());
+    for (const char* name :
+         {"/mission.state.a", "/mission.state.b", "/mission.state.a.tmp", "/mission.state.b.tmp"}) {
+      unlink((dir + name).c_str());
+    }
     rmdir(dir.c_str());
   }
 

@@ -92,8 +92,10 @@ int main() {
     }
   }
   const std::string base(dir);
-  unlink((base + "/mission.state").c_str());
-  unlink((base + "/mission.state.tmp").c_str());
+  for (const char* name :
+       {"/mission.state.a", "/mission.state.b", "/mission.state.a.tmp", "/mission.state.b.tmp"}) {
+    unlink((base + name).c_str());
+  }
   unlink((base + "/parameters.conf").c_str());
   rmdir(dir);
   if (status == 0) std::printf("tsan_state_saver: ok\n");

@@ -106,7 +106,8 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
   char error[256] = "";
   m.state_loadable = g_store.open(dir, error, sizeof error) &&
                      g_store.load(g_state, error, sizeof error) == firmware::LoadResult::kLoaded;
-  for (const char* name : {"plan.txt", "out.txt", "err.txt", "mission.state"}) {
+  for (const char* name :
+       {"plan.txt", "out.txt", "err.txt", "mission.state.a", "mission.state.b"}) {
     ::unlink((std::string(dir) + "/" + name).c_str());
   }
   ::rmdir(dir);
@@ -235,7 +236,9 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
       config.state_dir = dir;
       const bool ran = boards::sim::run_fault_scenario(g_board, device, type, config, g_result);
       if (dir != nullptr) {
-        ::unlink((std::string(dir) + "/mission.state").c_str());
+        for (const char* name : firmware::StateStore::kCopyNames) {
+          ::unlink((std::string(dir) + "/" + name).c_str());
+        }
         ::rmdir(dir);
       }
       const MissionOutcome m = run_mission(firmware, world, device, type, e.operator_reset);

@@ -120,13 +120,14 @@ struct ModelSize {
 firmware::MissionState g_state;  // large: static
 mapping::OccupancyModel g_model;
 
-ModelSize model_size(const std::string& state_file) {
+firmware::StateStore g_store;
+
+ModelSize model_size(const std::string& state_dir) {
   ModelSize s;
-  const std::string file = read_file(state_file);
-  if (file.empty()) return s;
-  const char* why = "";
-  if (!firmware::decode_state(file, g_state, &why)) {
-    std::fprintf(stderr, "mission: %s: %s\n", state_file.c_str(), why);
+  char why[512] = "";
+  if (!g_store.open(state_dir.c_str(), why, sizeof why) ||
+      g_store.load(g_state, why, sizeof why) != firmware::LoadResult::kLoaded) {
+    std::fprintf(stderr, "mission: %s: %s\n", state_dir.c_str(), why);
     return s;
   }
   s.text_bytes = g_state.model_bytes;
@@ -281,7 +282,7 @@ int run() {
     successes += success ? 1U : 0U;
     spl_sum += spl;
     const double compute_s = m.look_s + m.think_s + m.plan_s;
-    const ModelSize size = model_size(state_dir + "/" + firmware::StateStore::kFileName);
+    const ModelSize size = model_size(state_dir);
 
     JsonLine line(kSuite, name.c_str());
     line.text("result", m.result.c_str())

@@ -16,6 +16,7 @@
 #include "bench.h"
 #include "bench_process.h"
 #include "fault_scenario.h"
+#include "firmware/state/persistence.h"
 #include "hal/sim/fault_plan.h"
 #include "sim_board.h"
 
@@ -106,7 +107,9 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
   const bool ran = boards::sim::run_fault_soak(g_board, g_plan, run_s, config, g_result);
   const double wall = wall_s() - wall0;
   if (dir != nullptr) {
-    ::unlink((std::string(dir) + "/mission.state").c_str());
+    for (const char* name : firmware::StateStore::kCopyNames) {
+      ::unlink((std::string(dir) + "/" + name).c_str());
+    }
     ::rmdir(dir);
   }
   if (!ran) {

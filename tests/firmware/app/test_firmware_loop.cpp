@@ -90,8 +90,8 @@ TEST_GROUP(FirmwareLoop) {
     dir = mkdtemp(templ);
   }
   void teardown() override {
-    rmdir((dir + "/mission.state.tmp").c_str());
-    unlink((dir + "/mission.state").c_str());
+    rmdir((dir + "/mission.state.a.tmp").c_str());
+    for (const char* name : {"/mission.state.a", "/mission.state.b"}) unlink((dir + name).c_str());
     rmdir(dir.c_str());
   }
 };
@@ -140,14 +140,15 @@ TEST(FirmwareLoop, AFailingStateSaveIsLoggedAtOnceAndMakesTheStorageUnhealthyUnt
   g_loop_state.clear();
   // A directory where the temporary file must go: every save fails (as on a full or
   // read-only disk), also for root.
-  CHECK_EQUAL(0, mkdir((dir + "/mission.state.tmp").c_str(), 0700));
+  // (The first save goes to copy A.)
+  CHECK_EQUAL(0, mkdir((dir + "/mission.state.a.tmp").c_str(), 0700));
   LoopRig rig;
   rig.start();
   CHECK_NO_ALLOCATION(rig.frames(103));  // the first checkpoint at 1 s, then 3 frames
   CHECK_EQUAL(1U, rig.saver.failures());
   STRCMP_CONTAINS("LOG error storage unhealthy: state not saved (1 failed): ",
                   rig.port.written().c_str());
-  STRCMP_CONTAINS("mission.state.tmp", rig.port.written().c_str());
+  STRCMP_CONTAINS("mission.state.a.tmp", rig.port.written().c_str());
   rig.port.feed("status\rstats\r");
   rig.frames(2);
   STRCMP_CONTAINS("healthy=0 unhealthy=storage cycles=1", rig.port.written().c_str());
@@ -156,7 +157,7 @@ TEST(FirmwareLoop, AFailingStateSaveIsLoggedAtOnceAndMakesTheStorageUnhealthyUnt
   const int kicks = rig.watchdog.kicks;
   rig.frames(20);
   CHECK(rig.watchdog.kicks > kicks);
-  CHECK_EQUAL(0, rmdir((dir + "/mission.state.tmp").c_str()));
+  CHECK_EQUAL(0, rmdir((dir + "/mission.state.a.tmp").c_str()));
   rig.port.clear_written();
   rig.frames(100);  // the next checkpoint is saved
   STRCMP_CONTAINS("LOG info storage healthy again: state saved", rig.port.written().c_str());

@@ -146,7 +146,9 @@ TEST_GROUP(FirmwareMain) {
     dir = mkdtemp(templ);
   }
   void teardown() override {
-    unlink((dir + "/mission.state").c_str());
+    for (const char* name : {"/mission.state", "/mission.state.a", "/mission.state.b"}) {
+      unlink((dir + name).c_str());
+    }
     for (int i = 1; i <= StateStore::kKeptStates; ++i) {
       unlink((dir + "/mission.state." + std::to_string(i)).c_str());
     }
@@ -218,6 +220,8 @@ TEST(FirmwareMain, SavesEachCycleAndResumesFromTheStateDirectory) {
   CHECK_EQUAL(9U, state.seed);
   CHECK_EQUAL(1U, state.log.size());  // ... and the end was saved with its reason
   STRCMP_CONTAINS("mission aborted: no camera frame", std::string(state.log[0].view()).c_str());
+  // A device fault ends this run only: the state keeps the mission running for --resume.
+  CHECK(state.end == MissionEnd::kRunning);
 
   r = run_firmware({"--max-cycles", "2", "--state", dir.c_str(), "--resume"});
   CHECK_EQUAL(kExitNotFound, r.exit_code);
@@ -257,6 +261,144 @@ TEST(FirmwareMain, AStateDirectoryOthersMayWriteInStopsTheStartWithTheUsageCode)
                   r.err.c_str());
   CHECK(r.out.find("MISSION") == std::string::npos);
   CHECK_EQUAL(0, chmod(dir.c_str(), 0700));
+}
+
+namespace {
+// Saves a state of `cycle` cycles, ended as `end` (or running), in `dir` as the firmware would.
+void save_state(const std::string& dir, std::uint64_t cycle, MissionEnd end, const char* why) {
+  static MissionState state;  // large: static storage
+  static StateStore store;
+  char error[256] = "";
+  CHECK_TRUE_TEXT(store.open(dir.c_str(), error, sizeof error), error);
+  state.clear();
+  state.cycle = cycle;
+  state.seed = 3;
+  state.add_log(cycle, "looked");
+  if (end != MissionEnd::kRunning) state.set_end(end, why);
+  CHECK_TRUE_TEXT(store.save(state, error, sizeof error), error);
+}
+
+struct FramesThenSignal {
+  int frames = 0;
+  int at_frame = 0;
+  float fastest_m_s = 0.0F;
+  FakeBoard* board = nullptr;
+};
+void count_then_sigterm(void* context) {
+  auto* f = static_cast<FramesThenSignal*>(context);
+  const float v = f->board->base.v_m_s < 0.0F ? -f->board->base.v_m_s : f->board->base.v_m_s;
+  if (v > f->fastest_m_s) f->fastest_m_s = v;
+  if (++f->frames == f->at_frame) std::raise(SIGTERM);
+}
+}  // namespace
+
+TEST(FirmwareMain, AMissionThatHasEndedIsNotResumedAndTheFirmwareStaysUpWithTheRobotStopped) {
+  save_state(dir, 5, MissionEnd::kFound, "within the stand-off of the target");
+  static FramesThenSignal watch;
+  watch = FramesThenSignal{0, 500, 0.0F, nullptr};
+  static MainHooks hooks;
+  hooks.after_frame = count_then_sigterm;
+  hooks.context = &watch;
+  std::string console_output;
+  const Run r = run_firmware({"--state", dir.c_str(), "--resume"}, [&](FakeBoard& b) {
+    b.hooks = &hooks;
+    watch.board = &b;
+    b.console.feed("status\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  STRCMP_CONTAINS(
+      "the saved mission has ended (found at cycle 5: within the stand-off of the target): not "
+      "resumed, the robot stays stopped; start without --resume for a new mission",
+      r.err.c_str());
+  // It did not end by itself: it ran until the signal, 5 s of board time, without moving.
+  CHECK_EQUAL(500, watch.frames);
+  DOUBLES_EQUAL(0.0, watch.fastest_m_s, 0.0);
+  STRCMP_CONTAINS("status state=done", console_output.c_str());
+  STRCMP_CONTAINS("mission already ended (found: within the stand-off of the target)",
+                  console_output.c_str());
+  // The MISSION line and the exit code are the saved result's; the state keeps it.
+  CHECK_EQUAL(kExitFound, r.exit_code);
+  STRCMP_CONTAINS("MISSION result=found cycles=5 ", last_line(r.out).c_str());
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(state.end == MissionEnd::kFound);
+  CHECK_EQUAL(5U, state.cycle);
+  // With --max-cycles there is nothing to run: it ends at once, with the same words.
+  const Run once = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "2"});
+  CHECK_EQUAL(kExitFound, once.exit_code);
+  STRCMP_CONTAINS("not resumed", once.err.c_str());
+  STRCMP_CONTAINS("MISSION result=found cycles=5 ", last_line(once.out).c_str());
+}
+
+TEST(FirmwareMain, AnOperatorsStopLeavesTheMissionToResumeButNothingLeftEndsIt) {
+  // A console shutdown (like a signal or --max-cycles) stops this run only.
+  save_state(dir, 2, MissionEnd::kRunning, "");
+  Run r = run_firmware({"--state", dir.c_str(), "--resume"},
+                       [](FakeBoard& b) { b.console.feed("quit\r"); });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("resumed from", r.err.c_str());
+  r = run_firmware({"--state", dir.c_str(), "--resume"},
+                   [](FakeBoard& b) { b.console.feed("quit\r"); });
+  STRCMP_CONTAINS("resumed from", r.err.c_str());
+  // Nothing left to explore is an end: the next start says so and does not carry it on.
+  save_state(dir, 9, MissionEnd::kNotFound, "nothing left to explore");
+  r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
+  STRCMP_CONTAINS("the saved mission has ended (not_found at cycle 9: nothing left to explore)",
+                  r.err.c_str());
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS("MISSION result=not_found cycles=9 ", last_line(r.out).c_str());
+}
+
+namespace {
+void press_bumper_at_frame_50(void* context) {
+  auto* f = static_cast<FramesThenSignal*>(context);
+  if (++f->frames == 50) f->board->bumper.level = true;
+}
+}  // namespace
+
+TEST(FirmwareMain, ABumperContactEndsTheMissionForGoodAndTheNextStartSaysSo) {
+  static FramesThenSignal watch;
+  watch = FramesThenSignal{};
+  static MainHooks hooks;
+  hooks.after_frame = press_bumper_at_frame_50;
+  hooks.context = &watch;
+  Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.hooks = &hooks;
+    watch.board = &b;
+  });
+  STRCMP_CONTAINS("MISSION result=aborted cycles=0 ", last_line(r.out).c_str());
+  STRCMP_CONTAINS("reason=\"bumper contact\"", last_line(r.out).c_str());
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(state.end == MissionEnd::kAborted);
+  STRCMP_EQUAL("bumper contact", state.end_reason.data());
+  r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
+  STRCMP_CONTAINS("the saved mission has ended (aborted at cycle 0: bumper contact)",
+                  r.err.c_str());
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+}
+
+TEST(FirmwareMain, ADamagedNewestStateCopyIsPassedOverWithAWarningAndTheOlderOneResumed) {
+  save_state(dir, 3, MissionEnd::kRunning, "");
+  save_state(dir, 4, MissionEnd::kRunning, "");
+  FILE* f = std::fopen((dir + "/mission.state.b").c_str(), "r+b");
+  std::fseek(f, 30, SEEK_SET);
+  std::fputc('#', f);
+  std::fclose(f);
+  const Run r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  STRCMP_CONTAINS(("boticelli: state copy damaged: " + dir +
+                   "/mission.state.b: checksum mismatch (corrupt file); loaded " + dir +
+                   "/mission.state.a (sequence 1) instead")
+                      .c_str(),
+                  r.err.c_str());
+  STRCMP_CONTAINS(("resumed from " + dir + "/mission.state.a at cycle 3").c_str(), r.err.c_str());
 }
 
 // qemu-user cannot be trusted to fork a process it emulates (the child hangs): native only.
@@ -319,6 +461,16 @@ std::string read_all(const std::string& path) {
   std::fclose(f);
   return s;
 }
+// The copy (A or B) with the higher sequence number: the state a --resume would load.
+std::string read_newest(const std::string& dir) {
+  const std::string a = read_all(dir + "/mission.state.a");
+  const std::string b = read_all(dir + "/mission.state.b");
+  const auto sequence = [](const std::string& f) {
+    const std::size_t at = f.find("\nsequence ");
+    return at == std::string::npos ? -1L : std::atol(f.c_str() + at + 10);
+  };
+  return sequence(a) > sequence(b) ? a : b;
+}
 }  // namespace
 
 TEST(FirmwareMain, ANewMissionKeepsTheSavedOneInsteadOfOverwritingIt) {
@@ -326,14 +478,14 @@ TEST(FirmwareMain, ANewMissionKeepsTheSavedOneInsteadOfOverwritingIt) {
               run_firmware({"--state", dir.c_str(), "--seed", "5"}, [](FakeBoard& b) {
                 b.console.feed("quit\r");
               }).exit_code);
-  const std::string first = read_all(dir + "/mission.state");
+  const std::string first = read_newest(dir);
   STRCMP_CONTAINS("seed 5", first.c_str());
   Run r = run_firmware({"--state", dir.c_str(), "--seed", "6"},
                        [](FakeBoard& b) { b.console.feed("quit\r"); });
   CHECK_EQUAL(kExitNotFound, r.exit_code);
   STRCMP_CONTAINS(("the saved one is kept as " + dir + "/mission.state.1").c_str(), r.err.c_str());
   CHECK(first == read_all(dir + "/mission.state.1"));
-  STRCMP_CONTAINS("seed 6", read_all(dir + "/mission.state").c_str());
+  STRCMP_CONTAINS("seed 6", read_newest(dir).c_str());
   // Older copies shift up; the oldest beyond kKeptStates is dropped.
   for (int i = 0; i < StateStore::kKeptStates; ++i) {
     r = run_firmware({"--state", dir.c_str()}, [](FakeBoard& b) { b.console.feed("quit\r"); });

@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -63,11 +65,14 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   for (std::uint64_t c = 1; c <= cycle && c <= 200; ++c) {
     s.add_log(c, "cycle " + std::to_string(c) + " done");
   }
+  if (cycle % 5 == 0) s.set_end(MissionEnd::kNotFound, "nothing left to explore");
 }
 
 void remove_dir(const std::string& dir) {
   for (const char* name :
-       {"/mission.state", "/mission.state.tmp", "/parameters.conf", "/parameters.conf.tmp"}) {
+       {"/mission.state", "/mission.state.tmp", "/mission.state.a", "/mission.state.a.tmp",
+        "/mission.state.b", "/mission.state.b.tmp", "/mission.state.1", "/mission.state.2",
+        "/parameters.conf", "/parameters.conf.tmp"}) {
     unlink((dir + name).c_str());
   }
   rmdir(dir.c_str());
@@ -90,6 +95,7 @@ TEST_GROUP(Persistence) {
     dir = temp_dir("state");
   }
   void teardown() override {
+    set_storage_fault_hook(nullptr, nullptr);  // a failed test may have left one
     remove_dir(dir);
   }
 };
@@ -172,7 +178,18 @@ TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
        {head + "obstacles 3000\n" + tail, head + "obstacles 1\n1 nan\n" + tail,
         head + "obstacles 1\n1 2 3\n" + tail, head + "obstacles 2\n1 2\n" + tail,
         head + "obstacles -1\n" + tail, std::string("BOTICELLI-STATE 2\n") + "cycle 3\n",
+        "BOTICELLI-STATE 4" + head.substr(17) + "obstacles 0\n" + tail,
+        // Version 3 has a sequence number and the mission's result.
         "BOTICELLI-STATE 3" + head.substr(17) + "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 3\nsequence 4\n" + head.substr(18) + "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 3\nsequence x\ncycle 3\nseed 1\nresult running\n" + head.substr(33) +
+            "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 3\nsequence 4\ncycle 3\nseed 1\nresult won\n" + head.substr(33) +
+            "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 3\nsequence 4\ncycle 3\nseed 1\nresult running late\n" + head.substr(33) +
+            "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 3\nsequence 4\ncycle 3\nseed 1\nresult found \x1b[2J\n" + head.substr(33) +
+            "obstacles 0\n" + tail,
         "BOTICELLI-STATE 0" + head.substr(17) + "obstacles 0\n" + tail,
         "BOTICELLI-STATE 2x" + head.substr(17) + "obstacles 0\n" + tail,
         "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal 1 2\nobstacles 0\n" + tail,
@@ -227,23 +244,161 @@ TEST(Persistence, ReadsAVersionOneFileWhoseGoalHasNoHeight) {
   DOUBLES_EQUAL(0.0, g_b.goal_height_m, 0.0);
 }
 
+TEST(Persistence, KeepsTheMissionsResultAndTheSequenceNumber) {
+  make_state(7, g_a);
+  g_a.set_end(MissionEnd::kFound, "within the stand-off of the target");
+  const std::size_t n = encode_state(g_a, g_file, sizeof g_file, 41);
+  const char* why = "";
+  std::uint64_t sequence = 0;
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why, &sequence), why);
+  CHECK(g_a == g_b);
+  CHECK(g_b.end == MissionEnd::kFound);
+  STRCMP_EQUAL("within the stand-off of the target", g_b.end_reason.data());
+  CHECK_EQUAL(41U, sequence);
+  CHECK_TRUE_TEXT(peek_state({g_file, n}, sequence = 0, &why), why);
+  CHECK_EQUAL(41U, sequence);
+  // The result is part of what a state is: a different end is a different state.
+  g_b.set_end(MissionEnd::kAborted, "within the stand-off of the target");
+  CHECK_FALSE(g_a == g_b);
+  // A file written before the result was kept is a running mission with sequence 0.
+  const std::string v2 = with_crc(
+      "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal none\nobstacles 0\n"
+      "exploration 0\nmodel 0\n\nlog 0\nend\n");
+  sequence = 9;
+  CHECK_TRUE_TEXT(decode_state(v2, g_b, &why, &sequence), why);
+  CHECK(g_b.end == MissionEnd::kRunning);
+  CHECK_EQUAL(0U, sequence);
+}
+
+TEST(Persistence, SavesAlternateBetweenTwoCopiesEachWithTheNextSequenceNumber) {
+  CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
+  for (std::uint64_t c = 1; c <= 4; ++c) {
+    make_state(c, g_a);
+    CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  }
+  // Saves 1 and 3 went to A, 2 and 4 to B; the newest (B, cycle 4) loads.
+  STRCMP_CONTAINS("sequence 3\ncycle 3\n", read_file(dir + "/mission.state.a").c_str());
+  STRCMP_CONTAINS("sequence 4\ncycle 4\n", read_file(dir + "/mission.state.b").c_str());
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(4U, g_b.cycle);
+  STRCMP_EQUAL((dir + "/mission.state.b").c_str(), g_store.loaded_path());
+  STRCMP_EQUAL("", g_store.load_warning());
+  // A store opened afresh (a restart without --resume's load) carries the numbering on.
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  make_state(5, g_a);
+  CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  STRCMP_CONTAINS("sequence 5\ncycle 5\n", read_file(dir + "/mission.state.a").c_str());
+}
+
+TEST(Persistence, AFlippedByteInTheNewestCopyFallsBackToTheOtherWithAWarning) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  for (std::uint64_t c = 20; c <= 21; ++c) {
+    make_state(c, g_a);
+    CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  }
+  const std::string newest = dir + "/mission.state.b";
+  std::string bad = read_file(newest);
+  bad[bad.size() / 2] = static_cast<char>(bad[bad.size() / 2] ^ 0x01);
+  write_file(newest, bad);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(20U, g_b.cycle);  // one save lost, not the mission
+  make_state(20, g_a);
+  CHECK(g_a == g_b);
+  STRCMP_CONTAINS((newest + ": checksum mismatch (corrupt file)").c_str(), g_store.load_warning());
+  STRCMP_CONTAINS(("loaded " + dir + "/mission.state.a (sequence 1) instead").c_str(),
+                  g_store.load_warning());
+  // The next save replaces the damaged copy, not the good one.
+  make_state(22, g_a);
+  CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
+  STRCMP_CONTAINS("sequence 2\ncycle 22\n", read_file(newest).c_str());
+  STRCMP_CONTAINS("sequence 1\ncycle 20\n", read_file(dir + "/mission.state.a").c_str());
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(22U, g_b.cycle);
+  STRCMP_EQUAL("", g_store.load_warning());
+}
+
+TEST(Persistence, WhenBothCopiesAreDamagedNothingLoadsAndEachCopySaysWhy) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  for (std::uint64_t c = 1; c <= 2; ++c) {
+    make_state(c, g_a);
+    CHECK(g_store.save(g_a, error, sizeof error));
+  }
+  const std::string a = read_file(dir + "/mission.state.a");
+  write_file(dir + "/mission.state.a", a.substr(0, a.size() - 3));
+  std::string b = read_file(dir + "/mission.state.b");
+  b[40] = static_cast<char>(b[40] ^ 0x10);
+  write_file(dir + "/mission.state.b", b);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kCorrupt);
+  STRCMP_CONTAINS((dir + "/mission.state.a: ").c_str(), error);
+  STRCMP_CONTAINS((dir + "/mission.state.b: checksum mismatch").c_str(), error);
+  CHECK_EQUAL(0U, g_b.cycle);
+}
+
+TEST(Persistence, AStateFileOfTheSingleFileLayoutLoadsAndGoesOnceBothCopiesAreNewer) {
+  // As an earlier firmware left it: one file, version 2, no sequence number.
+  const std::string old_file = with_crc(
+      "BOTICELLI-STATE 2\ncycle 6\nseed 3\npose 1 2 0.5\ngoal none\nobstacles 1\n1 2\n"
+      "exploration 0\nmodel 0\n\nlog 1\n6 looked\nend\n");
+  write_file(dir + "/mission.state", old_file);
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  CHECK_TRUE_TEXT(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded, error);
+  CHECK_EQUAL(6U, g_b.cycle);
+  CHECK_EQUAL(3U, g_b.seed);
+  STRCMP_EQUAL((dir + "/mission.state").c_str(), g_store.loaded_path());
+  g_b.cycle = 7;
+  CHECK(g_store.save(g_b, error, sizeof error));
+  // Still there while only one copy is newer: it is the fallback for a damaged A.
+  STRCMP_EQUAL(old_file.c_str(), read_file(dir + "/mission.state").c_str());
+  g_b.cycle = 8;
+  CHECK(g_store.save(g_b, error, sizeof error));
+  struct stat st {};
+  CHECK(stat((dir + "/mission.state").c_str(), &st) != 0);
+  CHECK(g_store.load(g_a, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(8U, g_a.cycle);
+}
+
+TEST(Persistence, ANewMissionKeepsTheNewestValidCopyAndClearsBoth) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  char kept[600] = "";
+  CHECK(g_store.keep_previous(kept, sizeof kept, error, sizeof error) == LoadResult::kMissing);
+  for (std::uint64_t c = 30; c <= 32; ++c) {
+    make_state(c, g_a);
+    CHECK(g_store.save(g_a, error, sizeof error));
+  }
+  // A (cycle 32) damaged: B (cycle 31) is the mission to keep.
+  std::string a = read_file(dir + "/mission.state.a");
+  a[60] = static_cast<char>(a[60] ^ 0x04);
+  write_file(dir + "/mission.state.a", a);
+  CHECK(g_store.keep_previous(kept, sizeof kept, error, sizeof error) == LoadResult::kLoaded);
+  STRCMP_EQUAL((dir + "/mission.state.1").c_str(), kept);
+  STRCMP_CONTAINS("cycle 31\n", read_file(dir + "/mission.state.1").c_str());
+  struct stat st {};
+  CHECK(stat((dir + "/mission.state.a").c_str(), &st) != 0);
+  CHECK(stat((dir + "/mission.state.b").c_str(), &st) != 0);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kMissing);
+  // The new mission numbers its saves from 1 again.
+  make_state(1, g_a);
+  CHECK(g_store.save(g_a, error, sizeof error));
+  STRCMP_CONTAINS("sequence 1\n", read_file(dir + "/mission.state.a").c_str());
+}
+
 TEST(Persistence, SavesAtomicallyAndLoadsBack) {
   CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kMissing);
   make_state(17, g_a);
   CHECK_TRUE_TEXT(g_store.save(g_a, error, sizeof error), error);
   struct stat st {};
-  CHECK(stat((dir + "/mission.state.tmp").c_str(), &st) != 0);  // no temporary left behind
+  CHECK(stat((dir + "/mission.state.a.tmp").c_str(), &st) != 0);  // no temporary left behind
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
   CHECK(g_a == g_b);
 }
 
 TEST(Persistence, ASymlinkedTemporaryFileIsReplacedNotWrittenThrough) {
-  // Someone who could write in the directory left mission.state.tmp pointing elsewhere.
+  // Someone who could write in the directory left mission.state.a.tmp pointing elsewhere.
   const std::string outside_dir = temp_dir("outside");
   const std::string outside = outside_dir + "/precious";
   write_file(outside, "do not touch\n");
-  CHECK_EQUAL(0, symlink(outside.c_str(), (dir + "/mission.state.tmp").c_str()));
+  CHECK_EQUAL(0, symlink(outside.c_str(), (dir + "/mission.state.a.tmp").c_str()));
   CHECK_EQUAL(0, symlink(outside.c_str(), (dir + "/parameters.conf.tmp").c_str()));
   CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
   make_state(12, g_a);
@@ -251,19 +406,19 @@ TEST(Persistence, ASymlinkedTemporaryFileIsReplacedNotWrittenThrough) {
   CHECK_TRUE_TEXT(g_store.save_parameters("telemetry_ms = 250\n", error, sizeof error), error);
   STRCMP_EQUAL("do not touch\n", read_file(outside).c_str());
   struct stat st {};
-  CHECK_EQUAL(0, lstat((dir + "/mission.state").c_str(), &st));
+  CHECK_EQUAL(0, lstat((dir + "/mission.state.a").c_str(), &st));
   CHECK(S_ISREG(st.st_mode));  // a file of its own, not the symlink renamed into place
   CHECK_EQUAL(0, lstat((dir + "/parameters.conf").c_str(), &st));
   CHECK(S_ISREG(st.st_mode));
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
   CHECK(g_a == g_b);
-  CHECK(lstat((dir + "/mission.state.tmp").c_str(), &st) != 0);
+  CHECK(lstat((dir + "/mission.state.a.tmp").c_str(), &st) != 0);
   unlink(outside.c_str());
   rmdir(outside_dir.c_str());
 }
 
 TEST(Persistence, AStaleTemporaryFileLeftByACrashDoesNotBlockASave) {
-  write_file(dir + "/mission.state.tmp", "half a state from a killed run");
+  write_file(dir + "/mission.state.a.tmp", "half a state from a killed run");
   write_file(dir + "/parameters.conf.tmp", "half");
   CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
   make_state(5, g_a);
@@ -273,7 +428,7 @@ TEST(Persistence, AStaleTemporaryFileLeftByACrashDoesNotBlockASave) {
   CHECK(g_a == g_b);
   STRCMP_EQUAL("telemetry_ms = 250\n", read_file(dir + "/parameters.conf").c_str());
   struct stat st {};
-  CHECK(stat((dir + "/mission.state.tmp").c_str(), &st) != 0);
+  CHECK(stat((dir + "/mission.state.a.tmp").c_str(), &st) != 0);
   CHECK(stat((dir + "/parameters.conf.tmp").c_str(), &st) != 0);
 }
 
@@ -322,7 +477,7 @@ TEST(Persistence, ReportsACorruptOrTruncatedFileAndDoesNotLoadIt) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   make_state(40, g_a);
   CHECK(g_store.save(g_a, error, sizeof error));
-  const std::string path = dir + "/mission.state";
+  const std::string path = dir + "/mission.state.a";  // the only copy after one save
   const std::string good = read_file(path);
   write_file(path, good.substr(0, good.size() / 2));
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kCorrupt);
@@ -470,6 +625,44 @@ TEST(Persistence, TheWriterThreadEndsWithTheNewestSubmittedState) {
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
   CHECK_EQUAL(30U, g_b.cycle);
   make_state(30, g_a);
+  CHECK(g_a == g_b);
+}
+namespace {
+// Fails the first `failures` creations of a temporary file with EIO.
+struct FailingCreates {
+  std::atomic<int> failures{0};
+};
+int fail_creates(StorageCall call, void* context) {
+  auto* f = static_cast<FailingCreates*>(context);
+  if (call != StorageCall::kCreate) return 0;
+  return f->failures.fetch_sub(1) > 0 ? EIO : 0;
+}
+}  // namespace
+
+TEST(Persistence, TheWriterThreadRetriesAFailedSaveWithoutANewSubmission) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static FailingCreates failing;
+  failing.failures = 2;
+  set_storage_fault_hook(fail_creates, &failing);
+  {
+    auto owner = std::make_unique<StateSaver>(g_store);
+    StateSaver& saver = *owner;
+    saver.set_retry_interval_ms(20);
+    saver.start();
+    make_state(12, g_a);
+    CHECK(saver.submit(g_a));
+    // Nothing more is submitted (a finished mission): the writer tries again by itself.
+    for (int i = 0; i < 500 && saver.saved() == 0; ++i) {
+      timespec pause{0, 10000000L};
+      nanosleep(&pause, nullptr);
+    }
+    CHECK_EQUAL(1U, saver.saved());
+    CHECK_EQUAL(2U, saver.failures());
+    CHECK_EQUAL(2U, saver.retries());
+    CHECK_FALSE(saver.failing());
+  }
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
   CHECK(g_a == g_b);
 }
 #endif

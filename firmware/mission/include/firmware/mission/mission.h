@@ -121,11 +121,15 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] std::uint64_t cycles_this_run() const { return cycles_this_run_; }
   // Distance between the target estimate and the true target (NaN without either).
   [[nodiscard]] float target_error_m() const;
-  // Ends the mission from outside: shutdown (aborted) or --max-cycles (not found).
-  void abort(const char* why);
-  // abort() with the device's own words: "WHY: DEVICE_ERROR" (just WHY when it gave none).
-  void abort_with(const char* why, const char* device_error);
-  void finish_not_found(const char* why) { finish(Result::kNotFound, why); }
+  // True when the resumed state's mission had already ended (found, nothing left, aborted
+  // for good): start() keeps it ended, the robot stopped, and result() and end_reason() are
+  // the saved ones.
+  [[nodiscard]] bool ended_before_start() const { return ended_before_start_; }
+  // Ends the mission from outside: a signal or the console's shutdown (aborted) or
+  // --max-cycles (not found). The state keeps the mission running: a later --resume
+  // carries it on.
+  void abort(const char* why) { finish(Result::kAborted, why, Ending::kResumable); }
+  void finish_not_found(const char* why) { finish(Result::kNotFound, why, Ending::kResumable); }
   // Shutdown: saves the pose where the base came to rest and waits until the state is written.
   void finish_saving();
   // Per-stage host CPU time so far [s] (the benchmark's split).
@@ -160,7 +164,12 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   void control_drive(std::uint64_t now_us);
   bool hold_needed();
   void control_hold(std::uint64_t now_us);
-  void finish(Result result, const char* why);
+  // kFinal is saved in the state (a resumed run does not carry the mission on); kResumable
+  // ends this run only.
+  enum class Ending : std::uint8_t { kFinal, kResumable };
+  void finish(Result result, const char* why, Ending ending);
+  // A device fault: "WHY: DEVICE_ERROR" (just WHY when it gave none); resumable.
+  void abort_with(const char* why, const char* device_error);
   void end_cycle(const char* what);
   // A part of the grabbed view's processing (a unit); true when the view is done.
   bool process_view(ViewPart part);
@@ -198,6 +207,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   Phase phase_ = Phase::kStart;
   Phase held_phase_ = Phase::kStart;
   Result result_ = Result::kRunning;
+  bool ended_before_start_ = false;
   TextBuffer<160> end_reason_;  // a copy: a device's reason may change after the end
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;

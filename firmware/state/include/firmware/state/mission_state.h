@@ -21,6 +21,13 @@ struct MissionLogEntry {
   std::string_view view() const { return {text.data()}; }
 };
 
+// How a mission ended, as the state keeps it. A mission stopped from outside (a signal, the
+// console's `shutdown`, --max-cycles) or by a fault a restart may cure is still kRunning: the
+// next start with --resume carries it on. The other three are final: a resumed run says so and
+// keeps the robot stopped.
+enum class MissionEnd : std::uint8_t { kRunning, kFound, kNotFound, kAborted };
+const char* mission_end_name(MissionEnd end);  // "running", "found", "not_found", "aborted"
+
 struct MissionState {
   // The global map's capacities (mapping::GlobalMap), so a saved state holds what the map
   // holds and a restored one fits back into it.
@@ -31,6 +38,8 @@ struct MissionState {
 
   std::uint64_t cycle = 0;  // completed cycles
   std::uint64_t seed = 1;   // --seed of the run that started the mission
+  MissionEnd end = MissionEnd::kRunning;
+  std::array<char, MissionLogEntry::kMaxTextBytes + 1> end_reason{};  // printable, NUL-terminated
   // Robot pose [m, rad] in the mission's frame: the odometry frame of the run that started the
   // mission (a resumed run carries it on from here).
   core::Pose2 pose;
@@ -48,6 +57,10 @@ struct MissionState {
   std::uint64_t log_dropped = 0;
 
   std::string_view model_text() const { return {model.data(), model_bytes}; }
+  std::string_view end_reason_text() const { return {end_reason.data()}; }
+  bool finished() const { return end != MissionEnd::kRunning; }
+  // Records a final end and its reason (cut and made printable as a log line is).
+  void set_end(MissionEnd how, std::string_view why);
   // False (model unchanged) when the text is longer than kMaxModelBytes or contains NUL.
   bool set_model(std::string_view text);
   // Appends a log line; the oldest line goes when the log is full. Bytes outside printable

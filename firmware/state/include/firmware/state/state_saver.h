@@ -20,8 +20,11 @@ namespace boticelli::firmware {
 // no allocation); the writer thread (normal scheduling, started at init) encodes and saves
 // it atomically through the StateStore. When states come faster than the disk takes them,
 // the newest one waits and older, not yet started ones are dropped (each file is a
-// complete state, so only the latest matters). The console's saved parameters take the
-// same road (submit_parameters), so `param save` never waits for the disk either.
+// complete state, so only the latest matters). A save that fails is tried again by the writer
+// thread every retry interval (1 s by default) until it succeeds or a newer state replaces
+// it, so a full or briefly unwritable disk loses nothing once it recovers, even when the
+// mission submits nothing more (a finished or held one). The console's saved parameters take
+// the same road (submit_parameters), so `param save` never waits for the disk either.
 class StateSaver {
  public:
   explicit StateSaver(StateStore& store) : store_(store) {}
@@ -30,8 +33,14 @@ class StateSaver {
   StateSaver& operator=(const StateSaver&) = delete;
 
   // Starts the writer thread (allocates: call at init). Without it submit() saves in the
-  // caller's thread (the sim board, where the clock stands still while code runs anyway).
+  // caller's thread (the sim board, where the clock stands still while code runs anyway) and
+  // a failed save is retried only by the next submit.
   void start();
+  // How long the writer thread waits before trying a failed save again (before start()).
+  void set_retry_interval_ms(std::uint32_t ms) { retry_interval_ms_ = ms; }
+  // Failed saves that the writer thread tried again (each also counts in failures() or
+  // saved()).
+  std::uint64_t retries() const;
   // Hands a copy of `state` to the writer; false (nothing changed) when the writer is just
   // taking the previous one: call again in a later slice.
   bool submit(const MissionState& state);
@@ -78,7 +87,10 @@ class StateSaver {
   bool stop_ = false;
   std::uint64_t saved_ = 0;
   std::uint64_t failures_ = 0;
-  bool failing_ = false;  // guarded by mutex_
+  bool failing_ = false;    // guarded by mutex_
+  bool retry_due_ = false;  // writing_ failed and nothing newer came yet; guarded by mutex_
+  std::uint64_t retries_ = 0;
+  std::uint32_t retry_interval_ms_ = 1000;
   char error_[256] = "";
   MissionState writing_;  // the writer thread's own copy
   std::array<char, ParameterTable::kMaxFileBytes> parameters_pending_{};  // guarded by mutex_
