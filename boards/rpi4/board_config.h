@@ -83,8 +83,13 @@ inline firmware::BoardConfig make_config() {
   c.fifo_priority = 50;
   // /dev/watchdog: longer than systemd's whole restart chain after a hang (WatchdogSec 2 s,
   // TimeoutAbortSec 2 s, RestartSec 1 s, start-up to the watchdog's open about 3 s), so the
-  // service restarts before the board resets (docs/flashing.md, "Watchdogs").
+  // service restarts before the board resets (docs/flashing.md, "Watchdogs"). The range a
+  // configuration may set: that chain (8 s) plus 2 s to spare, up to the most the BCM2711's
+  // watchdog counts (bcm2835_wdt: 15 s). test_service_unit checks the bottom against the unit.
+  c.watchdog_enabled = true;
   c.watchdog_timeout_ms = 12000;
+  c.watchdog_min_timeout_ms = 10000;
+  c.watchdog_max_timeout_ms = 15000;
   c.background_units_per_slice = 0;
   c.checkpoint_period_ms = 1000;
   return c;

@@ -6,6 +6,15 @@
 namespace boticelli::firmware {
 
 bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
+  // The watchdog's range is the board's (BoardConfig::watchdog_min/max_timeout_ms); 0 no
+  // longer switches it off, `enabled = false` does.
+  ConfigKey watchdog_timeout =
+      ConfigKey::whole("watchdog", "timeout_ms", c.watchdog_timeout_ms, c.watchdog_min_timeout_ms,
+                       c.watchdog_max_timeout_ms);
+  watchdog_timeout.below_min_note =
+      "shorter, the hardware watchdog would reset the board before systemd restarts a hung "
+      "firmware (to switch the watchdog off: enabled = false)";
+  watchdog_timeout.above_max_note = "longer than the board's watchdog can count";
   // Full resolution is downsampled by 4 (rig.h) into at most LowResFrame's 320x240; YUYV
   // needs an even width, the 4x4 blocks whole ones.
   constexpr std::uint32_t kMaxWidth = image::LowResFrame::kMaxWidth * 4;
@@ -30,7 +39,8 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::baud("console", "baud", c.console_baud)) &&
          s.add(
              ConfigKey::whole("console", "telemetry_period_ms", c.telemetry_period_ms, 0, 60000)) &&
-         s.add(ConfigKey::whole("watchdog", "timeout_ms", c.watchdog_timeout_ms, 0, 60000)) &&
+         s.add(ConfigKey::flag_key("watchdog", "enabled", c.watchdog_enabled)) &&
+         s.add(watchdog_timeout) &&
          s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner));
 }
 

@@ -81,9 +81,11 @@ bool check_value(const ConfigKey& key, const toml::node& node, Value& out, char*
       const auto min = static_cast<std::int64_t>(key.min);
       const auto max = static_cast<std::int64_t>(key.max);
       if (out.whole < min || out.whole > max) {
-        std::snprintf(why, why_size, "%s.%s = %lld is out of range (%lld to %lld)", key.table,
+        const char* note = out.whole < min ? key.below_min_note : key.above_max_note;
+        std::snprintf(why, why_size, "%s.%s = %lld is out of range (%lld to %lld)%s%s", key.table,
                       key.name, static_cast<long long>(out.whole), static_cast<long long>(min),
-                      static_cast<long long>(max));
+                      static_cast<long long>(max), note != nullptr ? ": " : "",
+                      note != nullptr ? note : "");
         return false;
       }
       if (key.multiple_of > 1 && out.whole % key.multiple_of != 0) {

@@ -205,7 +205,12 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   if (!hal.pan_tilt.init()) return fail("pan-tilt unit", hal.pan_tilt.error());
   if (!hal.camera.init()) return fail("camera", hal.camera.error());
   bool watchdog_armed = false;
-  if (config.watchdog_timeout_ms != 0) {
+  if (!config.watchdog_enabled) {
+    // Only an explicit key switches it off, and every start says so.
+    slog.log(LogLevel::kWarn,
+             "hardware watchdog disabled by the configuration ([watchdog] enabled = false): a "
+             "hang that systemd cannot end is not reset");
+  } else {
     watchdog_armed = hal.watchdog.start(config.watchdog_timeout_ms);
     if (!watchdog_armed) {
       slog.log(LogLevel::kWarn, "watchdog not armed (%s)", hal.watchdog.error());
@@ -243,6 +248,9 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   Console& console = *rt.console;
   console.set_log_ring(&g_log_ring, &hal.clock);
   console.set_board_name(info.name);
+  console.set_watchdog_state(watchdog_armed             ? Console::WatchdogState::kArmed
+                             : !config.watchdog_enabled ? Console::WatchdogState::kDisabled
+                                                        : Console::WatchdogState::kUnavailable);
   console.set_fault_injection(board.fault_injection());
   console.set_telemetry_ms(static_cast<float>(config.telemetry_period_ms));
   float background_slice_us = 0.0F;

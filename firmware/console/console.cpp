@@ -276,6 +276,9 @@ void Console::cmd_status(const Words& w) {
                  stop_cause_name(safety_.cause()), paused ? 1 : 0, awaited_command(safety_, paused),
                  robot_healthy() ? 1 : 0);
   append_unhealthy(reply_);
+  reply_.appendf(" watchdog=%s", watchdog_state_ == WatchdogState::kArmed      ? "armed"
+                                 : watchdog_state_ == WatchdogState::kDisabled ? "disabled"
+                                                                               : "unavailable");
   reply_.appendf(" cycles=%llu pieces=%u features=%u obstacle_points=%u exploration_points=%u",
                  static_cast<unsigned long long>(view_.cycles()), view_.pieces(), view_.features(),
                  m.obstacle_points, m.exploration_points);

@@ -301,7 +301,7 @@ bool start_rig(SimBoard& board, const FaultScenarioConfig& config, bool wants_fr
     std::snprintf(error, error_size, "device init failed");
     return false;
   }
-  (void)hal.watchdog.start(board.config().watchdog_timeout_ms);
+  const bool watchdog_armed = hal.watchdog.start(board.config().watchdog_timeout_ms);
   g_rig.reset();
   g_rig.emplace(hal, g_store, config.state_dir != nullptr);
   Rig& rig = *g_rig;
@@ -313,6 +313,9 @@ bool start_rig(SimBoard& board, const FaultScenarioConfig& config, bool wants_fr
     return false;
   }
   rig.runtime.console->set_telemetry_ms(0.0F);
+  rig.runtime.console->set_watchdog_state(watchdog_armed
+                                              ? fw::Console::WatchdogState::kArmed
+                                              : fw::Console::WatchdogState::kUnavailable);
   rig.runtime.console->set_fault_injection(&board);
   if (config.state_dir != nullptr) rig.runtime.console->set_parameter_saver(&rig.runtime.saver);
   fw::ExecutiveConfig exec_config;

@@ -140,6 +140,51 @@ TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
   }
 }
 
+// The watchdog's timeout stays where a hang restarts the service before the board resets
+// (docs/flashing.md, "Watchdogs"), and 0 no longer switches it off: only `enabled = false`.
+TEST(ConfigFile, TheWatchdogTimeoutIsBoundedByTheRestartChainAndOnlyAKeySwitchesItOff) {
+  struct Case {
+    const char* line;
+    const char* why;  // nullptr: accepted
+  };
+  const Case cases[] = {
+      {"timeout_ms = 9999",
+       "watchdog.timeout_ms = 9999 is out of range (10000 to 15000): shorter, the hardware "
+       "watchdog would reset the board before systemd restarts a hung firmware (to switch the "
+       "watchdog off: enabled = false)"},
+      {"timeout_ms = 0", "watchdog.timeout_ms = 0 is out of range (10000 to 15000): shorter"},
+      {"timeout_ms = 1", "watchdog.timeout_ms = 1 is out of range (10000 to 15000): shorter"},
+      {"timeout_ms = 15001",
+       "watchdog.timeout_ms = 15001 is out of range (10000 to 15000): longer than the board's "
+       "watchdog can count"},
+      {"timeout_ms = 60000", "is out of range (10000 to 15000): longer"},
+      {"enabled = 0", "watchdog.enabled must be true or false"},
+      {"timeout_ms = 10000", nullptr},
+      {"timeout_ms = 15000", nullptr},
+  };
+  for (const Case& c : cases) {
+    Rpi4Keys k;
+    char error[320] = "";
+    const std::string text = std::string("[watchdog]\n") + c.line + "\n";
+    const bool ok = apply_config_text(text, "w.conf", k.schema, error, sizeof error);
+    if (c.why == nullptr) {
+      CHECK_TRUE_TEXT(ok, error);
+    } else {
+      CHECK_FALSE_TEXT(ok, c.line);
+      STRCMP_CONTAINS(c.why, error);
+      CHECK_EQUAL(12000U, k.config.watchdog_timeout_ms);
+    }
+  }
+  Rpi4Keys k;
+  char error[320] = "";
+  CHECK(k.config.watchdog_enabled);
+  CHECK_TEXT(
+      apply_config_text("[watchdog]\nenabled = false\n", "w.conf", k.schema, error, sizeof error),
+      error);
+  CHECK_FALSE(k.config.watchdog_enabled);
+  CHECK_EQUAL(12000U, k.config.watchdog_timeout_ms);
+}
+
 // toml++ 3.3.0 reaches undefined behaviour on some non-ASCII code points (fuzz_config_file
 // found U+FEBF); such bytes never get to it.
 TEST(ConfigFile, ANonAsciiByteIsRefusedWithItsLineBeforeTheTomlLibrarySeesIt) {

@@ -28,12 +28,21 @@ using namespace boticelli::test;
 
 namespace {
 
+// Refuses to arm unless `accept` (then counts its starts and keeps the timeout asked for).
 class NullWatchdog final : public boticelli::hal::Watchdog {
  public:
-  bool start(std::uint32_t) override { return false; }
+  bool start(std::uint32_t timeout_ms) override {
+    if (!accept) return false;
+    ++starts;
+    started_ms = timeout_ms;
+    return true;
+  }
   void kick() override {}
   void stop() override {}
   const char* error() const override { return "no watchdog in tests"; }
+  bool accept = false;
+  int starts = 0;
+  std::uint32_t started_ms = 0;
 };
 
 // Everything fake; the clock moves only in sleep_until_us (lockstep, like the sim board).
@@ -350,6 +359,61 @@ TEST(FirmwareMain, AnOperatorsStopLeavesTheMissionToResumeButNothingLeftEndsIt) 
                   r.err.c_str());
   CHECK_EQUAL(kExitNotFound, r.exit_code);
   STRCMP_CONTAINS("MISSION result=not_found cycles=9 ", last_line(r.out).c_str());
+}
+
+TEST(FirmwareMain, TheWatchdogIsOffOnlyByItsKeyEveryStartWarnsOfItAndStatusShowsItsState) {
+  const std::string conf = dir + "/boticelli.conf";
+  FILE* f = std::fopen(conf.c_str(), "w");
+  std::fputs("[watchdog]\nenabled = false\n", f);
+  std::fclose(f);
+  for (int start = 0; start < 2; ++start) {
+    std::string console_output;
+    int starts = -1;
+    const Run r = run_firmware({"--config", conf.c_str()}, [&](FakeBoard& b) {
+      b.watchdog.accept = true;
+      b.console.feed("status\rquit\r");
+      b.after_run = [&](FakeBoard& done) {
+        console_output = done.console.written();
+        starts = done.watchdog.starts;
+      };
+    });
+    CHECK_EQUAL(kExitNotFound, r.exit_code);
+    STRCMP_CONTAINS(
+        "boticelli: hardware watchdog disabled by the configuration ([watchdog] enabled = "
+        "false): a hang that systemd cannot end is not reset",
+        r.err.c_str());
+    CHECK_EQUAL(0, starts);
+    STRCMP_CONTAINS("unhealthy=none watchdog=disabled ", console_output.c_str());
+  }
+  // Enabled (the default): armed with the configured timeout, and said so.
+  std::string console_output;
+  std::uint32_t started_ms = 0;
+  Run r = run_firmware({}, [&](FakeBoard& b) {
+    b.watchdog.accept = true;
+    b.console.feed("status\rquit\r");
+    b.after_run = [&](FakeBoard& done) {
+      console_output = done.console.written();
+      started_ms = done.watchdog.started_ms;
+    };
+  });
+  CHECK(r.err.find("watchdog") == std::string::npos);
+  CHECK_EQUAL(2000U, started_ms);
+  STRCMP_CONTAINS("watchdog=armed ", console_output.c_str());
+  // A device that cannot be armed: a warning, and status does not pretend it is.
+  r = run_firmware({}, [&](FakeBoard& b) {
+    b.console.feed("status\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  STRCMP_CONTAINS("boticelli: watchdog not armed (no watchdog in tests)", r.err.c_str());
+  STRCMP_CONTAINS("watchdog=unavailable ", console_output.c_str());
+  // 0 no longer means "off": it is refused with the reason.
+  f = std::fopen(conf.c_str(), "w");
+  std::fputs("[watchdog]\ntimeout_ms = 0\n", f);
+  std::fclose(f);
+  r = run_firmware({"--config", conf.c_str()});
+  CHECK_EQUAL(kExitUsage, r.exit_code);
+  STRCMP_CONTAINS("watchdog.timeout_ms = 0 is out of range (1000 to 60000): shorter",
+                  r.err.c_str());
 }
 
 namespace {

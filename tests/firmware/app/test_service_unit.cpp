@@ -104,6 +104,36 @@ TEST(ServiceUnit, AHungFirmwareIsRestartedWellInsideTheHardwareWatchdogTimeout) 
   CHECK(watchdog_s >= 1.0);
 }
 
+// Not only the shipped timeout: every timeout the configuration file accepts
+// ([watchdog] timeout_ms, BoardConfig::watchdog_min_timeout_ms and _max_) keeps the chain above
+// with its margin, and none is beyond what the BCM2711 counts.
+TEST(ServiceUnit, EveryWatchdogTimeoutTheConfigurationAcceptsLeavesTheRestartChainIntact) {
+  constexpr double kStartS = 3.0;
+  constexpr double kMarginS = 2.0;
+  const auto keys = service_keys();
+  CHECK(keys.count("WatchdogSec") == 1 && keys.count("RestartSec") == 1 &&
+        keys.count("TimeoutAbortSec") == 1);
+  if (keys.count("WatchdogSec") == 0 || keys.count("RestartSec") == 0 ||
+      keys.count("TimeoutAbortSec") == 0) {
+    return;
+  }
+  const double chain_s = seconds(keys.at("WatchdogSec")) + seconds(keys.at("TimeoutAbortSec")) +
+                         seconds(keys.at("RestartSec")) + kStartS;
+  const boticelli::firmware::BoardConfig c = boticelli::boards::rpi4::make_config();
+  const double lowest_s = static_cast<double>(c.watchdog_min_timeout_ms) * 1e-3;
+  if (chain_s + kMarginS > lowest_s) {
+    char why[160];
+    std::snprintf(why, sizeof why,
+                  "the configuration accepts %.1f s, but the restart chain is %.1f s + %.1f s "
+                  "to spare",
+                  lowest_s, chain_s, kMarginS);
+    FAIL(why);
+  }
+  CHECK(c.watchdog_max_timeout_ms <= 15000U);
+  CHECK(c.watchdog_timeout_ms >= c.watchdog_min_timeout_ms &&
+        c.watchdog_timeout_ms <= c.watchdog_max_timeout_ms);
+}
+
 // The firmware refuses a state directory its group or others may write in; the one systemd
 // makes for the unit (StateDirectory=, owned by User=, StateDirectoryMode=, 0755 when not
 // set) must pass, or the service would never start.

@@ -38,6 +38,10 @@ struct ConfigKey {
   double min = 0.0;
   double max = 0.0;
   std::uint32_t multiple_of = 1;
+  // Said after a kWhole value's range error, below the minimum or above the maximum (why the
+  // range is what it is, and what to do instead; nullptr: nothing).
+  const char* below_min_note = nullptr;
+  const char* above_max_note = nullptr;
 
   static ConfigKey whole(const char* table, const char* name, std::uint32_t& value,
                          std::uint32_t min, std::uint32_t max, std::uint32_t multiple_of = 1);

@@ -40,7 +40,14 @@ struct BoardConfig {
   // stack, SCHED_FIFO at this priority when permitted. Off on the host simulation.
   bool realtime = false;
   int fifo_priority = 50;
-  std::uint32_t watchdog_timeout_ms = 2000;  // /dev/watchdog timeout; 0 = do not arm it
+  // Hardware watchdog (/dev/watchdog). Its timeout must lie in the board's range: at least the
+  // service's restart chain after a hang plus a margin (shorter, the board would reset before
+  // systemd has restarted a hung firmware), at most what the device can count. It is off only
+  // by an explicit `[watchdog] enabled = false`, which every start warns about.
+  bool watchdog_enabled = true;
+  std::uint32_t watchdog_timeout_ms = 2000;      // [ms]
+  std::uint32_t watchdog_min_timeout_ms = 1000;  // the board's range [ms] (not a file key)
+  std::uint32_t watchdog_max_timeout_ms = 60000;
   // Background units per frame (0 = limited by time only); a simulated board may set it so
   // the work done per frame does not depend on the host's speed.
   std::uint32_t background_units_per_slice = 0;

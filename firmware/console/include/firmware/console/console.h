@@ -44,6 +44,13 @@ class Console {
     clock_ = clock;
   }
   void set_board_name(const char* name) { board_name_ = name; }
+  // The hardware watchdog's state, which `status` shows (`watchdog=`). At init.
+  enum class WatchdogState : std::uint8_t {
+    kArmed,        // armed, kicked while every task is healthy
+    kDisabled,     // switched off by the configuration ([watchdog] enabled = false)
+    kUnavailable,  // enabled, but the device could not be armed (the start-up log says why)
+  };
+  void set_watchdog_state(WatchdogState state) { watchdog_state_ = state; }
   // Where `param save` hands the changed parameters (written into the state directory by
   // the saver's thread); without one (no --state DIR) `param save` is refused. The console
   // also watches the same saver's mission-state saves: a failed one is a LOG error line at
@@ -140,6 +147,7 @@ class Console {
   LogRing* ring_ = nullptr;
   hal::Clock* clock_ = nullptr;
   const char* board_name_ = "?";
+  WatchdogState watchdog_state_ = WatchdogState::kUnavailable;
   bool log_streaming_ = false;  // a `log show` or `log mission` reply is being queued
   bool log_mission_ = false;    // ... and it is `log mission` (the mission log, by line number)
   std::uint64_t log_next_ = 0;  // its next line's sequence number in the ring
