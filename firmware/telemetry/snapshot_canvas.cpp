@@ -74,6 +74,7 @@ void Canvas::put(int x, int y, Rgb c) {
   p[0] = c.r;
   p[1] = c.g;
   p[2] = c.b;
+  if (writes_ != nullptr) ++*writes_;
 }
 
 void Canvas::fill(Rect r, Rgb c) {
@@ -81,8 +82,19 @@ void Canvas::fill(Rect r, Rgb c) {
   const int x1 = std::min(r.x1, clip_.x1);
   const int y0 = std::max(r.y0, clip_.y0);
   const int y1 = std::min(r.y1, clip_.y1);
+  if (x0 >= x1 || y0 >= y1) return;
   for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) put(x, y, c);
+    std::uint8_t* p = rgb_ + (static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                              static_cast<std::size_t>(x0)) *
+                                 3U;
+    for (int x = x0; x < x1; ++x, p += 3) {
+      p[0] = c.r;
+      p[1] = c.g;
+      p[2] = c.b;
+    }
+  }
+  if (writes_ != nullptr) {
+    *writes_ += static_cast<std::uint64_t>(x1 - x0) * static_cast<std::uint64_t>(y1 - y0);
   }
 }
 

@@ -42,7 +42,9 @@ struct Rect {
 
 class Canvas {
  public:
-  Canvas(std::uint8_t* rgb, int width, int height) : rgb_(rgb), width_(width), height_(height) {}
+  // `writes`, when given, counts every pixel written (the work a drawing step did).
+  Canvas(std::uint8_t* rgb, int width, int height, std::uint64_t* writes = nullptr)
+      : rgb_(rgb), width_(width), height_(height), writes_(writes) {}
 
   void set_clip(Rect r) { clip_ = r; }
   void clear_clip() { clip_ = {0, 0, width_, height_}; }
@@ -63,6 +65,7 @@ class Canvas {
   std::uint8_t* rgb_;
   int width_;
   int height_;
+  std::uint64_t* writes_;
   Rect clip_{0, 0, 0, 0};
 };
 

@@ -211,15 +211,20 @@ void sample_field(const PanelMap& m, SnapshotField fn, const void* context, floa
   }
 }
 
-void draw_readings(Canvas& c, const PanelMap& m, const SnapshotFrame& f) {
-  panel_title(c, m, "1 READINGS ON THE FLOOR");
+void draw_readings(Canvas& c, const PanelMap& m, const SnapshotFrame& f, std::size_t first,
+                   std::size_t end) {
+  if (first == 0) {
+    panel_title(c, m, "1 READINGS ON THE FLOOR");
+    c.set_clip(m.plot());
+    c.fill(m.plot(), kInk);
+    draw_truth(c, m, f);
+  }
   c.set_clip(m.plot());
-  c.fill(m.plot(), kInk);
-  draw_truth(c, m, f);
-  for (const SnapshotReading& r : f.readings) {
+  for (const SnapshotReading& r : f.readings.subspan(first, end - first)) {
     if (!std::isfinite(r.m)) continue;
     c.square(m.u(r.x_m), m.v(r.y_m), 1, grey(0.25F + 0.75F * r.m));
   }
+  if (end < f.readings.size()) return;
   draw_robot_outline(c, m, f, kRobot);
   Legend legend(c, m);
   legend.item(grey(0.25F), "M=0");
@@ -271,11 +276,15 @@ void draw_occupancy(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const 
   legend.item(kContour, "CONTOUR");
 }
 
-void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f) {
+void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int part) {
+  if (part == 0) {
+    c.set_clip(m.plot());
+    c.fill(m.plot(), Rgb{255, 255, 255});
+    fill_polygon(c, m, f.free_polygon, kFreeFill);
+    return;
+  }
   panel_title(c, m, "3 NAVIGATION POLYGON");
   c.set_clip(m.plot());
-  c.fill(m.plot(), Rgb{255, 255, 255});
-  fill_polygon(c, m, f.free_polygon, kFreeFill);
   fill_polygon(c, m, f.navigable_polygon, kNavigableFill);
   draw_polyline(c, m, f.free_polygon, true, kFreeLine);
   draw_polyline(c, m, f.navigable_polygon, true, kNavigableLine);

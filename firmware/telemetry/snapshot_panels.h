@@ -44,11 +44,17 @@ void draw_axes(Canvas& c, const PanelMap& m);
 void sample_field(const PanelMap& m, SnapshotField fn, const void* context, float* out, int j0,
                   int j1);
 
-// The four panels: title, plot area and legend (not the axes).
-void draw_readings(Canvas& c, const PanelMap& m, const SnapshotFrame& f);
+// The four panels: title, plot area and legend (not the axes), each in one or more parts
+// (a part is one of the SnapshotWriter's units of work).
+// Readings [first, end) of f.readings; the first part (first == 0) draws the title, the plot
+// and the truth under them, the last (end == f.readings.size()) the robot and the legend.
+void draw_readings(Canvas& c, const PanelMap& m, const SnapshotFrame& f, std::size_t first,
+                   std::size_t end);
 // `field` holds the panel's samples of f.occupancy already (sample_field).
 void draw_occupancy(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const float* field);
-void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f);
+// Part 0: the plot and the free polygon's fill; part 1: the title and everything drawn over
+// the fill.
+void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int part);
 // `field` holds the panel's samples of f.value already (sample_field).
 void draw_value(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const float* field);
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -253,17 +254,91 @@ TEST(SnapshotWriter, WrittenInStepsThePictureIsTheSameAndNoFileShowsBeforeTheLas
   }
   CHECK_TRUE_TEXT(g_writer.ok(), g_writer.error());
   CHECK_FALSE(g_writer.busy());
-  // Title, readings, ten field bands, occupancy, navigation, ten bands, value, axes, open,
-  // the rows in bands of kBandRows, finish.
+  // The paper in bands of kBandRows rows, title, readings, ten field bands, occupancy,
+  // navigation in two parts, ten bands, value, axes, open, the rows in bands of kBandRows,
+  // finish.
   const auto field_bands =
       static_cast<std::size_t>((SnapshotWriter::kFieldCells + SnapshotWriter::kFieldBandRows - 1) /
                                SnapshotWriter::kFieldBandRows);
   const auto row_bands = static_cast<std::size_t>(
       (SnapshotWriter::kHeightPx + SnapshotWriter::kBandRows - 1) / SnapshotWriter::kBandRows);
-  CHECK_EQUAL(2U + field_bands + 2U + field_bands + 3U + row_bands + 1U, steps);
+  CHECK_EQUAL(row_bands + 2U + field_bands + 3U + field_bands + 3U + row_bands + 1U, steps);
   Image stepped;
   CHECK_TRUE(read_png(dir + "/cycle-000004.png", stepped));
   CHECK(whole.rgb == stepped.rgb);
+}
+
+namespace {
+
+// The most a mission's picture can hold: every reading a look keeps, polygons over the whole
+// view, full point lists and path.
+constexpr std::size_t kManyReadings = 28672;  // kMaxLookFeatures + kMaxLookFloorObstacles
+std::array<SnapshotReading, kManyReadings> g_many_readings;
+std::array<Point2, 4096> g_many_obstacles;
+std::array<Point2, 1024> g_many_exploration;
+std::array<Point2, 1024> g_long_path;
+constexpr std::array<Point2, 4> kEverywhere{
+    {{-50.0F, -50.0F}, {50.0F, -50.0F}, {50.0F, 50.0F}, {-50.0F, 50.0F}}};
+
+SnapshotFrame crowded_frame() {
+  for (std::size_t i = 0; i < g_many_readings.size(); ++i) {
+    const float t = static_cast<float>(i) * 0.001F;
+    g_many_readings[i] = {-1.9F + std::fmod(t * 7.0F, 4.8F), -1.9F + std::fmod(t * 3.0F, 4.8F),
+                          static_cast<float>(i % 11) / 10.0F};
+  }
+  for (std::size_t i = 0; i < g_many_obstacles.size(); ++i) {
+    const float t = static_cast<float>(i);
+    g_many_obstacles[i] = {-1.9F + std::fmod(t * 0.037F, 4.8F),
+                           -1.9F + std::fmod(t * 0.011F, 4.8F)};
+  }
+  for (std::size_t i = 0; i < g_many_exploration.size(); ++i) {
+    const float t = static_cast<float>(i);
+    g_many_exploration[i] = {-1.9F + std::fmod(t * 0.013F, 4.8F), 2.5F};
+  }
+  for (std::size_t i = 0; i < g_long_path.size(); ++i) {
+    const float t = static_cast<float>(i) * 0.01F;
+    g_long_path[i] = {2.0F * std::cos(t), 2.0F * std::sin(t)};
+  }
+  SnapshotFrame f = synthetic_frame(9);
+  f.readings = g_many_readings;
+  f.free_polygon = kEverywhere;
+  f.navigable_polygon = kEverywhere;
+  f.obstacle_points = g_many_obstacles;
+  f.exploration_points = g_many_exploration;
+  f.path = g_long_path;
+  return f;
+}
+
+}  // namespace
+
+TEST(SnapshotWriter, NoStepDoesMoreThanItsShareOfTheWorkHoweverFullThePicture) {
+  // Work is counted, not timed: pixels written, rows encoded and field rows sampled per step.
+  CHECK_TRUE_TEXT(g_writer.open(dir.c_str(), error, sizeof error), error);
+  g_writer.begin(crowded_frame());
+  std::uint64_t pixels = 0;
+  int rows = 0;
+  int field_rows = 0;
+  std::uint64_t most_pixels = 0;
+  bool done = false;
+  for (int step = 0; step < 1000 && !done; ++step) {
+    done = g_writer.run_unit();
+    const SnapshotWriter::UnitWork& w = g_writer.last_unit_work();
+    CHECK(w.pixels_written <= SnapshotWriter::kMaxUnitPixels);
+    CHECK(w.rows_encoded <= SnapshotWriter::kBandRows);
+    CHECK(w.field_rows <= SnapshotWriter::kFieldBandRows);
+    pixels += w.pixels_written;
+    rows += w.rows_encoded;
+    field_rows += w.field_rows;
+    most_pixels = std::max(most_pixels, w.pixels_written);
+  }
+  CHECK_TRUE(done);
+  CHECK_TRUE_TEXT(g_writer.ok(), g_writer.error());
+  // The counts are the whole picture's work: every pixel painted, every row encoded, both
+  // fields sampled whole; and the fullest step is near its share (the measure is real).
+  CHECK(pixels >= static_cast<std::uint64_t>(SnapshotWriter::kWidthPx) * SnapshotWriter::kHeightPx);
+  CHECK_EQUAL(SnapshotWriter::kHeightPx, rows);
+  CHECK_EQUAL(2 * SnapshotWriter::kFieldCells, field_rows);
+  CHECK(most_pixels > SnapshotWriter::kMaxUnitPixels / 2);
 }
 
 TEST(SnapshotWriter, AMissingDirectoryIsCreatedWithItsParents) {

@@ -114,12 +114,26 @@ class SnapshotWriter {
 
   // The same in bounded steps, for a background slice: begin() takes the frame (its spans and
   // the fields' contexts must stay valid and unchanged until the picture is done), then each
-  // run_unit() draws one panel or encodes kBandRows rows; it returns true when the picture is
-  // written or has failed (ok(), error()). A begin() while busy abandons the picture before.
+  // run_unit() clears kBandRows rows of the canvas, draws the title or one panel, samples
+  // kFieldBandRows rows of a field or encodes kBandRows rows; it returns true when the
+  // picture is written or has failed (ok(), error()). A begin() while busy abandons the
+  // picture before.
   static constexpr int kBandRows = 96;
-  static constexpr int kFieldBandRows = 10;  // field rows sampled per step
+  static constexpr int kFieldBandRows = 10;              // field rows sampled per step
+  static constexpr std::size_t kReadingsPerUnit = 8192;  // readings drawn per step
   void begin(const SnapshotFrame& frame);
   bool run_unit();
+  // The work of the last run_unit(), counted (not timed): every unit stays within its share
+  // (kMaxUnitPixels pixels written, kBandRows rows encoded, kFieldBandRows field rows), so
+  // none is much longer than another on any host: at most two panels' area (a panel's plot
+  // and a fill or marks over it) of the canvas's 920,576 pixels.
+  struct UnitWork {
+    std::uint64_t pixels_written = 0;
+    int rows_encoded = 0;
+    int field_rows = 0;
+  };
+  static constexpr std::uint64_t kMaxUnitPixels = std::uint64_t{2} * kPanelPx * kPanelPx;
+  [[nodiscard]] const UnitWork& last_unit_work() const { return unit_work_; }
   [[nodiscard]] bool busy() const { return stage_ != Stage::kIdle; }
   [[nodiscard]] bool ok() const { return ok_; }
   [[nodiscard]] const char* error() const { return error_; }
@@ -148,11 +162,13 @@ class SnapshotWriter {
  private:
   enum class Stage : std::uint8_t {
     kIdle,
+    kClear,
     kTitle,
     kReadings,
     kOccupancyField,
     kOccupancy,
     kNavigation,
+    kNavigationMarks,
     kValueField,
     kValue,
     kAxes,
@@ -176,6 +192,9 @@ class SnapshotWriter {
   char tmp_name_[56] = {};
   int next_row_ = 0;
   int field_row_ = 0;
+  int clear_row_ = 0;
+  std::size_t next_reading_ = 0;
+  UnitWork unit_work_{};
   void* png_ = nullptr;   // png_structp while encoding
   void* info_ = nullptr;  // png_infop
 
