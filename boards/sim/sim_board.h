@@ -45,6 +45,7 @@ class SimBoard final : public firmware::Board,
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
   hal::Hal& hal() override { return hal_; }
   const firmware::TruthSource* truth() const override { return this; }
+  firmware::HostClock* host_clock() override { return &host_clock_; }
   firmware::FaultInjection* fault_injection() override { return this; }
   // FaultInjection: the console's `fault DEVICE TYPE [SECONDS]`, into the world's injector.
   bool inject(std::string_view device, std::string_view type, double seconds,
@@ -76,6 +77,24 @@ class SimBoard final : public firmware::Board,
  private:
   static constexpr firmware::BoardInfo kInfo{"sim", "host simulation board", true};
 
+  // The POSIX clocks, less the simulator's own CPU work inside device calls (the camera's
+  // rendering, SimWorld::simulator_cpu_ns): the thread CPU time the executive sees is the
+  // firmware's. Wall time stays the host's: what a deadline on this host sees.
+  class SimHostClock final : public firmware::HostClock {
+   public:
+    explicit SimHostClock(const hal::sim::SimWorld& world) : world_(world) {}
+    std::uint64_t monotonic_ns() override { return host_.monotonic_ns(); }
+    std::uint64_t thread_cpu_ns() override {
+      const std::uint64_t cpu_ns = host_.thread_cpu_ns();
+      const std::uint64_t simulator_ns = world_.simulator_cpu_ns();
+      return cpu_ns > simulator_ns ? cpu_ns - simulator_ns : 0;
+    }
+
+   private:
+    firmware::PosixHostClock host_;
+    const hal::sim::SimWorld& world_;
+  };
+
   firmware::BoardConfig config_;
   SimSettings settings_;
   hal::sim::World world_;
@@ -90,6 +109,7 @@ class SimBoard final : public firmware::Board,
   hal::sim::BumperInputSim bumper_;
   hal::sim::LedOutputSim status_led_;
   hal::sim::ClockSim clock_;
+  SimHostClock host_clock_{sim_};
   hal::sim::WatchdogSim watchdog_;
   hal_linux::ConsolePort console_;
   hal::Hal hal_;

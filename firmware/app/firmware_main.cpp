@@ -12,6 +12,7 @@
 #include "firmware/app/device_tasks.h"
 #include "firmware/app/runtime.h"
 #include "firmware/executive/executive.h"
+#include "firmware/executive/host_timing_text.h"
 #include "firmware/common/log.h"
 #include "firmware/mission/mission.h"
 #include "firmware/telemetry/trace_writer.h"
@@ -226,7 +227,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   g_parameters = ParameterTable{};
   g_mission_task.reset();  // made on the last run's runtime: gone before it
   g_mission.reset();
-  g_runtime.emplace(hal, hal.console, g_store, g_parameters);
+  g_runtime.emplace(hal, hal.console, g_store, g_parameters, board.host_clock());
   Runtime& rt = *g_runtime;
   g_mission.emplace(mission::MissionContext{
       hal, config, rt.safety, rt.executive, g_state, store != nullptr ? &rt.saver : nullptr,
@@ -276,7 +277,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     console.set_parameter_saver(&rt.saver);
   }
 
-  if (config.realtime) {
+  if (config.realtime || options.realtime) {
     RealtimeConfig realtime;
     realtime.fifo_priority = config.fifo_priority;
     const RealtimeReport report = prepare_realtime(realtime);
@@ -297,6 +298,11 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   ExecutiveConfig exec_config;
   exec_config.frame_us = config.minor_frame_us;
   exec_config.background_units_per_slice = config.background_units_per_slice;
+  if (options.host_slices) {
+    // As on the robot: each slice ends by the clock (the host's), not after a count of units.
+    exec_config.slices_on_host_clock = true;
+    exec_config.background_units_per_slice = 0;
+  }
   if (!executive.start(exec_config, &why)) return fail("executive", why);
   const std::uint64_t start_us = hal.clock.now_us();
   mission.start(start_us);
@@ -376,6 +382,15 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       line.appendf(" %s=%.2f", mission::unit_name(unit), mission.longest_unit_s(unit) * 1e3);
     }
     console.log(LogLevel::kInfo, "%s", line.c_str());
+  }
+  {
+    // The executive's figures on the host's clocks (docs/console.md, `stats`): what the
+    // tasks, slices and frames took on this processor, whatever the board's clock says.
+    for (std::size_t i = 0; i < host_timing_line_count(executive); ++i) {
+      TextBuffer<256> line;
+      append_host_timing_line(line, executive, i);
+      console.log(LogLevel::kInfo, "%s", line.c_str());
+    }
   }
   for (int i = 0; i < 50 && console.pending_output() > 0 && console.healthy(); ++i) {
     console.drain();

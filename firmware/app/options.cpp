@@ -57,6 +57,10 @@ const char* usage_text() {
          "  --faults FILE       inject the faults planned in FILE (sim board only)\n"
          "  --speed X           simulated time per wall time: 1 = real time, 0 = as fast\n"
          "                      as possible (default; sim board only)\n"
+         "  --host-slices       end background slices by the host's clock, as on the robot,\n"
+         "                      not by a count of units (timing runs; sim board only)\n"
+         "  --realtime          lock memory and run SCHED_FIFO where permitted, as on the\n"
+         "                      robot (sim board only)\n"
          "  --seed N            random seed for the simulation and training (default 1)\n"
          "  --max-cycles N      stop after N Look-Think-Drive cycles (default: no limit)\n"
          "  --snapshots DIR     write a picture of the map after each cycle into DIR\n"
@@ -101,6 +105,12 @@ ParseResult parse_options(int argc, const char* const* argv, bool simulated, Opt
         return fail("option ", arg, " needs a number from 0 to 1000 (1 = real time)");
       }
       if (!simulated) return fail("option ", arg, " is only for the sim board");
+    } else if (std::strcmp(arg, "--host-slices") == 0) {
+      if (!simulated) return fail("option ", arg, " is only for the sim board");
+      out.host_slices = true;
+    } else if (std::strcmp(arg, "--realtime") == 0) {
+      if (!simulated) return fail("option ", arg, " is only for the sim board");
+      out.realtime = true;
     } else if (std::strcmp(arg, "--seed") == 0) {
       if (!value(v) || !parse_u64(v, out.seed))
         return fail("option ", arg, " needs a whole number");

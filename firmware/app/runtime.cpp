@@ -6,9 +6,9 @@
 namespace boticelli::firmware {
 
 Runtime::Runtime(hal::Hal& hal, hal::SerialPort& console_port, StateStore& store,
-                 ParameterTable& parameters)
+                 ParameterTable& parameters, HostClock* host)
     : saver(store),
-      executive(hal.clock),
+      executive(hal.clock, host != nullptr ? host : &host_clock),
       safety(hal.estop, hal.bumper, hal.base),
       estop_task(safety),
       base_task(hal.base, safety),

@@ -5,6 +5,8 @@
 #include <cstdarg>
 #include <cstring>
 
+#include "firmware/executive/host_timing_text.h"
+
 namespace boticelli::firmware {
 namespace {
 
@@ -321,7 +323,7 @@ void Console::cmd_stats(const Words& w) {
   reply_.appendf(
       "frame frame_us=%u frames=%llu overruns=%llu missed=%llu jitter_avg_us=%llu "
       "jitter_worst_us=%u\r\n"
-      "background util_pct=%.1f slices=%llu overruns=%llu done=%llu paused=%d\r\nOK\r\n",
+      "background util_pct=%.1f slices=%llu overruns=%llu done=%llu paused=%d\r\n",
       executive_.config().frame_us, static_cast<unsigned long long>(f.frames),
       static_cast<unsigned long long>(f.overruns), static_cast<unsigned long long>(f.missed_frames),
       static_cast<unsigned long long>(f.jitter_average_us()), f.jitter_worst_us,
@@ -329,6 +331,13 @@ void Console::cmd_stats(const Words& w) {
       static_cast<unsigned long long>(f.background_slices),
       static_cast<unsigned long long>(f.background_overruns),
       static_cast<unsigned long long>(f.background_done), executive_.background_paused() ? 1 : 0);
+  // The same work on the host's clocks, beside the board's (on the sim board the board's
+  // time stands still while the host computes).
+  for (std::size_t line = 0; line < host_timing_line_count(executive_); ++line) {
+    append_host_timing_line(reply_, executive_, line);
+    reply_.append(kEol);
+  }
+  reply_.append("OK\r\n");
   if (reply_.truncated()) return reply_error("stats reply too long");
   emit(reply_.view());
 }

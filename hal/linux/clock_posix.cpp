@@ -5,6 +5,16 @@
 #include <ctime>
 
 namespace boticelli::hal_linux {
+namespace {
+
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL +
+         static_cast<std::int64_t>(ts.tv_nsec);
+}
+
+}  // namespace
 
 std::uint64_t ClockPosix::now_us() {
   timespec ts{};
@@ -23,6 +33,7 @@ void ClockPosix::sleep_until_us(std::uint64_t deadline_us) {
   do {
     rc = ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
   } while (rc == EINTR);
+  last_wake_latency_ns_ = monotonic_ns() - static_cast<std::int64_t>(deadline_us) * 1000LL;
 }
 
 }  // namespace boticelli::hal_linux

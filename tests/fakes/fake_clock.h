@@ -28,12 +28,16 @@ class FakeClock final : public hal::Clock {
   std::uint64_t last_deadline_us() const { return last_deadline_us_; }
   // Current time without the auto-advance side effect.
   std::uint64_t peek_us() const { return now_us_; }
+  // What last_wake_latency_ns() reports (-1, the default: not a wall clock).
+  std::int64_t last_wake_latency_ns() const override { return wake_latency_ns_; }
+  void set_wake_latency_ns(std::int64_t ns) { wake_latency_ns_ = ns; }
 
  private:
   std::uint64_t now_us_;
   std::uint64_t auto_advance_us_ = 0;
   std::uint64_t sleep_calls_ = 0;
   std::uint64_t last_deadline_us_ = 0;
+  std::int64_t wake_latency_ns_ = -1;
 };
 
 }  // namespace boticelli::fakes

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "firmware/executive/host_clock.h"
 #include "hal/hal.h"
 
 namespace boticelli::test {
@@ -104,6 +105,21 @@ class FakeWatchdog final : public hal::Watchdog {
 }  // namespace boticelli::test
 
 namespace boticelli::test {
+
+// Manual host clocks for the executive's host timings: time moves only when a test (or the
+// work it times) says so; spend() moves the wall and the thread's CPU time together.
+class FakeHostClock final : public firmware::HostClock {
+ public:
+  std::uint64_t monotonic_ns() override { return wall_ns; }
+  std::uint64_t thread_cpu_ns() override { return cpu_ns; }
+  // Work that ran on the CPU for `cpu` and took `wall` (≥ cpu: preempted or blocked) [ns].
+  void spend(std::uint64_t wall, std::uint64_t cpu) {
+    wall_ns += wall;
+    cpu_ns += cpu;
+  }
+  std::uint64_t wall_ns = 7000000000ULL;
+  std::uint64_t cpu_ns = 3000000ULL;
+};
 
 // A camera that delivers a small grey frame every `every` polls.
 class FakeCamera final : public hal::Camera {

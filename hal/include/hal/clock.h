@@ -15,6 +15,11 @@ class Clock : private NonCopyable {
   // Waits until now_us() ≥ deadline_us (clock_nanosleep TIMER_ABSTIME on Linux; the sim
   // board advances simulated time to the deadline instead). Returns at once if past.
   virtual void sleep_until_us(std::uint64_t deadline_us) = 0;
+  // How late the last sleep_until_us() returned on the host's CLOCK_MONOTONIC [ns]: the
+  // actual minus the intended wake-up, as cyclictest measures it (a deadline already past
+  // counts how far past). -1 when that sleep did not wait on the host's clock (the sim
+  // board in lockstep, without --speed) or before the first sleep.
+  virtual std::int64_t last_wake_latency_ns() const { return -1; }
 };
 
 }  // namespace boticelli::hal

@@ -26,6 +26,7 @@ void ClockSim::set_speed(double speed) {
 }
 
 void ClockSim::sleep_until_us(std::uint64_t deadline_us) {
+  last_wake_latency_ns_ = -1;
   world_.advance_to(deadline_us);
   FaultType fault = FaultType::kOff;
   if (world_.faults().failing(FaultDevice::kMainLoop, fault)) {
@@ -50,11 +51,15 @@ void ClockSim::sleep_until_us(std::uint64_t deadline_us) {
   const double wall_ns = static_cast<double>(sim_us - anchor_sim_us_) * 1e3 / speed_;
   const std::uint64_t due_ns = anchor_wall_ns_ + static_cast<std::uint64_t>(wall_ns);
   if (now_ns > due_ns + kMaxLagNs) {
+    last_wake_latency_ns_ = static_cast<std::int64_t>(now_ns - due_ns);
     anchor_sim_us_ = sim_us;
     anchor_wall_ns_ = now_ns;
     return;
   }
-  if (due_ns <= now_ns) return;
+  if (due_ns <= now_ns) {
+    last_wake_latency_ns_ = static_cast<std::int64_t>(now_ns - due_ns);
+    return;
+  }
   timespec ts{};
   ts.tv_sec = static_cast<std::time_t>(due_ns / 1000000000U);
   ts.tv_nsec = static_cast<long>(due_ns % 1000000000U);
@@ -62,6 +67,8 @@ void ClockSim::sleep_until_us(std::uint64_t deadline_us) {
   // signal after the frame.
   while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
   }
+  last_wake_latency_ns_ =
+      static_cast<std::int64_t>(monotonic_ns()) - static_cast<std::int64_t>(due_ns);
 }
 
 }  // namespace boticelli::hal::sim

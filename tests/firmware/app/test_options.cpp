@@ -83,6 +83,25 @@ TEST(Options, TakesASpeedOnlyOnTheSimBoardAndOnlyFromZeroUp) {
   STRCMP_CONTAINS("sim board", r.error);
 }
 
+TEST(Options, TakesHostSlicesAndTheRobotsProcessSetUpOnlyOnTheSimBoard) {
+  CHECK_FALSE(options.host_slices);
+  CHECK_FALSE(options.realtime);
+  const char* argv[] = {"boticelli", "--host-slices", "--realtime"};
+  CHECK(parse_options(3, argv, true, options).ok);
+  CHECK(options.host_slices);
+  CHECK(options.realtime);
+  const char* one[] = {"boticelli", "--realtime"};
+  CHECK(parse_options(2, one, true, options).ok);
+  CHECK_FALSE(options.host_slices);
+  CHECK(options.realtime);
+  for (const char* option : {"--host-slices", "--realtime"}) {
+    const char* hardware[] = {"boticelli", option};
+    const ParseResult r = parse_options(2, hardware, false, options);
+    CHECK_FALSE_TEXT(r.ok, option);
+    STRCMP_CONTAINS("is only for the sim board", r.error);
+  }
+}
+
 TEST(Options, TakesAConfigFileAndRefusesAnEmptyOne) {
   const char* argv[] = {"boticelli", "--config", "/etc/robot2.conf"};
   CHECK(parse_options(3, argv, false, options).ok);

@@ -339,6 +339,40 @@ TEST(Console, ShowsExecutiveTimingPerTask) {
   STRCMP_CONTAINS("runs=0", command("stats").at(0).c_str());
 }
 
+TEST(Console, ShowsTheHostsTimingsBesideTheBoardsWhenTheExecutiveHasAHostClock) {
+  // A lockstep board clock: the board's figures stay 0, the host's show what the work took.
+  FakeHostClock host;
+  Executive timed{clock, &host};
+  class HostWork final : public Task {
+   public:
+    explicit HostWork(FakeHostClock& h) : host_(h) {}
+    void run(std::uint64_t) override { host_.spend(180000, 150000); }
+
+   private:
+    FakeHostClock& host_;
+  } work{host};
+  CHECK(timed.add_task({"estop", 10000, 200}, work, &error));
+  CHECK(timed.add_task({"camera", 20000, 2000}, idle, &error));
+  CHECK(timed.start(ExecutiveConfig{}, &error));
+  for (int i = 0; i < 10; ++i) timed.run_frame();
+  ParameterTable timed_parameters;
+  Console timed_console{port, timed, safety, view, timed_parameters};
+  timed_console.set_telemetry_ms(0.0F);
+  port.clear_written();
+  port.feed("stats\r");
+  for (int i = 0; i < 3; ++i) timed_console.service(now_us += 10000);
+  const auto reply = lines_of(port.written());
+  CHECK_EQUAL(9U, reply.size());
+  STRCMP_CONTAINS("task estop    period_us=10000 budget_us=200 runs=10 avg_us=0 worst_us=0",
+                  reply[0].c_str());
+  STRCMP_CONTAINS("host task estop    budget_us=200 runs=10 wall_avg_us=180.0", reply[4].c_str());
+  STRCMP_CONTAINS("cpu_worst_us=150.0", reply[4].c_str());
+  STRCMP_CONTAINS("host task camera   budget_us=2000 runs=5", reply[5].c_str());
+  STRCMP_CONTAINS("host background limit_us=9000 slices=0", reply[6].c_str());
+  STRCMP_CONTAINS("host frame frame_us=10000 frames=10 work_wall_p99_us=180.0", reply[7].c_str());
+  CHECK_EQUAL("OK", reply.back());
+}
+
 TEST(Console, SaysThereIsNoModelUntilTheMissionHasOne) {
   const auto reply = command("model");
   CHECK_EQUAL(1U, reply.size());

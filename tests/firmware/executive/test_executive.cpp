@@ -5,7 +5,9 @@
 
 #include "fake_clock.h"
 #include "firmware/app/device_tasks.h"
+#include "firmware/executive/duration_histogram.h"
 #include "firmware/executive/executive.h"
+#include "firmware/executive/host_timing_text.h"
 #include "firmware/telemetry/mission_view.h"
 #include "firmware/safety/safety.h"
 #include "firmware/executive/task_table.h"
@@ -328,6 +330,298 @@ TEST(Executive, RunsFramesWithoutAllocatingAfterStart) {
   start();
   CHECK_NO_ALLOCATION(frames(500));
   CHECK(work.jobs > 0);
+}
+
+namespace {
+
+// A task that takes no board time (the sim board's lockstep clock) but spends host time:
+// `wall_us`/`cpu_us` per run, `slow_wall_us`/`slow_cpu_us` on every `slow_every`-th run.
+class HostTimedTask final : public Task {
+ public:
+  HostTimedTask(FakeHostClock& host, std::uint64_t wall_us, std::uint64_t cpu_us)
+      : host_(host), wall_us_(wall_us), cpu_us_(cpu_us) {}
+  void run(std::uint64_t) override {
+    ++runs;
+    if (slow_every != 0 && runs % slow_every == 0) {
+      host_.spend(slow_wall_us * 1000U, slow_cpu_us * 1000U);
+    } else {
+      host_.spend(wall_us_ * 1000U, cpu_us_ * 1000U);
+    }
+  }
+  std::uint64_t runs = 0;
+  std::uint64_t slow_every = 0;
+  std::uint64_t slow_wall_us = 0;
+  std::uint64_t slow_cpu_us = 0;
+
+ private:
+  FakeHostClock& host_;
+  std::uint64_t wall_us_;
+  std::uint64_t cpu_us_;
+};
+
+// Background work whose units each spend `unit_us` of host time (wall and CPU) and no board
+// time; it never finishes.
+class HostTimedWork final : public BackgroundWork {
+ public:
+  HostTimedWork(FakeHostClock& host, std::uint64_t unit_us) : host_(host), unit_us_(unit_us) {}
+  SliceResult run_slice(SliceBudget& budget) override {
+    std::uint32_t units = 0;
+    while (budget.next_unit()) {
+      host_.spend(unit_us_ * 1000U, unit_us_ * 1000U);
+      ++units;
+    }
+    last_slice_units = units;
+    ++slices;
+    return SliceResult::kMore;
+  }
+  std::uint32_t last_slice_units = 0;
+  std::uint64_t slices = 0;
+
+ private:
+  FakeHostClock& host_;
+  std::uint64_t unit_us_;
+};
+
+}  // namespace
+
+TEST_GROUP(ExecutiveHostTiming) {
+  FakeClock clock{1000000};  // the board's: moves only in sleep_until_us (lockstep)
+  FakeHostClock host;
+  Executive exec{clock, &host};
+  const char* error = "";
+  ExecutiveConfig config;
+
+  void add(const TaskSpec& spec, Task& task) {
+    CHECK_TRUE_TEXT(exec.add_task(spec, task, &error), error);
+  }
+  void start() {
+    CHECK_TRUE_TEXT(exec.start(config, &error), error);
+  }
+  void frames(int n) {
+    for (int i = 0; i < n; ++i) exec.run_frame();
+  }
+};
+
+TEST(ExecutiveHostTiming, TimesEachTaskBodyOnTheHostWhileTheBoardsClockStandsStill) {
+  HostTimedTask fast(host, 40, 30);
+  HostTimedTask slow(host, 300, 120);
+  slow.slow_every = 10;  // one run in ten: 900 µs wall (preempted), 700 µs CPU
+  slow.slow_wall_us = 900;
+  slow.slow_cpu_us = 700;
+  add({"fast", 10000, 200}, fast);
+  add({"slow", 20000, 500}, slow);
+  start();
+  frames(400);
+  // The board's figures are true and empty: its time did not move while the tasks ran.
+  CHECK_EQUAL(0U, exec.task_stats(0).worst_us);
+  CHECK_EQUAL(0U, exec.task_stats(1).overruns);
+  const HostTiming& f = exec.host_task_timing(0);
+  CHECK_EQUAL(400U, f.wall.count());
+  CHECK_EQUAL(40000U, f.wall.max_ns());
+  CHECK_EQUAL(40000U, f.wall.average_ns());
+  CHECK_EQUAL(30000U, f.cpu.max_ns());
+  const HostTiming& s = exec.host_task_timing(1);
+  CHECK_EQUAL(200U, s.wall.count());
+  CHECK_EQUAL(900000U, s.wall.max_ns());
+  CHECK_EQUAL(700000U, s.cpu.max_ns());
+  CHECK_EQUAL((180U * 120000U + 20U * 700000U) / 200U, s.cpu.average_ns());
+  // 10% of the runs are slow: the 99th percentile is a slow run, the 50th a normal one
+  // (bucket edges: at most 1/32 above the value, never below).
+  CHECK(s.cpu.percentile_ns(990) >= 700000U && s.cpu.percentile_ns(990) <= 700000U);
+  CHECK(s.cpu.percentile_ns(500) >= 120000U && s.cpu.percentile_ns(500) <= 120000U * 33 / 32);
+  // A frame's work is its tasks and slice from its start: the worst frame ran both tasks.
+  CHECK_EQUAL(400U, exec.host_frame_stats().work.wall.count());
+  CHECK_EQUAL(940000U, exec.host_frame_stats().work.wall.max_ns());
+  CHECK_EQUAL(730000U, exec.host_frame_stats().work.cpu.max_ns());
+  exec.reset_stats();
+  CHECK_EQUAL(0U, exec.host_task_timing(1).wall.count());
+  CHECK_EQUAL(0U, exec.host_frame_stats().work.wall.count());
+}
+
+TEST(ExecutiveHostTiming, TimesBackgroundSlicesAndCountsThosePastTheirShareOfTheFrame) {
+  // Lockstep: 32 units per slice, as the sim board runs; each unit 400 µs of host time, so
+  // every slice takes 12.8 ms on the host, past the 9 ms the frame leaves it.
+  HostTimedTask t(host, 100, 100);
+  HostTimedWork work(host, 400);
+  add({"t", 10000, 500}, t);
+  exec.set_background(&work);
+  config.background_units_per_slice = 32;
+  start();
+  frames(20);
+  const HostFrameStats& f = exec.host_frame_stats();
+  CHECK_EQUAL(20U, f.slice.wall.count());
+  CHECK_EQUAL(32U * 400000U, f.slice.wall.max_ns());
+  CHECK_EQUAL(32U * 400000U, f.slice.cpu.max_ns());
+  CHECK_EQUAL(20U, f.slice_overruns);
+  CHECK_EQUAL((100U + 32U * 400U - 9000U) * 1000U, f.slice_overshoot_worst_ns);
+  CHECK_EQUAL(0U, exec.frame_stats().background_overruns);  // the board saw no time pass
+}
+
+TEST(ExecutiveHostTiming, EndsSlicesByTheHostsClockWhenToldSo) {
+  // As on the robot: no unit count, the slice ends when the host's clock reaches the frame's
+  // end minus the margin, counted from the frame's start on the host (the task's 1.5 ms too),
+  // and no unit is begun that would end after that, by the longest unit so far.
+  HostTimedTask t(host, 1500, 1500);
+  HostTimedWork work(host, 1000);
+  add({"t", 10000, 2000}, t);
+  exec.set_background(&work);
+  config.slices_on_host_clock = true;
+  config.background_margin_us = 1000;
+  start();
+  frames(5);
+  // 10 ms − 1 ms margin − 1.5 ms task = 7.5 ms: units of 1 ms start at 0, 1, … 6 ms into the
+  // slice; one at 7 ms would end 0.5 ms past its limit.
+  CHECK_EQUAL(7U, work.last_slice_units);
+  CHECK_EQUAL(5U, work.slices);
+  CHECK_EQUAL(0U, exec.host_frame_stats().slice_overruns);
+  CHECK_EQUAL(0U, exec.host_frame_stats().slice_overshoot_worst_ns);
+  // The longest-slice setting bounds it on the host clock too: 3 ms, two units.
+  exec.set_background_max_slice_us(3000);
+  frames(1);
+  CHECK_EQUAL(2U, work.last_slice_units);
+}
+
+TEST(ExecutiveHostTiming, AUnitLongerThanASliceOverrunsOnceAndStarvesNoLaterSlice) {
+  // One unit of 12 ms among units of 1 ms: the estimate is capped at half the slice, so the
+  // slices after it still get work (the first halves of their time).
+  class OneLongUnit final : public BackgroundWork {
+   public:
+    explicit OneLongUnit(FakeHostClock& h) : host_(h) {}
+    SliceResult run_slice(SliceBudget& budget) override {
+      last_units = 0;
+      while (budget.next_unit()) {
+        const std::uint64_t us = ++units == 3 ? 12000 : 1000;
+        host_.spend(us * 1000U, us * 1000U);
+        ++last_units;
+      }
+      return SliceResult::kMore;
+    }
+    std::uint32_t units = 0;
+    std::uint32_t last_units = 0;
+
+   private:
+    FakeHostClock& host_;
+  } work{host};
+  exec.set_background(&work);
+  config.slices_on_host_clock = true;
+  start();
+  frames(1);  // units 1 and 2 of 1 ms, then the 12 ms one
+  CHECK_EQUAL(3U, work.last_units);
+  CHECK_EQUAL(1U, exec.host_frame_stats().slice_overruns);
+  frames(1);  // 9 ms slice, estimate capped at 4.5 ms: units begun at 0 … 4 ms
+  CHECK_EQUAL(5U, work.last_units);
+  CHECK_EQUAL(1U, exec.host_frame_stats().slice_overruns);
+}
+
+TEST(ExecutiveHostTiming, RefusesSlicesOnTheHostsClockWithoutOne) {
+  Executive board_only(clock);
+  TimedTask t(clock, 0);
+  CHECK(board_only.add_task({"t", 10000, 500}, t, &error));
+  config.slices_on_host_clock = true;
+  CHECK_FALSE(board_only.start(config, &error));
+  STRCMP_CONTAINS("host clock", error);
+}
+
+TEST(ExecutiveHostTiming, KeepsTheFrameStartLatencyTheBoardsClockMeasured) {
+  HostTimedTask t(host, 10, 10);
+  add({"t", 10000, 500}, t);
+  start();
+  frames(10);  // lockstep: the clock did not wait on the host's, nothing to count
+  CHECK_EQUAL(0U, exec.host_frame_stats().start_latency.count());
+  clock.set_wake_latency_ns(12000);
+  frames(99);
+  clock.set_wake_latency_ns(480000);
+  frames(1);
+  const DurationHistogram& l = exec.host_frame_stats().start_latency;
+  CHECK_EQUAL(100U, l.count());
+  CHECK_EQUAL(480000U, l.max_ns());
+  CHECK(l.percentile_ns(990) >= 12000U && l.percentile_ns(990) <= 12000U * 33 / 32);
+  CHECK_EQUAL(480000U, l.percentile_ns(1000));
+}
+
+TEST(ExecutiveHostTiming, RunsFramesWithHostTimingWithoutAllocating) {
+  HostTimedTask a(host, 30, 20), b(host, 200, 150);
+  HostTimedWork work(host, 700);
+  add({"a", 10000, 500}, a);
+  add({"b", 20000, 1000}, b);
+  exec.set_background(&work);
+  config.slices_on_host_clock = true;
+  clock.set_wake_latency_ns(5000);
+  start();
+  CHECK_NO_ALLOCATION(frames(500));
+  CHECK(work.slices > 0);
+  CHECK_EQUAL(500U, exec.host_frame_stats().start_latency.count());
+}
+
+TEST(ExecutiveHostTiming, WritesOneLinePerTaskThenTheBackgroundAndTheFrames) {
+  HostTimedTask t(host, 250, 200);
+  HostTimedWork work(host, 1000);
+  add({"estop", 10000, 200}, t);
+  exec.set_background(&work);
+  config.background_units_per_slice = 2;
+  start();
+  frames(10);
+  CHECK_EQUAL(3U, host_timing_line_count(exec));
+  TextBuffer<512> line;
+  append_host_timing_line(line, exec, 0);
+  STRCMP_EQUAL(
+      "host task estop    budget_us=200 runs=10 wall_avg_us=250.0 wall_p99_us=250.0 "
+      "wall_worst_us=250.0 cpu_avg_us=200.0 cpu_p99_us=200.0 cpu_worst_us=200.0",
+      line.c_str());
+  line.clear();
+  append_host_timing_line(line, exec, 1);
+  STRCMP_EQUAL(
+      "host background limit_us=9000 slices=10 wall_p99_us=2000.0 wall_worst_us=2000.0 "
+      "cpu_p99_us=2000.0 cpu_worst_us=2000.0 over_limit=0 overshoot_worst_us=0.0 margin_us=1000",
+      line.c_str());
+  line.clear();
+  append_host_timing_line(line, exec, 2);
+  STRCMP_EQUAL(
+      "host frame frame_us=10000 frames=10 work_wall_p99_us=2250.0 work_wall_worst_us=2250.0 "
+      "work_cpu_p99_us=2200.0 work_cpu_worst_us=2200.0 latencies=0 start_latency_p99_us=0.0 "
+      "start_latency_worst_us=0.0",
+      line.c_str());
+  Executive board_only(clock);
+  CHECK_EQUAL(0U, host_timing_line_count(board_only));
+}
+
+TEST_GROUP(HostDurations){};
+
+TEST(HostDurations, KeepsShortDurationsExactlyAndLongOnesWithinAThirtySecondAbove) {
+  DurationHistogram h;
+  CHECK_EQUAL(0U, h.percentile_ns(990));
+  for (std::uint64_t ns = 0; ns < 64; ++ns) {
+    CHECK_EQUAL(ns, DurationHistogram::bucket_upper_ns(DurationHistogram::bucket(ns)));
+  }
+  // Every duration's bucket ends at or above it and at most 1/32 of it higher; buckets
+  // never go back.
+  std::size_t last = 0;
+  for (std::uint64_t ns = 64; ns < DurationHistogram::kMaxNs; ns += ns / 97 + 1) {
+    const std::size_t b = DurationHistogram::bucket(ns);
+    const std::uint64_t upper = DurationHistogram::bucket_upper_ns(b);
+    CHECK(b >= last);
+    CHECK(upper >= ns);
+    CHECK(upper - ns <= ns / 32);
+    last = b;
+  }
+  CHECK_EQUAL(DurationHistogram::kBuckets - 1, DurationHistogram::bucket(UINT64_MAX));
+}
+
+TEST(HostDurations, GivesPercentilesByRankNeverBelowTheTrueValueNorAboveTheWorst) {
+  DurationHistogram h;
+  for (std::uint64_t us = 1; us <= 1000; ++us) h.add(us * 1000U);  // 1 µs … 1 ms
+  CHECK_EQUAL(1000U, h.count());
+  CHECK_EQUAL(1000000U, h.max_ns());
+  CHECK_EQUAL(500500U, h.average_ns());
+  const std::uint64_t p99 = h.percentile_ns(990);  // the 990th smallest: 990 µs
+  CHECK(p99 >= 990000U && p99 <= 990000U + 990000U / 32);
+  const std::uint64_t p50 = h.percentile_ns(500);
+  CHECK(p50 >= 500000U && p50 <= 500000U + 500000U / 32);
+  CHECK_EQUAL(1000000U, h.percentile_ns(1000));  // the worst exactly
+  CHECK(h.percentile_ns(1) >= 1000U && h.percentile_ns(1) <= 1000U + 1000U / 32);
+  h.clear();
+  CHECK_EQUAL(0U, h.count());
+  CHECK_EQUAL(0U, h.percentile_ns(500));
 }
 
 TEST_GROUP(EstopInTheExecutive) {

@@ -8,6 +8,7 @@
 #include "firmware/app/config_file.h"
 #include "firmware/common/board_config.h"
 #include "firmware/console/fault_injection.h"
+#include "firmware/executive/host_clock.h"
 #include "firmware/app/options.h"
 #include "firmware/telemetry/truth_source.h"
 #include "hal/hal.h"
@@ -41,6 +42,9 @@ class Board {
   virtual hal::Hal& hal() = 0;
   // Ground truth, or nullptr (hardware).
   virtual const TruthSource* truth() const { return nullptr; }
+  // The host clocks the executive times work with, or nullptr: the POSIX clocks as they are.
+  // The sim board's leaves its own simulation work (rendering) out of the thread's CPU time.
+  virtual HostClock* host_clock() { return nullptr; }
   // The console's `fault` command, or nullptr (hardware: faults cannot be injected).
   virtual FaultInjection* fault_injection() { return nullptr; }
   // A resumed mission's saved pose, in the mission's frame (the robot's pose when the mission

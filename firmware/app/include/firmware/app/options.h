@@ -12,7 +12,9 @@ struct Options {
   const char* world_file = nullptr;   // --world FILE (sim board only)
   const char* faults_file = nullptr;  // --faults FILE: a fault plan (sim board only)
   double speed = 0.0;  // --speed X (sim board only): simulated/wall time, 0 = as fast as possible
-  std::uint64_t seed = 1;                     // --seed N
+  bool host_slices = false;  // --host-slices (sim board only): slices end by the host's clock
+  bool realtime = false;     // --realtime (sim board only): mlockall and SCHED_FIFO if permitted
+  std::uint64_t seed = 1;    // --seed N
   std::uint64_t max_cycles = 0;               // --max-cycles N; 0 = no limit
   const char* snapshots_dir = nullptr;        // --snapshots DIR
   const char* trace_file = nullptr;           // --trace FILE

@@ -11,6 +11,7 @@
 #include "firmware/console/console.h"
 #include "firmware/executive/executive.h"
 #include "firmware/executive/frame_consumer.h"
+#include "firmware/executive/host_clock.h"
 #include "firmware/safety/safety.h"
 #include "firmware/state/persistence.h"
 #include "firmware/state/state_saver.h"
@@ -33,9 +34,10 @@ class Runtime {
  public:
   // The parts bound to the devices; the mission is attached next (it needs the safety latch,
   // the executive and the saver made here). `console_port` is the console's line (the board's
-  // console, or a capture in tests).
+  // console, or a capture in tests). `host` times the executive's work (Board::host_clock);
+  // nullptr: the POSIX clocks (host_clock).
   Runtime(hal::Hal& hal, hal::SerialPort& console_port, StateStore& store,
-          ParameterTable& parameters);
+          ParameterTable& parameters, HostClock* host = nullptr);
   Runtime(const Runtime&) = delete;
   Runtime& operator=(const Runtime&) = delete;
 
@@ -46,6 +48,9 @@ class Runtime {
 
   ServiceNotifier notifier;
   StateSaver saver;
+  // What the executive times work with on every board (unless the board gives its own),
+  // beside the board's clock.
+  PosixHostClock host_clock;
   Executive executive;
   Safety safety;
   EstopTask estop_task;

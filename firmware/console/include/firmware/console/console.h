@@ -26,8 +26,8 @@ namespace boticelli::firmware {
 // Unsolicited lines start with "TLM " (telemetry) or "LOG " (log). Output lines end in CRLF.
 class Console {
  public:
-  static constexpr std::size_t kTxBytes = 8192;       // output ring
-  static constexpr std::size_t kReplyBytes = 2048;    // one command's reply
+  static constexpr std::size_t kTxBytes = 12288;      // output ring
+  static constexpr std::size_t kReplyBytes = 4096;    // one command's reply
   static constexpr std::size_t kReadChunkBytes = 64;  // bytes read per service() call
 
   Console(hal::SerialPort& port, Executive& executive, Safety& safety, MissionView& view,

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <span>
 
+#include "firmware/executive/duration_histogram.h"
+#include "firmware/executive/host_clock.h"
 #include "hal/clock.h"
 
 namespace boticelli::firmware {
@@ -35,28 +37,68 @@ class Task {
   Task& operator=(const Task&) = default;
 };
 
+// A slice ended by the host's clock (ExecutiveConfig::slices_on_host_clock): its deadline on
+// the monotonic clock, and the longest unit seen so far [ns of thread CPU], which the
+// executive keeps across slices. A unit is begun only when that long a unit would end before
+// the deadline; the estimate is capped at `longest_cap_ns` so that one unit longer than a
+// slice cannot starve the work.
+struct HostSlice {
+  HostClock* clock = nullptr;
+  std::uint64_t deadline_ns = 0;
+  std::uint64_t* longest_unit_ns = nullptr;
+  std::uint64_t longest_cap_ns = 0;
+};
+
 // What a background slice may use: the time until deadline_us on the executive's clock and
 // at most max_units units of work (0 = no unit limit). Work asks next_unit() before each
-// small, bounded unit of work and returns when it says no.
+// small, bounded unit of work and returns when it says no. With a HostSlice the deadline is
+// on the host's clock instead.
 class SliceBudget {
  public:
-  SliceBudget(hal::Clock& clock, std::uint64_t deadline_us, std::uint32_t max_units)
-      : clock_(&clock), deadline_us_(deadline_us), max_units_(max_units) {}
+  SliceBudget(hal::Clock& clock, std::uint64_t deadline_us, std::uint32_t max_units,
+              const HostSlice& host = {})
+      : clock_(&clock), host_(host), deadline_us_(deadline_us), max_units_(max_units) {}
   // True (and counts a unit) when another unit of work fits in the slice.
   bool next_unit() {
     if (max_units_ != 0 && units_ >= max_units_) return false;
-    if (clock_->now_us() >= deadline_us_) return false;
+    if (host_.clock != nullptr) {
+      const std::uint64_t cpu_ns = host_.clock->thread_cpu_ns();
+      end_unit(cpu_ns);
+      std::uint64_t expected_ns = host_.longest_unit_ns != nullptr ? *host_.longest_unit_ns : 0;
+      if (expected_ns > host_.longest_cap_ns) expected_ns = host_.longest_cap_ns;
+      if (host_.clock->monotonic_ns() + expected_ns >= host_.deadline_ns) return false;
+      unit_start_cpu_ns_ = cpu_ns;
+      in_unit_ = true;
+    } else if (clock_->now_us() >= deadline_us_) {
+      return false;
+    }
     ++units_;
     return true;
+  }
+  // The slice is over (the work returned): its last unit is measured (host slices only).
+  void end_slice() {
+    if (host_.clock != nullptr) end_unit(host_.clock->thread_cpu_ns());
   }
   std::uint64_t deadline_us() const { return deadline_us_; }
   std::uint32_t units_used() const { return units_; }
 
  private:
+  void end_unit(std::uint64_t cpu_ns) {
+    if (!in_unit_) return;
+    in_unit_ = false;
+    const std::uint64_t took_ns = cpu_ns > unit_start_cpu_ns_ ? cpu_ns - unit_start_cpu_ns_ : 0;
+    if (host_.longest_unit_ns != nullptr && took_ns > *host_.longest_unit_ns) {
+      *host_.longest_unit_ns = took_ns;
+    }
+  }
+
   hal::Clock* clock_;
+  HostSlice host_;
   std::uint64_t deadline_us_;
   std::uint32_t max_units_;
   std::uint32_t units_ = 0;
+  std::uint64_t unit_start_cpu_ns_ = 0;
+  bool in_unit_ = false;
 };
 
 enum class SliceResult : std::uint8_t {
@@ -110,6 +152,42 @@ struct FrameStats {
   }
 };
 
+// Durations of one kind of work on the host's clocks [ns] (Executive with a HostClock): what
+// the work took, whatever the board's clock says (on the sim board its time stands still
+// while the host computes).
+struct HostTiming {
+  DurationHistogram wall;  // monotonic: what a deadline sees (preemption and blocking included)
+  DurationHistogram cpu;   // the thread's CPU time: what an execution-time budget means
+  void clear() {
+    wall.clear();
+    cpu.clear();
+  }
+};
+
+// The frames and the background slot on the host's clocks.
+struct HostFrameStats {
+  HostTiming work;   // each frame's tasks and background slice, from its start to its end
+  HostTiming slice;  // each background slice
+  // Slices whose host wall time passed what their frame left them (the frame's end minus
+  // the margin, or the longest-slice setting): on a lockstep sim board a slice is bounded by
+  // units, not time, so these count how far the units overshoot on this host.
+  std::uint64_t slice_overruns = 0;
+  // The furthest a slice ran past that limit [ns]: a unit begun just before it ends after it,
+  // which the frame's margin is there to absorb (past the margin, the next frame starts late).
+  std::uint64_t slice_overshoot_worst_ns = 0;
+  // Frame start latency [ns] (hal::Clock::last_wake_latency_ns): how late the executive
+  // woke for each frame on the host's monotonic clock, as cyclictest measures; frames whose
+  // clock did not wait on the host (lockstep sim) are not counted.
+  DurationHistogram start_latency;
+  void clear() {
+    work.clear();
+    slice.clear();
+    slice_overruns = 0;
+    slice_overshoot_worst_ns = 0;
+    start_latency.clear();
+  }
+};
+
 struct ExecutiveConfig {
   std::uint32_t frame_us = 10000;                // minor frame
   std::uint32_t background_margin_us = 1000;     // left free before the next frame starts
@@ -118,18 +196,25 @@ struct ExecutiveConfig {
   std::uint32_t background_units_per_slice = 0;  // 0 = limited by time only
   std::uint32_t unhealthy_after_overruns =
       3;  // consecutive budget overruns that make a task unhealthy
+  // Background slices end by the host's monotonic clock (needs a HostClock): the frame's
+  // share measured from the frame's start on the host, as on a board whose clock is the
+  // host's, and no unit begun that the longest unit so far says would not end in time
+  // (HostSlice). For timing a sim board as the robot would run (its work per frame then
+  // depends on the host's speed); with background_units_per_slice 0.
+  bool slices_on_host_clock = false;
 };
 
 // Runs the tasks of a table in minor frames on a hal::Clock. Everything is set up by
 // add_task()/start(); run_frame() then never allocates. Tasks run in table order each frame
 // they are due (put the e-stop first); the background slot gets what is left of the frame
 // minus the margin. After a frame overrun the schedule is re-anchored at the overrun's end
-// (missed frames are skipped and counted, never run in a burst).
+// (missed frames are skipped and counted, never run in a burst). Statistics are kept on the
+// board's clock (the schedule's) and, given a HostClock, on the host's clocks too.
 class Executive {
  public:
   static constexpr std::size_t kMaxTasks = 12;
 
-  explicit Executive(hal::Clock& clock) : clock_(clock) {}
+  explicit Executive(hal::Clock& clock, HostClock* host = nullptr) : clock_(clock), host_(host) {}
   Executive(const Executive&) = delete;
   Executive& operator=(const Executive&) = delete;
 
@@ -163,6 +248,11 @@ class Executive {
   const TaskSpec& spec(std::size_t i) const { return entries_[i].spec; }
   const TaskStats& task_stats(std::size_t i) const { return entries_[i].stats; }
   const FrameStats& frame_stats() const { return frame_; }
+  // Host timings (all empty without a HostClock, but for the frame start latency, which the
+  // board's clock measures).
+  [[nodiscard]] bool host_timed() const { return host_ != nullptr; }
+  const HostTiming& host_task_timing(std::size_t i) const { return entries_[i].host; }
+  const HostFrameStats& host_frame_stats() const { return host_frame_; }
   const ExecutiveConfig& config() const { return config_; }
   // Index of the task with this name, or task_count() when there is none.
   std::size_t find(const char* name) const;
@@ -176,11 +266,23 @@ class Executive {
     std::uint64_t next_due_frame = 0;
     std::uint64_t last_run_us = 0;
     TaskStats stats;
+    HostTiming host;
   };
+  // A reading of the host's clocks [ns] (zeros without one).
+  struct HostMark {
+    std::uint64_t wall_ns = 0;
+    std::uint64_t cpu_ns = 0;
+  };
+  HostMark host_mark() const {
+    return host_ == nullptr ? HostMark{} : HostMark{host_->monotonic_ns(), host_->thread_cpu_ns()};
+  }
+  static void add_timing(HostTiming& timing, const HostMark& from, const HostMark& to);
 
-  void run_background(std::uint64_t now_us);
+  void run_background(std::uint64_t frame_start_us, std::uint64_t now_us,
+                      const HostMark& frame_start);
 
   hal::Clock& clock_;
+  HostClock* host_;
   ExecutiveConfig config_;
   std::array<Entry, kMaxTasks> entries_{};
   std::size_t count_ = 0;
@@ -189,9 +291,11 @@ class Executive {
   bool started_ = false;
   bool stop_requested_ = false;
   std::uint64_t frame_index_ = 0;
-  std::uint64_t next_start_us_ = 0;  // scheduled start of the frame to run next
-  std::uint64_t anchor_us_ = 0;      // start of the first frame (stats)
+  std::uint64_t next_start_us_ = 0;    // scheduled start of the frame to run next
+  std::uint64_t anchor_us_ = 0;        // start of the first frame (stats)
+  std::uint64_t longest_unit_ns_ = 0;  // host slices: the longest background unit [ns CPU]
   FrameStats frame_;
+  HostFrameStats host_frame_;
 };
 
 // For static_assert on a constexpr table: every period a positive multiple of the frame,

@@ -13,6 +13,10 @@ class ClockPosix final : public hal::Clock {
   std::uint64_t now_us() override;
   // Absolute sleep on CLOCK_MONOTONIC; resumes after a signal (EINTR) until the deadline.
   void sleep_until_us(std::uint64_t deadline_us) override;
+  std::int64_t last_wake_latency_ns() const override { return last_wake_latency_ns_; }
+
+ private:
+  std::int64_t last_wake_latency_ns_ = -1;
 };
 
 }  // namespace boticelli::hal_linux

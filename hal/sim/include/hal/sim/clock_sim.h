@@ -19,6 +19,9 @@ class ClockSim final : public Clock {
   // the executive stalls for the fault's whole duration once (time runs on, nothing of the
   // firmware runs), slow = every sleep ends 12 ms late (every frame overruns).
   void sleep_until_us(std::uint64_t deadline_us) override;
+  // With a speed: how late the wall clock woke for the simulated deadline (-1 in lockstep
+  // without a speed, and at the first paced sleep, which only anchors the pacing).
+  std::int64_t last_wake_latency_ns() const override { return last_wake_latency_ns_; }
   // Simulated seconds per wall second: 1 = real time, 0 = as fast as possible (the default).
   void set_speed(double speed);
   double speed() const { return speed_; }
@@ -31,6 +34,7 @@ class ClockSim final : public Clock {
   bool anchored_ = false;
   std::uint64_t anchor_sim_us_ = 0;   // simulated time at the anchor
   std::uint64_t anchor_wall_ns_ = 0;  // CLOCK_MONOTONIC at the anchor
+  std::int64_t last_wake_latency_ns_ = -1;
 };
 
 }  // namespace boticelli::hal::sim

@@ -129,6 +129,13 @@ class SimWorld {
   void watchdog_stop() { watchdog_armed_ = false; }
   std::uint32_t watchdog_expirations() const { return watchdog_expirations_; }
 
+  // ---- the simulator's own work ----
+  // Host CPU time [ns] the simulator spent on the board's behalf inside device calls the
+  // firmware times (the camera's ray-casting): the board's host clock leaves it out, so the
+  // firmware's CPU figures are its own work.
+  void add_simulator_cpu_ns(std::uint64_t ns) { simulator_cpu_ns_ += ns; }
+  std::uint64_t simulator_cpu_ns() const { return simulator_cpu_ns_; }
+
  private:
   void step(std::uint32_t dt_us);
   void step_axis(PtuAxis& axis, float dt_s) const;
@@ -176,6 +183,7 @@ class SimWorld {
   FaultInjector faults_;
   // Why the base cannot leave kStopped now (an axis or CAN fault is active), or nullptr.
   const char* base_fault() const;
+  std::uint64_t simulator_cpu_ns_ = 0;
 };
 
 }  // namespace boticelli::hal::sim
