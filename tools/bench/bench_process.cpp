@@ -1,6 +1,7 @@
 // Helpers for suites that run the firmware binary (see bench_process.h).
 #include "bench_process.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -27,6 +28,19 @@ std::string read_file(const std::string& path) {
     std::fclose(f);
   }
   return text;
+}
+
+void remove_tree(const std::string& dir) {
+  if (DIR* d = ::opendir(dir.c_str()); d != nullptr) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n == "." || n == "..") continue;
+      const std::string p = std::string(dir).append("/").append(n);
+      if (::unlink(p.c_str()) != 0) remove_tree(p);
+    }
+    ::closedir(d);
+  }
+  ::rmdir(dir.c_str());
 }
 
 // The directory of this executable (the firmware is built next to it: build/<preset>/bin).

@@ -8,6 +8,9 @@ namespace boticelli::bench {
 
 // The whole file ("" when it cannot be read).
 std::string read_file(const std::string& path);
+// Removes a directory with everything in it (a run's outputs: its files, its state and
+// snapshot directories).
+void remove_tree(const std::string& dir);
 // The directory of this executable (the firmware is built next to it: build/<preset>/bin).
 std::string own_directory();
 // Monotonic wall time [s].

@@ -1,5 +1,4 @@
 // Benchmark suite "mission": the firmware binary run on every shipped world, checked against it.
-#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -172,21 +171,6 @@ std::size_t grid_bytes(const hal::sim::World& w) {
 }
 
 hal::sim::World g_world;
-
-// Removes a directory with its files and its subdirectories' files (two levels: the run's
-// directory and its state directory).
-void remove_tree(const std::string& dir) {
-  if (DIR* d = ::opendir(dir.c_str()); d != nullptr) {
-    while (const dirent* e = ::readdir(d)) {
-      const std::string n = e->d_name;
-      if (n == "." || n == "..") continue;
-      const std::string p = std::string(dir).append("/").append(n);
-      if (::unlink(p.c_str()) != 0) remove_tree(p);
-    }
-    ::closedir(d);
-  }
-  ::rmdir(dir.c_str());
-}
 
 int run() {
   const std::string bin_dir = own_directory();
