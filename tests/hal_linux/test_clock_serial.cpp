@@ -77,6 +77,20 @@ TEST(ClockPosix, ReturnsAtOnceForAPastDeadline) {
   CHECK(c.now_us() - start < 1000000U);  // generous: no wait of the missed second
 }
 
+TEST(ClockPosix, ReportsHowLateEachSleepWokeOnTheMonotonicClock) {
+  ClockPosix c;
+  CHECK_EQUAL(-1, c.last_wake_latency_ns());  // no sleep yet
+  const std::uint64_t deadline = c.now_us() + 2000;
+  c.sleep_until_us(deadline);
+  const std::int64_t late_ns = c.last_wake_latency_ns();
+  CHECK(late_ns >= 0);
+  // Never more than the time between the deadline and now (both on CLOCK_MONOTONIC).
+  CHECK(late_ns <= static_cast<std::int64_t>(c.now_us() - deadline + 1) * 1000);
+  // A deadline a second past: that second is how late the frame started.
+  c.sleep_until_us(c.now_us() - 1000000);
+  CHECK(c.last_wake_latency_ns() >= 1000000000LL);
+}
+
 TEST(ClockPosix, ReadingTheTimeDoesNotAllocate) {
   ClockPosix c;
   std::uint64_t t = 0;

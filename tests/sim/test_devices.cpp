@@ -352,12 +352,18 @@ TEST(SimDevices, TheCameraDeliversFramesAtItsRateFromTheCurrentPose) {
   CHECK(camera.init());
   camera.set_depth_enabled(true);
   UNSIGNED_LONGS_EQUAL(160, camera.width_px());
+  // Rendering is the simulator's work: its CPU time is booked (the board's host clock leaves it
+  // out of the firmware's figures); a poll without a new frame renders nothing.
+  std::uint64_t booked_ns = g_sim.simulator_cpu_ns();
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kFrame);
+  CHECK(g_sim.simulator_cpu_ns() > booked_ns);
   UNSIGNED_LONGS_EQUAL(0, frame.sequence);
   UNSIGNED_LONGS_EQUAL(320, frame.stride_bytes);
   std::vector<std::uint8_t> first(frame.data, frame.data + 320 * 120);
   camera.release();
+  booked_ns = g_sim.simulator_cpu_ns();
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kNoFrame);
+  CHECK_EQUAL(booked_ns, g_sim.simulator_cpu_ns());
   clock.sleep_until_us(20000);
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kNoFrame);
   clock.sleep_until_us(33333);
@@ -444,4 +450,23 @@ TEST(SimDevices, TheClockKeepsPaceWithWallTimeAtTheSpeedAskedAndRacesWithoutOne)
   const double took_s = wall_s() - t0;
   DOUBLES_EQUAL(0.2, took_s, 0.05);
   CHECK_EQUAL(sim_us, clock.now_us());
+}
+
+TEST(SimDevices, TheClockReportsHowLateItWokeOnlyWhenItWaitedForTheWallClock) {
+  start("rectangular_room");
+  ClockSim clock(g_sim);
+  CHECK_EQUAL(-1, clock.last_wake_latency_ns());
+  std::uint64_t sim_us = clock.now_us();
+  clock.sleep_until_us(sim_us += 10000);
+  CHECK_EQUAL(-1, clock.last_wake_latency_ns());  // lockstep: no wall clock waited on
+  clock.set_speed(10.0);
+  clock.sleep_until_us(sim_us += 10000);
+  CHECK_EQUAL(-1, clock.last_wake_latency_ns());  // the first paced sleep only anchors
+  for (int i = 0; i < 5; ++i) {
+    clock.sleep_until_us(sim_us += 10000);  // 1 ms of wall time each
+    CHECK(clock.last_wake_latency_ns() >= 0);
+  }
+  clock.set_speed(0.0);
+  clock.sleep_until_us(sim_us += 10000);
+  CHECK_EQUAL(-1, clock.last_wake_latency_ns());
 }
