@@ -86,6 +86,7 @@ inline firmware::BoardConfig make_config() {
   // service restarts before the board resets (docs/flashing.md, "Watchdogs"). The range a
   // configuration may set: that chain (8 s) plus 2 s to spare, up to the most the BCM2711's
   // watchdog counts (bcm2835_wdt: 15 s). test_service_unit checks the bottom against the unit.
+  c.device_retry_s = 30.0F;  // the unit's start limit assumes it (test_service_unit)
   c.watchdog_enabled = true;
   c.watchdog_timeout_ms = 12000;
   c.watchdog_min_timeout_ms = 10000;

@@ -39,6 +39,7 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::baud("console", "baud", c.console_baud)) &&
          s.add(
              ConfigKey::whole("console", "telemetry_period_ms", c.telemetry_period_ms, 0, 60000)) &&
+         s.add(ConfigKey::number("faults", "retry_s", c.device_retry_s, 1.0, 600.0)) &&
          s.add(ConfigKey::flag_key("watchdog", "enabled", c.watchdog_enabled)) &&
          s.add(watchdog_timeout) &&
          s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner));

@@ -105,9 +105,44 @@ const char* led_pattern_name(LedPattern pattern) {
   return "?";
 }
 
-void WatchdogTask::run(std::uint64_t) {
+void BaseTask::run(std::uint64_t now_us) {
+  base_.update();
+  if (base_.health() != hal::BaseHealth::kStopped || safety_.holds()) {
+    retry_at_us_ = 0;  // running, starting, or the operator's to restart
+    return;
+  }
+  if (retry_at_us_ == 0) {
+    retry_at_us_ = now_us + kRetryIntervalUs;  // the first try a second after the stop
+    return;
+  }
+  if (now_us < retry_at_us_) return;
+  // Refused while the fault lasts (a lost heartbeat, bus-off); else the start-up sequence runs
+  // and the base is ready again with no velocity commanded.
+  (void)base_.resume();
+  ++retries_;
+  retry_at_us_ = now_us + kRetryIntervalUs;
+}
+
+void WatchdogTask::run(std::uint64_t now_us) {
   const bool healthy = executive_.all_healthy();
-  if (healthy) {
+  // A device fault is held and retried for the retry time, then given up on (the firmware
+  // exits and systemd restarts it with --resume); only a hang withholds the watchdog before.
+  for (std::size_t i = 0; i < executive_.task_count() && i < unhealthy_since_us_.size(); ++i) {
+    const char* why = executive_.task_health(i);
+    std::uint64_t& since = unhealthy_since_us_[i];
+    if (why == nullptr) {
+      since = 0;
+      continue;
+    }
+    if (since == 0) since = now_us != 0 ? now_us : 1;
+    if (!gave_up_ && now_us - since >= retry_us_) {
+      gave_up_ = true;
+      give_up_reason_.clear();
+      give_up_reason_.appendf("%s unhealthy for %.0f s: %s", executive_.spec(i).name,
+                              static_cast<double>(now_us - since) * 1e-6, why);
+    }
+  }
+  if (executive_.all_running() && !gave_up_) {
     watchdog_.kick();
     notifier_.watchdog();
     ++kicks_;

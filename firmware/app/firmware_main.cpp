@@ -3,6 +3,7 @@
 #include "firmware/app/firmware_main.h"
 
 #include <csignal>
+#include <cstdint>
 #include <optional>
 #include <cstdio>
 #include <ctime>
@@ -311,6 +312,11 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   // robot stopped (console, status, LED) until it is stopped; with --max-cycles there is
   // nothing to run, so it ends at once.
   const bool ended_before = mission.ended_before_start();
+  // The fault policy's give-up (a device unhealthy past its retry time) is for a running
+  // mission: an ended one has nothing a restart would carry on.
+  rt.watchdog_task.set_retry_us(
+      ended_before ? UINT64_MAX
+                   : static_cast<std::uint64_t>(static_cast<double>(config.device_retry_s) * 1e6));
   if (ended_before) {
     console.log(LogLevel::kWarn, "mission already ended (%s: %s): not resumed, robot stopped",
                 mission::result_name(mission.result()), mission.end_reason());
@@ -319,6 +325,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   if (hooks != nullptr && hooks->loop_started != nullptr) hooks->loop_started(hooks->context);
 
   const char* stop_reason = "";
+  TextBuffer<224> gave_up_reason;
   for (;;) {
     executive.set_background_max_slice_us(static_cast<std::uint32_t>(background_slice_us));
     executive.run_frame();
@@ -329,6 +336,13 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     }
     if (console.shutdown_requested()) {
       stop_reason = "console shutdown";
+      break;
+    }
+    if (rt.watchdog_task.gave_up()) {
+      // A device unhealthy for longer than its retry time: a restart re-opens everything.
+      gave_up_reason.clear();
+      gave_up_reason.appendf("gave up: %s", rt.watchdog_task.give_up_reason());
+      stop_reason = gave_up_reason.c_str();
       break;
     }
     if (ended_before) {
@@ -407,6 +421,12 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   }
   const double sim_time_s = static_cast<double>(hal.clock.now_us() - start_us) * 1e-6;
   const mission::Result result = mission.result();
+  // A device given up on: the code the service unit restarts on (with --resume).
+  const bool restart = rt.watchdog_task.gave_up() || mission.gave_up_on_device();
+  if (restart) {
+    slog.log(LogLevel::kError, "%s: exiting for a restart (--resume carries the mission on)",
+             mission.end_reason());
+  }
   // The reason last, quoted (it has spaces): why the mission ended, with the device's words
   // when a device ended it ("base stopped by itself: base: left axis: heartbeat lost ...").
   TextBuffer<160> reason;
@@ -424,6 +444,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   g_mission.reset();
   g_runtime.reset();
   g_signal = 0;
+  if (restart) return kExitFailure;
   return result == mission::Result::kFound ? kExitFound : kExitNotFound;
 }
 

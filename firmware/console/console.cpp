@@ -700,7 +700,10 @@ void Console::check_executive(std::uint64_t now_us) {
     logged.clear();
     logged.append(why);
     logged_at_us_[i] = now_us;
-    log(LogLevel::kError, "%s unhealthy: %s (watchdog not kicked)", executive_.spec(i).name, why);
+    // A hang (overrunning, starved) withholds the watchdog; a device fault is held and retried
+    // (the fault policy) until the retry time runs out.
+    log(LogLevel::kError, "%s unhealthy: %s (%s)", executive_.spec(i).name, why,
+        executive_.running_health(i) != nullptr ? "watchdog not kicked" : "held and retried");
   }
 }
 

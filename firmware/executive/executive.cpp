@@ -199,12 +199,24 @@ bool Executive::all_healthy() const {
   return true;
 }
 
+bool Executive::all_running() const {
+  for (std::size_t i = 0; i < count_; ++i) {
+    if (running_health(i) != nullptr) return false;
+  }
+  return true;
+}
+
 const char* Executive::task_health(std::size_t i) const {
   const Entry& e = entries_[i];
   if (!e.task->healthy()) {
     const char* why = e.task->health_reason();
     return why[0] != '\0' ? why : "unhealthy";
   }
+  return running_health(i);
+}
+
+const char* Executive::running_health(std::size_t i) const {
+  const Entry& e = entries_[i];
   if (e.stats.consecutive_overruns >= config_.unhealthy_after_overruns) {
     return "overrunning its budget";
   }

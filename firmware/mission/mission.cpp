@@ -126,6 +126,9 @@ void Mission::start(std::uint64_t now_us) {
   phase_ = Phase::kStart;
   result_ = Result::kRunning;
   end_reason_.clear();
+  device_hold_ = false;
+  device_trouble_since_us_ = 0;
+  gave_up_on_device_ = false;
   ended_before_start_ = state_.finished();
   if (ended_before_start_) {
     // A mission that ended for good is not carried on: it stays ended, the base stopped.
@@ -217,13 +220,27 @@ void Mission::finish(Result result, const char* why, Ending ending) {
   if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
 }
 
-void Mission::abort_with(const char* why, const char* device_error) {
-  if (device_error == nullptr || device_error[0] == '\0') {
-    return finish(Result::kAborted, why, Ending::kResumable);
+void Mission::hold_for_device(const char* why, const char* device_error, std::uint64_t now_us) {
+  device_reason_.clear();
+  device_reason_.append(why);
+  if (device_error != nullptr && device_error[0] != '\0')
+    device_reason_.appendf(": %s", device_error);
+  if (device_trouble_since_us_ == 0) {
+    device_trouble_since_us_ = now_us != 0 ? now_us : 1;
+    frames_at_trouble_ = scan_.frames_grabbed();
+    TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
+    line.appendf("held: %s", device_reason_.c_str());
+    state_.add_log(state_.cycle, line.view());
   }
-  TextBuffer<160> text;
-  text.appendf("%s: %s", why, device_error);
-  finish(Result::kAborted, text.c_str(), Ending::kResumable);
+  device_hold_ = true;
+  device_retry_at_us_ = now_us + params_.device_retry_interval_us;
+  if (phase_ != Phase::kHold) {
+    held_phase_ = phase_;
+    phase_ = Phase::kHold;
+  }
+  scan_.stop_frames();
+  if (driver_.busy()) driver_.abort("held");
+  hal_.base.set_velocity(0.0F, 0.0F);
 }
 
 // ---------------------------------------------------------------- control (mission task)
@@ -241,6 +258,14 @@ void Mission::control(std::uint64_t now_us) {
     hal_.base.set_velocity(0.0F, 0.0F);
     return;
   }
+  if (device_trouble_since_us_ != 0 && scan_.frames_grabbed() != frames_at_trouble_) {
+    // A frame again: the PTU reached its view and the camera delivered; the base was ready.
+    TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
+    line.appendf("devices back after %.1f s",
+                 static_cast<double>(now_us - device_trouble_since_us_) * 1e-6);
+    state_.add_log(state_.cycle, line.view());
+    device_trouble_since_us_ = 0;
+  }
   if (safety_.engaged() && safety_.cause() == StopCause::kBumper) {
     // The robot touched something its map did not hold: the operator looks before another
     // mission; a restart does not carry this one on.
@@ -256,7 +281,7 @@ void Mission::control(std::uint64_t now_us) {
   switch (phase_) {
     case Phase::kStart: {
       const hal::PanTiltState ptu = hal_.pan_tilt.state();
-      if (ptu.fault) return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
+      if (ptu.fault) return hold_for_device("pan-tilt unit fault", hal_.pan_tilt.error(), now_us);
       if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) {
         pose_.anchor(state_.pose);  // the odometry as the base reports it once ready
         begin_look(now_us);
@@ -286,6 +311,23 @@ void Mission::control_hold(std::uint64_t now_us) {
   if (driver_.busy()) {
     const hal::Odometry o = hal_.base.odometry();
     (void)driver_.update(pose_.pose(), o.v_m_s, o.omega_rad_s, now_us);
+  }
+  if (device_hold_) {
+    // The device retry time without a frame since the fault began: give up (the firmware
+    // exits for a restart, which re-opens every device; the state keeps the mission running).
+    if (now_us - device_trouble_since_us_ >= params_.device_retry_us) {
+      TextBuffer<MissionLogEntry::kMaxTextBytes + 1> why;
+      why.appendf("gave up after %.0f s: %s",
+                  static_cast<double>(now_us - device_trouble_since_us_) * 1e-6,
+                  device_reason_.c_str());
+      gave_up_on_device_ = true;
+      return finish(Result::kAborted, why.c_str(), Ending::kResumable);
+    }
+    // Try again once a retry interval has passed and the devices report no fault (the PTU's
+    // and the camera's drivers re-open by themselves; the base task restarts the base).
+    if (now_us < device_retry_at_us_ || hal_.pan_tilt.state().fault) return;
+    if (hal_.base.health() != hal::BaseHealth::kReady) return;
+    device_hold_ = false;
   }
   // Latched, or reset and waiting for the console's `resume`: only the operator ends it (a
   // released button or a line that comes back does not).
@@ -343,13 +385,13 @@ void Mission::control_look(std::uint64_t now_us) {
       phase_ = Phase::kThink;
       return;
     case ScanEvent::kPtuFault:
-      return abort_with("pan-tilt unit fault", hal_.pan_tilt.error());
+      return hold_for_device("pan-tilt unit fault", hal_.pan_tilt.error(), now_us);
     case ScanEvent::kPtuRefused:
-      return abort_with("pan-tilt unit refused a move", hal_.pan_tilt.error());
+      return hold_for_device("pan-tilt unit refused a move", hal_.pan_tilt.error(), now_us);
     case ScanEvent::kPtuTimeout:
-      return finish(Result::kAborted, "pan-tilt move did not complete", Ending::kResumable);
+      return hold_for_device("pan-tilt move did not complete", nullptr, now_us);
     case ScanEvent::kNoFrame:
-      return abort_with("no camera frame", hal_.camera.error());
+      return hold_for_device("no camera frame", hal_.camera.error(), now_us);
   }
 }
 
@@ -375,7 +417,7 @@ void Mission::control_drive(std::uint64_t now_us) {
   const DriveCommand cmd = driver_.update(pose_.pose(), o.v_m_s, o.omega_rad_s, now_us);
   hal_.base.set_velocity(cmd.v_m_s, cmd.omega_rad_s);
   if (hal_.base.health() == hal::BaseHealth::kStopped && !safety_.engaged()) {
-    return abort_with("base stopped by itself", hal_.base.error());
+    return hold_for_device("base stopped by itself", hal_.base.error(), now_us);
   }
   if (driver_.busy()) return;
   const bool ok = driver_.status() == DriveStatus::kDone;

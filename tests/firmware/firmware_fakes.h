@@ -57,6 +57,7 @@ class FakeBase final : public hal::Base {
     omega_rad_s = 0.0F;
   }
   bool resume() override {
+    ++resume_calls;
     if (refuse_resume) return false;
     health_ = hal::BaseHealth::kReady;
     return true;
@@ -70,6 +71,7 @@ class FakeBase final : public hal::Base {
   int updates = 0;
   int stops = 0;
   bool refuse_resume = false;
+  int resume_calls = 0;
   std::uint64_t stopped_at_us = 0;
   hal::BaseHealth health_ = hal::BaseHealth::kReady;
 
@@ -82,6 +84,7 @@ class FakePanTilt final : public hal::PanTilt {
   bool init() override { return true; }
   void update() override { ++updates; }
   bool move_to(float pan, float tilt) override {
+    if (refuse_moves) return false;
     state_value.pan_rad = pan;
     state_value.tilt_rad = tilt;
     return true;
@@ -90,6 +93,7 @@ class FakePanTilt final : public hal::PanTilt {
   hal::PanTiltState state() const override { return state_value; }
   hal::PanTiltLimits limits() const override { return {}; }
   hal::PanTiltState state_value;
+  bool refuse_moves = false;
   int updates = 0;
   int halts = 0;
 };

@@ -121,16 +121,19 @@ FAULT_PAIR_MORE(APtuAnsweringErrorsRefusesMovesButStaysHealthy, kPtu, kWrong)
 FAULT_PAIR_MORE(ASlowPtuKeepsMoving, kPtu, kSlow)
 FAULT_PAIR_MORE(ADelayedPtuKeepsMoving, kPtu, kDelayed)
 FAULT_PAIR_MORE(APtuWithIntermittentlyGarbledRepliesIsReported, kPtu, kIntermittent)
-FAULT_PAIR(TheLeftAxisLosingItsHeartbeatStopsTheBaseWithinAFrame, kAxisLeft, kOff)
-FAULT_PAIR_MORE(AnErrorOfTheLeftAxisStopsTheBaseWithinAFrame, kAxisLeft, kWrong)
-FAULT_PAIR_MORE(TheLeftAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kAxisLeft,
+FAULT_PAIR(TheLeftAxisLosingItsHeartbeatStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kAxisLeft,
+           kOff)
+FAULT_PAIR_MORE(AnErrorOfTheLeftAxisStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kAxisLeft,
+                kWrong)
+FAULT_PAIR_MORE(TheLeftAxisHeartbeatComingAndGoingStopsTheBaseInEveryGap, kAxisLeft, kIntermittent)
+FAULT_PAIR_MORE(TheRightAxisLosingItsHeartbeatStopsTheBaseWithinAFrameAndTheRetryRestartsIt,
+                kAxisRight, kOff)
+FAULT_PAIR_MORE(AnErrorOfTheRightAxisStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kAxisRight,
+                kWrong)
+FAULT_PAIR_MORE(TheRightAxisHeartbeatComingAndGoingStopsTheBaseInEveryGap, kAxisRight,
                 kIntermittent)
-FAULT_PAIR_MORE(TheRightAxisLosingItsHeartbeatStopsTheBaseWithinAFrame, kAxisRight, kOff)
-FAULT_PAIR_MORE(AnErrorOfTheRightAxisStopsTheBaseWithinAFrame, kAxisRight, kWrong)
-FAULT_PAIR_MORE(TheRightAxisHeartbeatComingAndGoingStopsTheBaseAtTheFirstGap, kAxisRight,
-                kIntermittent)
-FAULT_PAIR_MORE(ACanBusOffStopsTheBaseWithinAFrame, kCan, kOff)
-FAULT_PAIR_MORE(ACanBusGoingOffNowAndThenStopsTheBaseAtTheFirstTime, kCan, kIntermittent)
+FAULT_PAIR_MORE(ACanBusOffStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kCan, kOff)
+FAULT_PAIR_MORE(ACanBusGoingOffNowAndThenStopsTheBaseEachTime, kCan, kIntermittent)
 FAULT_PAIR_MORE(ABrokenEstopLineStopsTheBaseUntilClearEstopAndResumeAfterItIsBack, kEstop, kOff)
 FAULT_PAIR_MORE(AStuckEstopStopsTheBaseUntilClearEstopAndResumeAfterTheRelease, kEstop, kStuck)
 FAULT_PAIR_MORE(AChatteringEstopStopsTheBaseUntilClearEstopAndResumeAfterItIsQuiet, kEstop,
@@ -142,7 +145,8 @@ FAULT_PAIR_MORE(AnUnwritableStateDirectoryIsReportedAndTheLastGoodFileStays, kSt
 FAULT_PAIR(AFullStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kWrong)
 FAULT_PAIR_MORE(StateSavesFailingNowAndThenAreReportedAndTheLastGoodFileStays, kStorage,
                 kIntermittent)
-FAULT_PAIR_MORE(AStalledMainLoopIsCaughtByTheOdrivesWatchdogWithinItsTimeout, kMainLoop, kStuck)
+FAULT_PAIR_MORE(AStalledMainLoopIsCaughtByTheOdrivesWatchdogAndTheBaseRestartedAfter, kMainLoop,
+                kStuck)
 FAULT_PAIR_MORE(ASlowMainLoopOverrunsItsFramesAndKeepsTheBaseUnderControl, kMainLoop, kSlow)
 
 TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {

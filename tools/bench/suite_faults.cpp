@@ -51,6 +51,9 @@ struct MissionOutcome {
   std::string resume_seen;
   bool held_until_reset = false;
   bool held_until_resume = false;
+  // The mission log's hold for a device and its end (Mission::hold_for_device), if any.
+  std::string held;
+  std::string back;
 };
 
 // The MISSION line's fields: result=WORD ... reason="TEXT".
@@ -106,6 +109,13 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
   char error[256] = "";
   m.state_loadable = g_store.open(dir, error, sizeof error) &&
                      g_store.load(g_state, error, sizeof error) == firmware::LoadResult::kLoaded;
+  if (m.state_loadable) {
+    for (const firmware::MissionLogEntry& e : g_state.log) {
+      const std::string text(e.view());
+      if (m.held.empty() && text.rfind("held: ", 0) == 0) m.held = text;
+      if (m.back.empty() && text.rfind("devices back after ", 0) == 0) m.back = text;
+    }
+  }
   for (const char* name :
        {"plan.txt", "out.txt", "err.txt", "mission.state.a", "mission.state.b"}) {
     ::unlink((std::string(dir) + "/" + name).c_str());
@@ -124,8 +134,8 @@ std::string cell(std::string text) {
 }
 
 std::string expected_text(const FaultExpectation& e) {
-  std::string s =
-      e.stops_base ? "base stopped within a frame, stays stopped; " : "base keeps moving; ";
+  std::string s = e.stops_base ? "base stopped within a frame, stays stopped while it fails; "
+                               : "base keeps moving; ";
   s += "console: `" + std::string(e.console_says) + "`; ";
   if (e.operator_reset) {
     char buf[200];
@@ -136,6 +146,7 @@ std::string expected_text(const FaultExpectation& e) {
                   static_cast<double>(boards::sim::kResetToResumeUs) * 1e-6);
     s += buf;
   }
+  if (e.recovers && e.stops_base && !e.operator_reset) s += "restarted by the base task's retry: ";
   s += e.recovers ? "healthy and moving again" : "stays stopped (no restart by itself)";
   if (e.recovers && !e.operator_reset) s += " after it";
   return s;
@@ -246,7 +257,8 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
       // (the stand-in's run checks the simulator's own count, which stays 0).
       const bool contacts_ok = m.collisions == 0 || device == FaultDevice::kBumper;
       const bool reset_ok = !e.operator_reset || (m.held_until_reset && m.held_until_resume);
-      const bool mission_ok = m.ran && contacts_ok && m.state_loadable && reset_ok &&
+      const bool holds_ok = !e.mission_holds || (!m.held.empty() && !m.back.empty());
+      const bool mission_ok = m.ran && contacts_ok && m.state_loadable && reset_ok && holds_ok &&
                               (m.result == "aborted") == e.mission_aborts;
       const bool ok = ran && g_result.passed && mission_ok;
       passed += ok ? 1 : 0;
@@ -267,6 +279,8 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
           .flag("mission_state_loadable", m.state_loadable)
           .text("mission_clear_estop_after", m.reset_seen.c_str())
           .text("mission_resume_after", m.resume_seen.c_str())
+          .text("mission_held", m.held.c_str())
+          .text("mission_back", m.back.c_str())
           .num("mission_cpu_s", m.cpu_s)
           .flag("passed", ok)
           .emit();
@@ -281,6 +295,7 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
                                                        ": the faulted bumper's contacts)"
                                                  : ", COLLISIONS=" + std::to_string(m.collisions)) +
                (m.state_loadable ? "" : ", state file NOT loadable") +
+               (m.held.empty() ? "" : "; mission log: `" + m.held + "`, `" + m.back + "`") +
                (!e.operator_reset ? ""
                 : m.reset_seen.empty()
                     ? "; clear-estop NOT typed (no telemetry line for it)"

@@ -23,12 +23,13 @@ struct FaultExpectation {
   bool stops_base = false;
   // Console text naming the device and why (a LOG line, or the reply to `status`).
   const char* console_says = "";
-  // After the fault: every task and the storage healthy again, the stand-in moving again.
-  // False where the firmware does not restart on its own (a base that stopped by itself,
-  // the bumper: the mission ends aborted).
+  // After the fault: every task and the storage healthy again, the stand-in moving again (a
+  // base that stopped by itself restarted by the base task's retry). False where the
+  // firmware does not restart on its own (the bumper: the mission ends aborted for good).
   bool recovers = true;
   // What the whole mission does with the fault for kMissionFaultS in its first look (the
-  // bench's mission column), and whether it then ends aborted (else it carries on).
+  // bench's mission column), and whether it then ends aborted (else it carries on: device
+  // faults are held and retried, docs/reliability.md "Fault policy").
   const char* mission = "";
   bool mission_aborts = false;
   // Latched (the e-stop): after the fault the stand-in stays stopped until the operator's
@@ -37,6 +38,9 @@ struct FaultExpectation {
   // whole mission likewise waits for both (the bench types them, kMissionResetAfterS after the
   // fault's end).
   bool operator_reset = false;
+  // The whole mission holds for the device and carries on when it is back: its log says
+  // `held: ...` and `devices back after ...` (the fault policy).
+  bool mission_holds = false;
 };
 inline constexpr std::uint64_t kResetToResumeUs = 500000;
 // The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the

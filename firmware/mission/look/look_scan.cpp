@@ -59,6 +59,7 @@ ScanEvent LookScan::control(std::uint64_t now_us, hal::PanTilt& ptu) {
     case Step::kGrab:
       if (!frame_ready_) return now_us > deadline_us_ ? ScanEvent::kNoFrame : ScanEvent::kBusy;
       want_frame_ = false;
+      ++frames_grabbed_;
       if (!second_frame_) {
         pair_pose_.pan_rad = state.pan_rad;
         pair_pose_.first_tilt_rad = state.tilt_rad;

@@ -119,6 +119,8 @@ TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
       {"[base]\ncan_interface = \"can 0\"", "base.can_interface may hold only letters"},
       {"[gpio]\nestop_active_low = 1", "gpio.estop_active_low must be true or false"},
       {"[gpio]\nled_line = 58", "gpio.led_line = 58 is out of range (0 to 57)"},
+      {"[faults]\nretry_s = 0.5", "faults.retry_s = 0.5 is out of range (1 to 600)"},
+      {"[faults]\nretry_s = 601", "faults.retry_s = 601 is out of range (1 to 600)"},
       {"[lidar]", "unknown table 'lidar'"},
       {"[[camera]]", ""},  // a redefinition: a syntax error from the TOML library
       {"width_px = 640\nwidth_px = 800", ""},  // a duplicate key: the library refuses it too

@@ -178,7 +178,7 @@ TEST(FirmwareLoop, AnUnhealthyTaskIsLoggedWithItsNameAndReasonAndShownInStatusAn
   rig.port.feed("status\rstats\r");
   CHECK_NO_ALLOCATION(rig.frames(5));
   const std::string out = rig.port.written();
-  STRCMP_CONTAINS("LOG error base unhealthy: stopped by itself (watchdog not kicked)", out.c_str());
+  STRCMP_CONTAINS("LOG error base unhealthy: stopped by itself (held and retried)", out.c_str());
   STRCMP_CONTAINS("healthy=0 unhealthy=base watchdog=", out.c_str());
   STRCMP_CONTAINS("overruns=0 healthy=0 why=\"stopped by itself\"", out.c_str());
   STRCMP_CONTAINS("task ptu      period_us=20000 budget_us=500 runs=", out.c_str());

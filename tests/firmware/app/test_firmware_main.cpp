@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -45,6 +46,41 @@ class NullWatchdog final : public boticelli::hal::Watchdog {
   std::uint32_t started_ms = 0;
 };
 
+// A camera whose frames are of no use (2x2, no time stamp: the look never takes one) until
+// `good_after_us` of board time, then frames of the configured 160x120 size, time-stamped.
+class TestCamera final : public boticelli::hal::Camera {
+ public:
+  explicit TestCamera(boticelli::hal::Clock& clock) : clock_(clock) {}
+  bool init() override { return !fail_init; }
+  boticelli::hal::CameraPoll poll(boticelli::hal::Frame& frame) override {
+    if (++polls % 3 != 0) return boticelli::hal::CameraPoll::kNoFrame;
+    const bool good = good_after_us != 0 && clock_.now_us() >= good_after_us;
+    frame.data = kGood.data();
+    frame.width_px = good ? 160 : 2;
+    frame.height_px = good ? 120 : 2;
+    frame.stride_bytes = frame.width_px * 2;
+    frame.timestamp_us = good ? clock_.now_us() : 0;
+    frame.sequence = sequence++;
+    return boticelli::hal::CameraPoll::kFrame;
+  }
+  void release() override {}
+  std::uint32_t width_px() const override { return 160; }
+  std::uint32_t height_px() const override { return 120; }
+  const char* error() const override { return fail_init ? "no such device" : ""; }
+  bool fail_init = false;
+  std::uint64_t good_after_us = 0;  // 0: never
+
+ private:
+  static inline const std::array<std::uint8_t, 160 * 120 * 2> kGood = [] {
+    std::array<std::uint8_t, 160 * 120 * 2> a{};
+    a.fill(128);
+    return a;
+  }();
+  boticelli::hal::Clock& clock_;
+  int polls = 0;
+  std::uint32_t sequence = 0;
+};
+
 // Everything fake; the clock moves only in sleep_until_us (lockstep, like the sim board).
 class FakeBoard final : public Board {
  public:
@@ -71,7 +107,7 @@ class FakeBoard final : public Board {
   BoardConfig config_{};
   boticelli::fakes::FakeClock clock{1000};
   boticelli::fakes::FakeSerialPort console;
-  FakeCamera camera;
+  TestCamera camera{clock};
   FakePanTilt ptu;
   FakeBase base{&clock};
   FakeInput estop, bumper;
@@ -167,16 +203,84 @@ TEST_GROUP(FirmwareMain) {
   }
 };
 
-// The fake board's camera never delivers a frame of the configured size, so the mission's
-// first look ends in a camera fault after its frame timeout (3 s of board time).
-TEST(FirmwareMain, EndsAbortedOnACameraFaultAndPrintsTheMissionLineLast) {
+// The fake board's camera never delivers a frame of the configured size: the camera task is
+// unhealthy after 2 s and the mission's look holds after its frame timeout (3 s), trying
+// again every second; 30 s (the device retry time) after the camera turned unhealthy the
+// firmware gives up and exits with the code the service unit restarts on.
+TEST(FirmwareMain, GivesUpOnACameraThatNeverDeliversAfterTheRetryTimeAndExitsForARestart) {
   const Run r = run_firmware({"--max-cycles", "3"});
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS("boticelli 0.1.0 board=fake (test board)", r.out.c_str());
   const std::string line = last_line(r.out);
-  STRCMP_CONTAINS("MISSION result=aborted cycles=0 collisions=0 sim_time_s=3.", line.c_str());
+  STRCMP_CONTAINS("MISSION result=aborted cycles=0 collisions=0 sim_time_s=32.", line.c_str());
   STRCMP_CONTAINS("wall_time_s=", line.c_str());
   STRCMP_CONTAINS("target_error_m=nan", line.c_str());
+  STRCMP_CONTAINS(
+      "reason=\"gave up: camera unhealthy for 30 s: no new frame for 2.0 s: frames of the "
+      "wrong size\"",
+      line.c_str());
+  STRCMP_CONTAINS(
+      "boticelli: gave up: camera unhealthy for 30 s: no new frame for 2.0 s: frames "
+      "of the wrong size: exiting for a restart (--resume carries the mission on)",
+      r.err.c_str());
+}
+
+// A device whose task stays healthy but that the mission cannot use (a PTU that answers every
+// move with an error) is held and retried by the mission itself, which gives up after the
+// retry time: the same exit for a restart.
+TEST(FirmwareMain, TheMissionGivesUpOnAPtuThatRefusesEveryMoveAfterTheRetryTime) {
+  const Run r = run_firmware({}, [](FakeBoard& b) {
+    b.config_.camera_width_px = 160;
+    b.config_.camera_height_px = 120;
+    b.camera.good_after_us = 1;
+    b.ptu.refuse_moves = true;
+  });
+  CHECK_EQUAL(kExitFailure, r.exit_code);
+  const std::string line = last_line(r.out);
+  STRCMP_CONTAINS("MISSION result=aborted cycles=0 collisions=0 sim_time_s=30.", line.c_str());
+  STRCMP_CONTAINS("reason=\"gave up after 30 s: pan-tilt unit refused a move\"", line.c_str());
+  STRCMP_CONTAINS("exiting for a restart", r.err.c_str());
+}
+
+namespace {
+struct SigtermAt {
+  boticelli::hal::Clock* clock = nullptr;
+  std::uint64_t at_us = 0;
+};
+void sigterm_at(void* context) {
+  auto* s = static_cast<SigtermAt*>(context);
+  if (s->at_us != 0 && s->clock->now_us() >= s->at_us) {
+    s->at_us = 0;
+    std::raise(SIGTERM);
+  }
+}
+}  // namespace
+
+// Shorter than the retry time, a fault is ridden out: a camera that delivers again after 10 s
+// of holds and retries lets the look go on, and 45 s in nothing has been given up.
+TEST(FirmwareMain, ACameraBackWithinTheRetryTimeLetsTheLookGoOnWithNothingGivenUp) {
+  static SigtermAt stop;
+  static MainHooks hooks;
+  hooks.after_frame = sigterm_at;
+  hooks.context = &stop;
+  const Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.config_.camera_width_px = 160;
+    b.config_.camera_height_px = 120;
+    b.camera.good_after_us = 10000000;
+    stop = SigtermAt{&b.clock, 45000000};
+    b.hooks = &hooks;
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);  // stopped by the signal, not a give-up (1)
+  STRCMP_CONTAINS("reason=\"SIGTERM\"", last_line(r.out).c_str());
+  CHECK(r.err.find("gave up") == std::string::npos);
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(state.log.size() >= 2U);
+  STRCMP_CONTAINS("held: no camera frame", std::string(state.log[0].view()).c_str());
+  STRCMP_CONTAINS("devices back after ", std::string(state.log[1].view()).c_str());
 }
 
 TEST(FirmwareMain, ExitsWithTheUsageCodeOnABadOption) {
@@ -211,15 +315,15 @@ TEST(FirmwareMain, StopsOnTheConsolesQuitCommandAfterAnsweringOnTheConsole) {
 }
 
 TEST(FirmwareMain, RunsAgainInTheSameProcess) {
-  CHECK_EQUAL(kExitNotFound, run_firmware({"--max-cycles", "2"}).exit_code);
+  CHECK_EQUAL(kExitFailure, run_firmware({"--max-cycles", "2"}).exit_code);
   const Run r = run_firmware({"--max-cycles", "1"});
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS("MISSION result=aborted cycles=0 ", last_line(r.out).c_str());
 }
 
 TEST(FirmwareMain, SavesEachCycleAndResumesFromTheStateDirectory) {
   Run r = run_firmware({"--max-cycles", "4", "--state", dir.c_str(), "--seed", "9"});
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   static MissionState state;  // large: static storage
   static StateStore store;
   char error[256] = "";
@@ -227,23 +331,25 @@ TEST(FirmwareMain, SavesEachCycleAndResumesFromTheStateDirectory) {
   CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
   CHECK_EQUAL(0U, state.cycle);  // the look never finished (camera fault) ...
   CHECK_EQUAL(9U, state.seed);
-  CHECK_EQUAL(1U, state.log.size());  // ... and the end was saved with its reason
-  STRCMP_CONTAINS("mission aborted: no camera frame", std::string(state.log[0].view()).c_str());
+  CHECK_EQUAL(2U, state.log.size());  // ... the hold and the end were saved with their reasons
+  STRCMP_CONTAINS("held: no camera frame", std::string(state.log[0].view()).c_str());
+  STRCMP_CONTAINS("mission aborted: gave up: camera unhealthy for 30 s",
+                  std::string(state.log[1].view()).c_str());
   // A device fault ends this run only: the state keeps the mission running for --resume.
   CHECK(state.end == MissionEnd::kRunning);
 
   r = run_firmware({"--max-cycles", "2", "--state", dir.c_str(), "--resume"});
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS("resumed from", r.err.c_str());
   STRCMP_CONTAINS("MISSION result=aborted cycles=0", last_line(r.out).c_str());
   CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
   CHECK_EQUAL(9U, state.seed);  // the mission's seed survives the resume
-  CHECK_EQUAL(2U, state.log.size());
+  CHECK_EQUAL(4U, state.log.size());
 }
 
 TEST(FirmwareMain, StartsANewMissionWhenThereIsNothingToResume) {
   const Run r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS("starting a new mission", r.err.c_str());
   STRCMP_CONTAINS("MISSION result=aborted cycles=0", last_line(r.out).c_str());
 }
@@ -416,6 +522,29 @@ TEST(FirmwareMain, TheWatchdogIsOffOnlyByItsKeyEveryStartWarnsOfItAndStatusShows
                   r.err.c_str());
 }
 
+// A base that stopped by itself is restarted by the base task every second (the fault
+// policy); one that refuses every restart is given up on after the retry time: the firmware
+// exits with the code the service unit restarts on, the mission kept running in the state.
+TEST(FirmwareMain, ABaseThatCannotBeRestartedIsRetriedEverySecondThenGivenUpForARestart) {
+  int resumes = 0;
+  const Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.base.stop();
+    b.base.refuse_resume = true;
+    b.after_run = [&](FakeBoard& done) { resumes = done.base.resume_calls; };
+  });
+  CHECK_EQUAL(kExitFailure, r.exit_code);
+  STRCMP_CONTAINS("reason=\"gave up: base unhealthy for 30 s: stopped by itself\"",
+                  last_line(r.out).c_str());
+  STRCMP_CONTAINS("exiting for a restart", r.err.c_str());
+  CHECK(resumes >= 28 && resumes <= 31);
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(state.end == MissionEnd::kRunning);
+}
+
 namespace {
 void press_bumper_at_frame_50(void* context) {
   auto* f = static_cast<FramesThenSignal*>(context);
@@ -456,7 +585,7 @@ TEST(FirmwareMain, ADamagedNewestStateCopyIsPassedOverWithAWarningAndTheOlderOne
   std::fputc('#', f);
   std::fclose(f);
   const Run r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS(("boticelli: state copy damaged: " + dir +
                    "/mission.state.b: checksum mismatch (corrupt file); loaded " + dir +
                    "/mission.state.a (sequence 1) instead")
@@ -502,7 +631,7 @@ TEST(FirmwareMain, OutputToAClosedPipeDoesNotKillItAndTheMissionEndsWithItsSave)
   CHECK_TEXT(status != -1, "the child did not end (fork under an emulator?)");
   CHECK_FALSE_TEXT(WIFSIGNALED(status) && WTERMSIG(status) == SIGPIPE, "killed by SIGPIPE");
   CHECK(WIFEXITED(status));
-  CHECK_EQUAL(kExitNotFound, WEXITSTATUS(status));
+  CHECK_EQUAL(kExitFailure, WEXITSTATUS(status));
   // The orderly end ran: the state was saved with the mission's end in its log.
   static MissionState state;
   static StateStore store;
@@ -510,7 +639,7 @@ TEST(FirmwareMain, OutputToAClosedPipeDoesNotKillItAndTheMissionEndsWithItsSave)
   CHECK(store.open(dir.c_str(), error, sizeof error));
   CHECK_TRUE_TEXT(store.load(state, error, sizeof error) == LoadResult::kLoaded, error);
   CHECK_EQUAL(4U, state.seed);
-  CHECK_EQUAL(1U, state.log.size());
+  CHECK_EQUAL(2U, state.log.size());
 }
 #endif  // BOTICELLI_TESTS_UNDER_EMULATOR
 
@@ -683,7 +812,7 @@ void write_text(const std::string& path, const char* text) {
 TEST(FirmwareMain, AMissingFileAtTheDefaultPathIsFineButAMissingConfigFileIsAnError) {
   Run r = run_firmware({"--max-cycles", "1"},
                        [](FakeBoard& b) { b.default_config = "/nonexistent/boticelli.conf"; });
-  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK_EQUAL(kExitFailure, r.exit_code);
   STRCMP_CONTAINS("no /nonexistent/boticelli.conf: compiled-in defaults", r.err.c_str());
   r = run_firmware({"--config", "/nonexistent/other.conf"});
   CHECK_EQUAL(kExitUsage, r.exit_code);

@@ -13,8 +13,9 @@
 
 namespace {
 
-// The [Service] keys of the shipped unit (the last value of a key repeated wins, as in systemd).
-std::map<std::string, std::string> service_keys() {
+// The keys of one section of the shipped unit (the last value of a key repeated wins, as in
+// systemd).
+std::map<std::string, std::string> section_keys(const std::string& section) {
   std::map<std::string, std::string> keys;
   FILE* f = std::fopen(BOTICELLI_SOURCE_DIR "/boards/rpi4/packaging/boticelli.service", "r");
   if (f == nullptr) return keys;
@@ -25,7 +26,7 @@ std::map<std::string, std::string> service_keys() {
     while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
     if (s.empty() || s[0] == '#') continue;
     if (s[0] == '[') {
-      in_service = s == "[Service]";
+      in_service = s == section;
       continue;
     }
     const std::size_t eq = s.find('=');
@@ -33,6 +34,9 @@ std::map<std::string, std::string> service_keys() {
   }
   std::fclose(f);
   return keys;
+}
+std::map<std::string, std::string> service_keys() {
+  return section_keys("[Service]");
 }
 
 // A systemd time span as the unit writes them: "2s", "500ms", "1.5s" or bare seconds [s].
@@ -66,6 +70,34 @@ TEST(ServiceUnit, DoesNotRestartOnTheExitCodesARestartCannotMendButDoesOnAFailur
   CHECK(has_word(prevent, boticelli::firmware::kExitNotFound));
   CHECK_FALSE(has_word(prevent, boticelli::firmware::kExitFailure));
   STRCMP_EQUAL("on-failure", keys.at("Restart").c_str());
+}
+
+// The fault policy's end (docs/reliability.md): a device given up on after its retry time
+// exits kExitFailure, which the unit restarts; a fault that persists through restarts must end
+// the service, so the start limit must be reachable by such restarts: StartLimitBurst of them
+// (retry time + RestartSec + start-up each) fit in StartLimitIntervalSec.
+TEST(ServiceUnit, ADeviceGivenUpOnIsRestartedAndOneThatPersistsThroughRestartsEndsTheService) {
+  constexpr double kStartS = 3.0;
+  const auto keys = service_keys();
+  const auto unit = section_keys("[Unit]");
+  CHECK_TEXT(unit.count("StartLimitIntervalSec") == 1 && unit.count("StartLimitBurst") == 1,
+             "no StartLimitIntervalSec / StartLimitBurst in [Unit]");
+  if (unit.count("StartLimitIntervalSec") == 0 || unit.count("StartLimitBurst") == 0) return;
+  CHECK_FALSE(has_word(keys.at("RestartPreventExitStatus"), boticelli::firmware::kExitFailure));
+  STRCMP_EQUAL("on-failure", keys.at("Restart").c_str());
+  const double interval_s = seconds(unit.at("StartLimitIntervalSec"));
+  const int burst = std::atoi(unit.at("StartLimitBurst").c_str());
+  const double retry_s = static_cast<double>(boticelli::boards::rpi4::make_config().device_retry_s);
+  const double one_s = retry_s + seconds(keys.at("RestartSec")) + kStartS;
+  CHECK(burst >= 2);
+  if (static_cast<double>(burst) * one_s > interval_s) {
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  "%d restarts of %.0f s each do not fit StartLimitIntervalSec %.0f s: a device "
+                  "that never comes back is restarted for ever",
+                  burst, one_s, interval_s);
+    FAIL(why);
+  }
 }
 
 // The chain after the firmware hangs (docs/flashing.md, "Watchdogs"): the last WATCHDOG=1 and

@@ -1,6 +1,7 @@
 // Device tasks: the executive's fixed-rate tasks that service the HAL devices (see task_table.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "firmware/console/console.h"
@@ -25,11 +26,16 @@ class EstopTask final : public Task {
 };
 
 // Services the base; unhealthy when it stopped by itself (fault, lost link), not by the e-stop
-// latch (engaged, or reset and waiting for `resume`).
+// latch (engaged, or reset and waiting for `resume`). A base that stopped by itself is tried
+// again (Base::resume, the drivers' start-up sequence) every retry interval while the latch
+// does not hold it: the fault policy (docs/reliability.md) holds the robot stopped and
+// retries the device; only the mission commands motion after that, and it looks first.
 class BaseTask final : public Task {
  public:
+  static constexpr std::uint64_t kRetryIntervalUs = 1000000;
   BaseTask(hal::Base& base, const Safety& safety) : base_(base), safety_(safety) {}
-  void run(std::uint64_t) override { base_.update(); }
+  void run(std::uint64_t now_us) override;
+  std::uint64_t retries() const { return retries_; }
   bool healthy() const override {
     return base_.health() != hal::BaseHealth::kStopped || safety_.holds();
   }
@@ -41,6 +47,8 @@ class BaseTask final : public Task {
  private:
   hal::Base& base_;
   const Safety& safety_;
+  std::uint64_t retry_at_us_ = 0;  // 0: not stopped by itself
+  std::uint64_t retries_ = 0;
 };
 
 // Services the PTU; unhealthy while the unit reports a fault, or while a move has not
@@ -138,7 +146,10 @@ constexpr std::uint16_t led_pattern_bits(LedPattern pattern) {
 }
 const char* led_pattern_name(LedPattern pattern);
 
-// Kicks /dev/watchdog and sends WATCHDOG=1 to systemd only while every task is healthy;
+// Kicks /dev/watchdog and sends WATCHDOG=1 to systemd while the executive runs (no task
+// overrunning or starved: a hang) and no task has been unhealthy for longer than the device
+// retry time; a device fault within that time is the fault policy's to hold and retry, not a
+// hang. Past it the task gives up (gave_up(): the firmware exits for a restart);
 // drives the status LED with the pattern of the robot's condition; once a second, when it
 // changed, reports the state to systemd as "STATUS=state=... cycle=N healthy=0|1 estop=...
 // target=..." (what `systemctl status` shows). Runs every 100 ms (kTaskTable).
@@ -153,6 +164,12 @@ class WatchdogTask final : public Task {
     view_ = view;
   }
   void run(std::uint64_t now_us) override;
+  // How long a task may stay unhealthy before the firmware gives up on it [µs].
+  void set_retry_us(std::uint64_t us) { retry_us_ = us; }
+  // A task was unhealthy for longer than the retry time; give_up_reason() says which and why
+  // ("camera unhealthy for 30 s: no new frame ..."). Stays set.
+  bool gave_up() const { return gave_up_; }
+  const char* give_up_reason() const { return give_up_reason_.c_str(); }
   std::uint64_t kicks() const { return kicks_; }
   std::uint64_t withheld() const { return withheld_; }
   LedPattern pattern() const { return pattern_; }
@@ -177,6 +194,10 @@ class WatchdogTask final : public Task {
   TextBuffer<160> status_;
   std::uint64_t kicks_ = 0;
   std::uint64_t withheld_ = 0;
+  std::uint64_t retry_us_ = 30000000;
+  std::array<std::uint64_t, Executive::kMaxTasks> unhealthy_since_us_{};  // 0: healthy
+  bool gave_up_ = false;
+  TextBuffer<200> give_up_reason_;
 };
 
 }  // namespace boticelli::firmware

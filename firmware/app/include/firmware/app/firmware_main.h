@@ -5,8 +5,10 @@
 
 namespace boticelli::firmware {
 
-// Exit codes: 0 the target was found (or --help/--version), 1 a failure (board, device or
-// state directory could not be set up: a restart may help), 2 a usage error, a bad
+// Exit codes: 0 the target was found (or --help/--version), 1 a failure a restart may cure
+// (board, device or state directory could not be set up, or a device fault outlasted its
+// retry time, `[faults] retry_s`: the service unit restarts on it, with --resume), 2 a usage
+// error, a bad
 // configuration, a refused state directory (not a directory, another owner, writable by
 // others: StateStore::refused) or a saved state that cannot be loaded (a restart cannot
 // help: the service unit does not restart on it), 3 the mission ended without finding the

@@ -52,6 +52,10 @@ struct BoardConfig {
   // the work done per frame does not depend on the host's speed.
   std::uint32_t background_units_per_slice = 0;
   std::uint32_t checkpoint_period_ms = 1000;  // state checkpoint period while no cycle ends
+  // Fault policy (docs/reliability.md): a device fault holds the robot stopped and the device
+  // is retried for this long; then the firmware gives up and exits with kExitFailure, which
+  // the service unit restarts with --resume [s].
+  float device_retry_s = 30.0F;
   // The mission's look (§6.2.1, §6.3): pan positions spread over the PTU's pan range (the
   // camera's 56° field of view closes the circle beyond it), and tilt rows; each row is a
   // stereo pair (tilt, tilt − Φ) or a single frame for the floor cue only.

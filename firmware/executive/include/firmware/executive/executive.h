@@ -243,6 +243,11 @@ class Executive {
   // nullptr while task i is healthy by all_healthy()'s three rules, else why not: the task's
   // own reason ("unhealthy" when it gives none), "overrunning its budget" or "starved".
   const char* task_health(std::size_t i) const;
+  // The executive itself works: no task over its consecutive-overrun limit or starved (a
+  // task's own health, its device's, is not asked). What the watchdog guards.
+  bool all_running() const;
+  // The overrun and starvation rules of task_health() alone: nullptr, or why not.
+  const char* running_health(std::size_t i) const;
 
   std::size_t task_count() const { return count_; }
   const TaskSpec& spec(std::size_t i) const { return entries_[i].spec; }

@@ -35,7 +35,7 @@ inline constexpr std::array<TaskSpec, kTaskCount> kTaskTable{{
     {"camera", 10000, 2000},    // V4L2 dequeue / requeue (image work runs in the background)
     {"mission", 10000, 500},    // mission control: PTU scan, frames, the driven step, holds
     {"console", 10000, 1500},   // serial console: input, commands, telemetry, output
-    {"watchdog", 100000, 200},  // /dev/watchdog and systemd WATCHDOG=1 while all healthy
+    {"watchdog", 100000, 200},  // /dev/watchdog and systemd WATCHDOG=1 unless hung or given up
 }};
 
 static_assert(task_table_valid(kTaskTable, kDefaultMinorFrameUs),

@@ -125,6 +125,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // for good): start() keeps it ended, the robot stopped, and result() and end_reason() are
   // the saved ones.
   [[nodiscard]] bool ended_before_start() const { return ended_before_start_; }
+  // The mission gave up on a device it held for (no frame grabbed for the device retry time
+  // since the fault began): it ended aborted, and a restart may cure it (kExitFailure).
+  [[nodiscard]] bool gave_up_on_device() const { return gave_up_on_device_; }
   // Ends the mission from outside: a signal or the console's shutdown (aborted) or
   // --max-cycles (not found). The state keeps the mission running: a later --resume
   // carries it on.
@@ -168,8 +171,12 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // ends this run only.
   enum class Ending : std::uint8_t { kFinal, kResumable };
   void finish(Result result, const char* why, Ending ending);
-  // A device fault: "WHY: DEVICE_ERROR" (just WHY when it gave none); resumable.
-  void abort_with(const char* why, const char* device_error);
+  // A device fault (docs/reliability.md, "Fault policy"): the robot held stopped as for the
+  // e-stop, the device tried again every retry interval (the look's move and frame, once the
+  // PTU reports no fault and the base is ready), until a frame is grabbed again or, after
+  // the device retry time, the mission gives up. `why` and the device's own words
+  // ("WHY: DEVICE_ERROR") are the mission log's and the give-up's reason.
+  void hold_for_device(const char* why, const char* device_error, std::uint64_t now_us);
   void end_cycle(const char* what);
   // A part of the grabbed view's processing (a unit); true when the view is done.
   bool process_view(ViewPart part);
@@ -208,6 +215,12 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   Phase held_phase_ = Phase::kStart;
   Result result_ = Result::kRunning;
   bool ended_before_start_ = false;
+  bool device_hold_ = false;                   // held for a device, not (only) for the latch
+  std::uint64_t device_trouble_since_us_ = 0;  // first device hold since the last frame; 0: none
+  std::uint64_t device_retry_at_us_ = 0;
+  std::uint64_t frames_at_trouble_ = 0;  // scan_.frames_grabbed() when the trouble began
+  TextBuffer<160> device_reason_;
+  bool gave_up_on_device_ = false;
   TextBuffer<160> end_reason_;  // a copy: a device's reason may change after the end
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;

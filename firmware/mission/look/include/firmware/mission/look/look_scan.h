@@ -56,6 +56,8 @@ class LookScan {
   [[nodiscard]] bool wants_frames() const { return want_frame_; }
   // No more frames wanted (the mission is held or ended).
   void stop_frames() { want_frame_ = false; }
+  // Frames taken so far (each one means the PTU reached its view and the camera delivered).
+  [[nodiscard]] std::uint64_t frames_grabbed() const { return frames_grabbed_; }
   // After a hold: an interrupted move is issued again and waited for.
   void resume();
 
@@ -87,6 +89,7 @@ class LookScan {
   std::uint64_t settle_until_us_ = 0;
   bool want_frame_ = false;
   bool frame_ready_ = false;
+  std::uint64_t frames_grabbed_ = 0;
   bool view_ready_ = false;  // both frames in; the background's turn
   image::LowResFrame first_{};
   image::LowResFrame second_{};

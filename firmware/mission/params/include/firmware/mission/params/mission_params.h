@@ -45,9 +45,13 @@ struct MissionParams {
   std::uint32_t settle_us = 60000;           // PTU at rest → frames count after this [µs]
   std::uint32_t frame_timeout_us = 3000000;  // no usable frame this long: camera fault [µs]
   std::uint32_t ptu_timeout_us = 8000000;    // a PTU move taking longer: PTU fault [µs]
-  std::uint32_t trace_period_us = 100000;    // one trace row per this much time [µs]
-  std::uint32_t vi_work_per_unit = 256;      // value-iteration work per background unit
-  std::size_t max_failed_cycles = 4;         // cycles in a row with no safe step → not_found
+  // A device fault is held and retried every device_retry_interval_us; with no frame grabbed
+  // for device_retry_us since it began the mission gives up (BoardConfig::device_retry_s).
+  std::uint64_t device_retry_us = 30000000;
+  std::uint32_t device_retry_interval_us = 1000000;
+  std::uint32_t trace_period_us = 100000;  // one trace row per this much time [µs]
+  std::uint32_t vi_work_per_unit = 256;    // value-iteration work per background unit
+  std::size_t max_failed_cycles = 4;       // cycles in a row with no safe step → not_found
   // From this many such cycles in a row the robot backs off along its last step before the
   // next look (a fresh look on the spot first: the fit of one look can leave no room).
   std::size_t back_off_after_failed_cycles = 2;
