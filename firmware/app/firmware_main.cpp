@@ -108,6 +108,35 @@ bool apply_config(const Options& options, Board& board, char* error, std::size_t
   return false;
 }
 
+// How old the resumed pose is: the robot is trusted to stand where it was saved (a hardware
+// board cannot know it was moved), so say when that was.
+void log_pose_age(const MissionState& state, std::int64_t now_ms) {
+  ServiceLog& slog = service_log();
+  const double x = static_cast<double>(state.pose.x_m);
+  const double y = static_cast<double>(state.pose.y_m);
+  const double yaw = static_cast<double>(state.pose.yaw_rad);
+  if (state.pose_time_ms == 0 || now_ms == 0) {
+    slog.log(LogLevel::kInfo, "resumed pose x=%.3f y=%.3f yaw=%.3f, its age unknown (%s)", x, y,
+             yaw, now_ms == 0 ? "no wall clock on this board" : "saved without its time");
+    return;
+  }
+  const double age_s = static_cast<double>(now_ms - state.pose_time_ms) * 1e-3;
+  if (age_s < 0.0) {
+    slog.log(LogLevel::kWarn,
+             "resumed pose x=%.3f y=%.3f yaw=%.3f saved %.1f s in the future: the wall clock "
+             "was set back since",
+             x, y, yaw, -age_s);
+    return;
+  }
+  // Older than a restart's few seconds: someone may have moved the robot meanwhile.
+  constexpr double kFreshS = 60.0;
+  slog.log(age_s <= kFreshS ? LogLevel::kInfo : LogLevel::kWarn,
+           "resumed pose x=%.3f y=%.3f yaw=%.3f saved %.1f s ago%s", x, y, yaw, age_s,
+           age_s <= kFreshS ? ""
+                            : ": if the robot was moved since, its map is off (start a new "
+                              "mission without --resume)");
+}
+
 }  // namespace
 
 int firmware_main(int argc, const char* const* argv, Board& board, const MainHooks* hooks) {
@@ -187,6 +216,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
       } else {
         slog.log(LogLevel::kInfo, "resumed from %s at cycle %llu", g_store.loaded_path(),
                  static_cast<unsigned long long>(g_state.cycle));
+        log_pose_age(g_state, hal.clock.wall_time_ms());
       }
     }
   } else if (store != nullptr) {

@@ -412,6 +412,7 @@ void Mission::control_drive(std::uint64_t now_us) {
       if (move_ != Move::kBackOff) breadcrumbs_.step_started({from.x_m, from.y_m});
       driver_.start(from, planner_.target(), now_us);
     }
+    next_pose_save_us_ = now_us + params_.pose_save_period_us;
   }
   const hal::Odometry o = hal_.base.odometry();
   const DriveCommand cmd = driver_.update(pose_.pose(), o.v_m_s, o.omega_rad_s, now_us);
@@ -419,7 +420,11 @@ void Mission::control_drive(std::uint64_t now_us) {
   if (hal_.base.health() == hal::BaseHealth::kStopped && !safety_.engaged()) {
     return hold_for_device("base stopped by itself", hal_.base.error(), now_us);
   }
-  if (driver_.busy()) return;
+  if (driver_.busy()) {
+    // At least every second while driving: a firmware killed mid-step resumes near here.
+    if (now_us >= next_pose_save_us_) save_pose(now_us);
+    return;
+  }
   const bool ok = driver_.status() == DriveStatus::kDone;
   const core::Pose2 here = pose_.pose();
   planner_.visited({here.x_m, here.y_m});
@@ -453,6 +458,7 @@ void Mission::control_drive(std::uint64_t now_us) {
       break;
   }
   if (ok && ++steps_this_look_ < params_.steps_per_look) {
+    save_pose(now_us);  // the step's end (the other ends end the cycle, which saves)
     // Another step on the same look is worked out by the background (a unit of its own).
     plan_step_ = PlanStep::kNextOnLook;
     phase_ = Phase::kPlan;
@@ -462,10 +468,21 @@ void Mission::control_drive(std::uint64_t now_us) {
   if (phase_ != Phase::kDone) begin_look(now_us);
 }
 
+void Mission::take_pose() {
+  state_.pose = pose_.pose();
+  state_.pose_time_ms = hal_.clock.wall_time_ms();
+}
+
+void Mission::save_pose(std::uint64_t now_us) {
+  take_pose();
+  next_pose_save_us_ = now_us + params_.pose_save_period_us;
+  if (saver_ != nullptr) submit_pending_ = !saver_->submit(state_);
+}
+
 void Mission::end_cycle(const char* what) {
   ++state_.cycle;
   ++cycles_this_run_;
-  state_.pose = pose_.pose();
+  take_pose();
   map_.save(state_);
   state_.has_goal = tracker_.confirmed();
   if (state_.has_goal) {
@@ -752,7 +769,7 @@ void Mission::finish_saving() {
   if (saver_ == nullptr) return;
   // Where the base came to rest, not where the last cycle ended: it may still have rolled a
   // few millimetres after its step was done, or been stopped mid-drive.
-  state_.pose = pose_.pose();
+  take_pose();
   submit_pending_ = true;
   while (submit_pending_) submit_pending_ = !saver_->submit(state_);
   saver_->flush();

@@ -62,6 +62,7 @@ void MissionState::clear() {
   end = MissionEnd::kRunning;
   end_reason[0] = '\0';
   pose = {};
+  pose_time_ms = 0;
   has_goal = false;
   goal = {};
   goal_height_m = 0.0F;
@@ -86,7 +87,8 @@ bool same_points(const core::FixedVectorBase<core::Point2>& a,
 bool operator==(const MissionState& a, const MissionState& b) {
   if (a.end != b.end || a.end_reason_text() != b.end_reason_text()) return false;
   if (a.cycle != b.cycle || a.seed != b.seed || a.pose.x_m != b.pose.x_m ||
-      a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad || a.has_goal != b.has_goal) {
+      a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad ||
+      a.pose_time_ms != b.pose_time_ms || a.has_goal != b.has_goal) {
     return false;
   }
   if (a.has_goal && (a.goal.x_m != b.goal.x_m || a.goal.y_m != b.goal.y_m ||

@@ -208,6 +208,13 @@ bool decode_body(Reader& r, MissionState& s, std::uint64_t& sequence) {
   float pose[3];
   if (!r.keyed("pose", v) || !parse_floats(v, pose, 3)) return r.fail("bad pose");
   s.pose = {pose[0], pose[1], pose[2]};
+  if (version >= 4) {
+    std::uint64_t ms = 0;
+    if (!r.keyed("pose_time_ms", v) || !parse_u64(v, ms) || ms > INT64_MAX) {
+      return r.fail("bad pose time");
+    }
+    s.pose_time_ms = static_cast<std::int64_t>(ms);
+  }
   if (!r.keyed("goal", v)) return false;
   if (v == "none") {
     s.has_goal = false;
@@ -270,8 +277,9 @@ std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity,
   } else {
     w.printf("result running\n");
   }
-  w.printf("pose %.9g %.9g %.9g\n", static_cast<double>(s.pose.x_m),
-           static_cast<double>(s.pose.y_m), static_cast<double>(s.pose.yaw_rad));
+  w.printf("pose %.9g %.9g %.9g\npose_time_ms %lld\n", static_cast<double>(s.pose.x_m),
+           static_cast<double>(s.pose.y_m), static_cast<double>(s.pose.yaw_rad),
+           static_cast<long long>(s.pose_time_ms < 0 ? 0 : s.pose_time_ms));
   if (s.has_goal) {
     w.printf("goal %.9g %.9g %.9g\n", static_cast<double>(s.goal.x_m),
              static_cast<double>(s.goal.y_m), static_cast<double>(s.goal_height_m));

@@ -23,6 +23,13 @@ std::uint64_t ClockPosix::now_us() {
          static_cast<std::uint64_t>(ts.tv_nsec) / 1000ULL;
 }
 
+std::int64_t ClockPosix::wall_time_ms() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000 +
+         static_cast<std::int64_t>(ts.tv_nsec) / 1000000;
+}
+
 void ClockPosix::sleep_until_us(std::uint64_t deadline_us) {
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(deadline_us / 1000000ULL);

@@ -16,6 +16,11 @@ class FakeClock final : public hal::Clock {
 
   std::uint64_t now_us() override;
   void sleep_until_us(std::uint64_t deadline_us) override;
+  // The wall clock: wall_ms_at_zero + now [ms] once set (0 until then: no wall clock).
+  std::int64_t wall_time_ms() override {
+    return wall_ms_at_zero == 0 ? 0 : wall_ms_at_zero + static_cast<std::int64_t>(now_us_ / 1000U);
+  }
+  std::int64_t wall_ms_at_zero = 0;
 
   void advance_us(std::uint64_t delta_us) { now_us_ += delta_us; }
   // Sets the time; ignored when it would go backwards (the clock is monotonic).

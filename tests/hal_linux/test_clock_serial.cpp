@@ -35,6 +35,21 @@ TEST(ClockPosix, TimeIsMonotonic) {
   }
 }
 
+// The wall clock (how old a resumed pose is) is CLOCK_REALTIME in milliseconds.
+TEST(ClockPosix, TheWallClockIsTheRealtimeClockInMilliseconds) {
+  ClockPosix c;
+  timeval before{};
+  gettimeofday(&before, nullptr);
+  const std::int64_t wall = c.wall_time_ms();
+  timeval after{};
+  gettimeofday(&after, nullptr);
+  const auto ms = [](const timeval& t) {
+    return static_cast<std::int64_t>(t.tv_sec) * 1000 + static_cast<std::int64_t>(t.tv_usec) / 1000;
+  };
+  CHECK(wall >= ms(before));
+  CHECK(wall <= ms(after));
+}
+
 TEST(ClockPosix, SleepsUntilTheAbsoluteDeadline) {
   ClockPosix c;
   const std::uint64_t deadline = c.now_us() + 20000;

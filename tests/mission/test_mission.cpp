@@ -1,5 +1,6 @@
 // The mission end to end on the sim board: Look-Think-Drive finds the target without touching
 // anything, checked against the world's geometry from the trace, and is deterministic.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -423,6 +424,74 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndR
   CHECK(held);
   CHECK(drove_after);
   check_found_safely(r);
+}
+
+namespace {
+// Watches the state directory frame by frame: a save replaces a copy (a new inode, the atomic
+// rename), so each one is seen in the frame it happened; meanwhile the true pose tells when
+// the robot moves.
+struct PoseSaveWatch {
+  std::string dir;
+  bool started = false;
+  std::uint64_t last_save_us = 0;
+  std::uint64_t worst_gap_moving_us = 0;  // the longest time moving since the last save
+  int saves_while_moving = 0;
+  int moving_frames = 0;
+  ino_t inodes[2] = {0, 0};
+  bool was_moving = false;
+  boticelli::core::Pose2 last{};
+};
+void watch_pose_saves(void* context) {
+  auto* w = static_cast<PoseSaveWatch*>(context);
+  const std::uint64_t now = g_board.hal().clock.now_us();
+  const boticelli::core::Pose2 p = g_board.robot_pose();
+  bool saved = false;
+  const char* names[2] = {"/mission.state.a", "/mission.state.b"};
+  for (int i = 0; i < 2; ++i) {
+    struct stat st {};
+    if (stat((w->dir + names[i]).c_str(), &st) == 0 && st.st_ino != w->inodes[i]) {
+      w->inodes[i] = st.st_ino;
+      saved = true;
+    }
+  }
+  const bool moving = w->started && (std::hypot(p.x_m - w->last.x_m, p.y_m - w->last.y_m) > 1e-6F ||
+                                     std::fabs(p.yaw_rad - w->last.yaw_rad) > 1e-6F);
+  if (!w->started || saved) w->last_save_us = now;
+  if (saved && moving) ++w->saves_while_moving;
+  // From the start of a drive (still before) or the last save, whichever is later.
+  if (moving && !w->was_moving) w->last_save_us = std::max(w->last_save_us, now);
+  w->was_moving = moving;
+  if (moving) {
+    ++w->moving_frames;
+    w->worst_gap_moving_us = std::max(w->worst_gap_moving_us, now - w->last_save_us);
+  }
+  w->started = true;
+  w->last = p;
+}
+}  // namespace
+
+// Resume keeps the pose: while the robot drives, its pose goes to the state at least every
+// second (and at the end of each step), so a firmware killed mid-step resumes near where the
+// robot stands, not where the last cycle ended.
+TEST(MissionResume, WhileDrivingThePoseIsSavedAtLeastEverySecond) {
+  char dir_template[] = "/tmp/boticelli-posesave-XXXXXX";
+  static PoseSaveWatch watch;
+  watch = PoseSaveWatch{};
+  watch.dir = mkdtemp(dir_template);
+  static boticelli::firmware::MainHooks hooks;
+  hooks.after_frame = watch_pose_saves;
+  hooks.context = &watch;
+  const MissionRun run = run_mission("thesis_room", "1", 0.0F, &hooks,
+                                     {"--state", watch.dir.c_str(), "--max-cycles", "2"});
+  STRCMP_CONTAINS("MISSION result=not_found cycles=2 ", run.mission_line.c_str());
+  CHECK_TEXT(watch.moving_frames > 300, "the robot drove for more than 3 s");
+  CHECK(watch.saves_while_moving >= 3);
+  // A frame of slack: the save is due once a second has passed since the last.
+  CHECK_TEXT(watch.worst_gap_moving_us <= 1010000U,
+             std::to_string(watch.worst_gap_moving_us).c_str());
+  std::remove((watch.dir + "/mission.state.a").c_str());
+  std::remove((watch.dir + "/mission.state.b").c_str());
+  rmdir(watch.dir.c_str());
 }
 
 // Stopped after three cycles and started again with --resume: the robot is put back where it

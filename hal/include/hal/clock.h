@@ -20,6 +20,9 @@ class Clock : private NonCopyable {
   // counts how far past). -1 when that sleep did not wait on the host's clock (the sim
   // board in lockstep, without --speed) or before the first sleep.
   virtual std::int64_t last_wake_latency_ns() const { return -1; }
+  // Wall-clock time [ms since the Unix epoch], which outlives a restart and a reboot (how old
+  // a saved pose is); 0 when the board has none (the sim board: its runs stay repeatable).
+  virtual std::int64_t wall_time_ms() { return 0; }
 };
 
 }  // namespace boticelli::hal

@@ -380,7 +380,8 @@ TEST(FirmwareMain, AStateDirectoryOthersMayWriteInStopsTheStartWithTheUsageCode)
 
 namespace {
 // Saves a state of `cycle` cycles, ended as `end` (or running), in `dir` as the firmware would.
-void save_state(const std::string& dir, std::uint64_t cycle, MissionEnd end, const char* why) {
+void save_state(const std::string& dir, std::uint64_t cycle, MissionEnd end, const char* why,
+                std::int64_t pose_time_ms = 0) {
   static MissionState state;  // large: static storage
   static StateStore store;
   char error[256] = "";
@@ -389,6 +390,8 @@ void save_state(const std::string& dir, std::uint64_t cycle, MissionEnd end, con
   state.cycle = cycle;
   state.seed = 3;
   state.add_log(cycle, "looked");
+  state.pose = {1.25F, -0.5F, 0.75F};
+  state.pose_time_ms = pose_time_ms;
   if (end != MissionEnd::kRunning) state.set_end(end, why);
   CHECK_TRUE_TEXT(store.save(state, error, sizeof error), error);
 }
@@ -575,6 +578,42 @@ TEST(FirmwareMain, ABumperContactEndsTheMissionForGoodAndTheNextStartSaysSo) {
   STRCMP_CONTAINS("the saved mission has ended (aborted at cycle 0: bumper contact)",
                   r.err.c_str());
   CHECK_EQUAL(kExitNotFound, r.exit_code);
+}
+
+// The robot is trusted to stand where its pose was saved: a resumed run says how old that
+// pose is by the board's wall clock, and warns when it is old enough for someone to have
+// moved the robot.
+TEST(FirmwareMain, AResumedRunSaysHowOldItsPoseIs) {
+  constexpr std::int64_t kSavedMs = 1780000000000LL;
+  save_state(dir, 3, MissionEnd::kRunning, "", kSavedMs);
+  Run r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"},
+                       [](FakeBoard& b) { b.clock.wall_ms_at_zero = kSavedMs + 12000; });
+  STRCMP_CONTAINS("boticelli: resumed pose x=1.250 y=-0.500 yaw=0.750 saved 12.0 s ago\n",
+                  r.err.c_str());
+  // The run saved its own pose at its end with the wall clock's time then (after its 30 s of
+  // holds and retries for the fake camera).
+  {
+    static MissionState state;
+    static StateStore store;
+    char error[256] = "";
+    CHECK(store.open(dir.c_str(), error, sizeof error));
+    CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+    CHECK(state.pose_time_ms >= kSavedMs + 12000 + 30000);
+    CHECK(state.pose_time_ms <= kSavedMs + 12000 + 40000);
+  }
+  save_state(dir, 3, MissionEnd::kRunning, "", kSavedMs);
+  r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"},
+                   [](FakeBoard& b) { b.clock.wall_ms_at_zero = kSavedMs + 7200000; });
+  STRCMP_CONTAINS(
+      "boticelli: resumed pose x=1.250 y=-0.500 yaw=0.750 saved 7200.0 s ago: if the robot was "
+      "moved since, its map is off (start a new mission without --resume)",
+      r.err.c_str());
+  save_state(dir, 3, MissionEnd::kRunning, "", kSavedMs);
+  r = run_firmware({"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
+  STRCMP_CONTAINS(
+      "resumed pose x=1.250 y=-0.500 yaw=0.750, its age unknown (no wall clock on "
+      "this board)",
+      r.err.c_str());
 }
 
 TEST(FirmwareMain, ADamagedNewestStateCopyIsPassedOverWithAWarningAndTheOlderOneResumed) {

@@ -47,6 +47,7 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   s.cycle = cycle;
   s.seed = 42;
   s.pose = {0.1F * static_cast<float>(cycle), -0.37F, 0.001F * static_cast<float>(cycle)};
+  s.pose_time_ms = cycle % 4 == 0 ? 0 : 1700000000000LL + static_cast<std::int64_t>(cycle);
   s.has_goal = cycle % 3 == 0;
   s.goal = {1.0F / 3.0F, 2.5e-7F * static_cast<float>(cycle)};
   s.goal_height_m = 0.01F * static_cast<float>(cycle % 40);
@@ -190,6 +191,12 @@ TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
             "obstacles 0\n" + tail,
         "BOTICELLI-STATE 3\nsequence 4\ncycle 3\nseed 1\nresult found \x1b[2J\n" + head.substr(33) +
             "obstacles 0\n" + tail,
+        // Version 4 has the pose's time after the pose.
+        "BOTICELLI-STATE 4\nsequence 4\ncycle 3\nseed 1\nresult running\n" + head.substr(33) +
+            "obstacles 0\n" + tail,
+        "BOTICELLI-STATE 4\nsequence 4\ncycle 3\nseed 1\nresult running\npose 0 0 0\n"
+        "pose_time_ms -5\ngoal none\nobstacles 0\n" +
+            tail,
         "BOTICELLI-STATE 0" + head.substr(17) + "obstacles 0\n" + tail,
         "BOTICELLI-STATE 2x" + head.substr(17) + "obstacles 0\n" + tail,
         "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal 1 2\nobstacles 0\n" + tail,
@@ -247,6 +254,7 @@ TEST(Persistence, ReadsAVersionOneFileWhoseGoalHasNoHeight) {
 TEST(Persistence, KeepsTheMissionsResultAndTheSequenceNumber) {
   make_state(7, g_a);
   g_a.set_end(MissionEnd::kFound, "within the stand-off of the target");
+  CHECK_EQUAL(1700000000007LL, g_a.pose_time_ms);
   const std::size_t n = encode_state(g_a, g_file, sizeof g_file, 41);
   const char* why = "";
   std::uint64_t sequence = 0;
@@ -254,12 +262,22 @@ TEST(Persistence, KeepsTheMissionsResultAndTheSequenceNumber) {
   CHECK(g_a == g_b);
   CHECK(g_b.end == MissionEnd::kFound);
   STRCMP_EQUAL("within the stand-off of the target", g_b.end_reason.data());
+  CHECK_EQUAL(1700000000007LL, g_b.pose_time_ms);
   CHECK_EQUAL(41U, sequence);
   CHECK_TRUE_TEXT(peek_state({g_file, n}, sequence = 0, &why), why);
   CHECK_EQUAL(41U, sequence);
   // The result is part of what a state is: a different end is a different state.
   g_b.set_end(MissionEnd::kAborted, "within the stand-off of the target");
   CHECK_FALSE(g_a == g_b);
+  // Version 3 (no pose time): the pose's time is unknown.
+  const std::string v3 = with_crc(
+      "BOTICELLI-STATE 3\nsequence 7\ncycle 3\nseed 1\nresult running\npose 1 2 0\ngoal none\n"
+      "obstacles 0\nexploration 0\nmodel 0\n\nlog 0\nend\n");
+  g_b.pose_time_ms = 5;
+  CHECK_TRUE_TEXT(decode_state(v3, g_b, &why, &sequence), why);
+  CHECK_EQUAL(7U, sequence);
+  CHECK_EQUAL(0, g_b.pose_time_ms);
+  DOUBLES_EQUAL(2.0, g_b.pose.y_m, 0.0);
   // A file written before the result was kept is a running mission with sequence 0.
   const std::string v2 = with_crc(
       "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal none\nobstacles 0\n"

@@ -178,6 +178,10 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // ("WHY: DEVICE_ERROR") are the mission log's and the give-up's reason.
   void hold_for_device(const char* why, const char* device_error, std::uint64_t now_us);
   void end_cycle(const char* what);
+  // The pose and its wall-clock time into the state (take_pose), and the state to the writer
+  // (save_pose: a copy into its hand-over buffer, no I/O here with a writer thread).
+  void take_pose();
+  void save_pose(std::uint64_t now_us);
   // A part of the grabbed view's processing (a unit); true when the view is done.
   bool process_view(ViewPart part);
   // The pair aimed at the target's estimate (or its unconfirmed candidate) after the scan.
@@ -221,7 +225,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint64_t frames_at_trouble_ = 0;  // scan_.frames_grabbed() when the trouble began
   TextBuffer<160> device_reason_;
   bool gave_up_on_device_ = false;
-  TextBuffer<160> end_reason_;  // a copy: a device's reason may change after the end
+  std::uint64_t next_pose_save_us_ = 0;  // while driving
+  TextBuffer<160> end_reason_;           // a copy: a device's reason may change after the end
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;
   std::uint64_t next_trace_us_ = 0;

@@ -43,6 +43,9 @@ struct MissionState {
   // Robot pose [m, rad] in the mission's frame: the odometry frame of the run that started the
   // mission (a resumed run carries it on from here).
   core::Pose2 pose;
+  // When `pose` was taken, by the board's wall clock [ms since the Unix epoch]; 0: unknown
+  // (a board without one, or a state from before version 4). A resumed run says how old it is.
+  std::int64_t pose_time_ms = 0;
   bool has_goal = false;
   core::Point2 goal;           // target position once confirmed, mission frame [m]
   float goal_height_m = 0.0F;  // the target's height above the floor [m]

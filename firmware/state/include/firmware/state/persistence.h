@@ -15,16 +15,16 @@ namespace boticelli::firmware {
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
 
 // Format (docs/console.md "State directory"):
-//   BOTICELLI-STATE 3 / sequence N / cycle N / seed N / result running|found|not_found|aborted
-//   [REASON] / pose X Y YAW / goal none|goal X Y H / obstacles N + N lines "X Y" / exploration
-//   N + N lines / model BYTES + the bytes + "\n" / log N + N lines "CYCLE TEXT" / end /
-//   crc32 XXXXXXXX (over everything before that line).
-// Versions 1 (a goal without its height) and 2 (no sequence, no result) are still read: their
-// sequence is 0 and their mission running.
-inline constexpr std::uint32_t kStateFormatVersion = 3;  // 3: sequence number and result
+//   BOTICELLI-STATE 4 / sequence N / cycle N / seed N / result running|found|not_found|aborted
+//   [REASON] / pose X Y YAW / pose_time_ms MS / goal none|goal X Y H / obstacles N + N lines "X Y"
+//   / exploration N + N lines / model BYTES + the bytes + "\n" / log N + N lines "CYCLE TEXT" / end
+//   / crc32 XXXXXXXX (over everything before that line).
+// Versions 1 (a goal without its height), 2 (no sequence, no result) and 3 (no pose time) are
+// still read: their sequence is 0 (before 3), their mission running, their pose's time unknown.
+inline constexpr std::uint32_t kStateFormatVersion = 4;  // 4: the pose's wall-clock time
 inline constexpr std::size_t kMaxStateFileBytes =
     256 + 40 * (MissionState::kMaxObstaclePoints + MissionState::kMaxExplorationPoints) +
-    MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64 + 160;
+    MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64 + 224;
 
 // Writes the file's bytes into `out`; returns their count, 0 when `capacity` is too small.
 // `sequence` numbers the saves of a state directory (StateStore: the newest copy wins).

@@ -14,6 +14,8 @@ class ClockPosix final : public hal::Clock {
   // Absolute sleep on CLOCK_MONOTONIC; resumes after a signal (EINTR) until the deadline.
   void sleep_until_us(std::uint64_t deadline_us) override;
   std::int64_t last_wake_latency_ns() const override { return last_wake_latency_ns_; }
+  // CLOCK_REALTIME [ms] (a vDSO call: no I/O).
+  std::int64_t wall_time_ms() override;
 
  private:
   std::int64_t last_wake_latency_ns_ = -1;

@@ -49,6 +49,9 @@ struct MissionParams {
   // for device_retry_us since it began the mission gives up (BoardConfig::device_retry_s).
   std::uint64_t device_retry_us = 30000000;
   std::uint32_t device_retry_interval_us = 1000000;
+  // While driving the pose goes to the state writer at least this often, and at the end of
+  // every step, so a firmware killed mid-step resumes near where the robot stands [µs].
+  std::uint32_t pose_save_period_us = 1000000;
   std::uint32_t trace_period_us = 100000;  // one trace row per this much time [µs]
   std::uint32_t vi_work_per_unit = 256;    // value-iteration work per background unit
   std::size_t max_failed_cycles = 4;       // cycles in a row with no safe step → not_found
