@@ -445,3 +445,17 @@ TEST(NavPlanner, AFrontierOnOpenFloorFarFromAnyWallCountsLessOfItsLength) {
   g_nav.run();
   DOUBLES_EQUAL(160 * 0.05, g_nav.frontiers()[0].length_m, 1e-3);
 }
+
+TEST(NavPlanner, ChoosingOnlyTheTargetLeavesTheFrontierGoalAlone) {
+  corridor(3.0F);
+  g_nav.start(g_map, {0.0F, 0.0F}, {});
+  g_nav.run();
+  const Point2 near{2.5F, 0.8F};
+  const wm::NavChoice c = g_nav.choose_target(near, 0.75F);
+  CHECK(c.kind == wm::NavGoalKind::kTarget);
+  CHECK(boticelli::core::distance_m(c.goal, near) <= 0.75F + 1e-4F);
+  const Point2 beyond{2.5F, 3.0F};  // behind the wall: no stand-off cell reachable
+  CHECK(g_nav.choose_target(beyond, 0.75F).kind == wm::NavGoalKind::kNone);
+  CHECK(g_nav.path().empty());
+  CHECK(g_nav.choose(nullptr, 0.75F).kind == wm::NavGoalKind::kFrontier);
+}

@@ -323,6 +323,40 @@ void NavPlanner::trace_path(std::size_t goal_index) {
   std::reverse(path_.begin(), path_.end());
 }
 
+NavChoice NavPlanner::choose_target(core::Point2 target, float standoff_m) {
+  NavChoice choice;
+  path_.clear();
+  if (phase_ != Phase::kDone) return choice;
+  std::size_t best = 0;
+  const std::uint32_t best_cost = standoff_cell(target, standoff_m, best);
+  if (best_cost == kUnreached) return choice;
+  trace_path(best);
+  choice.kind = NavGoalKind::kTarget;
+  choice.goal = centre(best);
+  choice.path_m = static_cast<float>(best_cost) * 0.1F * map_->cell_m();
+  return choice;
+}
+
+std::uint32_t NavPlanner::standoff_cell(core::Point2 target, float standoff_m,
+                                        std::size_t& best) const {
+  const float inner = std::max(0.0F, standoff_m - params_.target_band_m);
+  const Cell lo = map_->cell_of({target.x_m - standoff_m, target.y_m - standoff_m});
+  const Cell hi = map_->cell_of({target.x_m + standoff_m, target.y_m + standoff_m});
+  std::uint32_t best_cost = kUnreached;
+  for (int iy = lo.iy; iy <= hi.iy; ++iy) {
+    for (int ix = lo.ix; ix <= hi.ix; ++ix) {
+      const core::Point2 p = map_->centre_of({ix, iy});
+      const float d = core::distance_m(p, target);
+      std::size_t i = 0;
+      if (d < inner || d > standoff_m || !window_index(p, i)) continue;
+      if (!passable_cell(i) || cost_[i] >= best_cost) continue;
+      best_cost = cost_[i];
+      best = i;
+    }
+  }
+  return best_cost;
+}
+
 NavChoice NavPlanner::choose(const core::Point2* target, float standoff_m) {
   NavChoice choice;
   path_.clear();
@@ -330,22 +364,8 @@ NavChoice NavPlanner::choose(const core::Point2* target, float standoff_m) {
   const float cell = map_->cell_m();
   if (target != nullptr) {
     // The target's goal: the cheapest reachable cell in the stand-off band round it.
-    const float inner = std::max(0.0F, standoff_m - params_.target_band_m);
-    const Cell lo = map_->cell_of({target->x_m - standoff_m, target->y_m - standoff_m});
-    const Cell hi = map_->cell_of({target->x_m + standoff_m, target->y_m + standoff_m});
     std::size_t best = 0;
-    std::uint32_t best_cost = kUnreached;
-    for (int iy = lo.iy; iy <= hi.iy; ++iy) {
-      for (int ix = lo.ix; ix <= hi.ix; ++ix) {
-        const core::Point2 p = map_->centre_of({ix, iy});
-        const float d = core::distance_m(p, *target);
-        std::size_t i = 0;
-        if (d < inner || d > standoff_m || !window_index(p, i)) continue;
-        if (!passable_cell(i) || cost_[i] >= best_cost) continue;
-        best_cost = cost_[i];
-        best = i;
-      }
-    }
+    std::uint32_t best_cost = standoff_cell(*target, standoff_m, best);
     if (best_cost == kUnreached) {
       // No stand-off reachable on what the map knows: as near the target as it allows (the
       // next look shows more), unless that is where the robot already stands.

@@ -17,10 +17,13 @@ void StepPlanner::start_value(const mapping::GlobalMap& map, const worldmap::Gri
                               const core::Point2* goal, core::Point2 centre, std::uint32_t seed) {
   has_goal_ = goal != nullptr;
   if (has_goal_) goal_ = *goal;
-  if (!params_.thesis_planner) {
-    nav_.start(grid, centre, params_.nav);
-    return;
-  }
+  path_mode_ = !params_.thesis_planner;
+  // The wavefront: for the frontier planner, and for the thesis's too once the target is
+  // confirmed (its stand-off is then reached by path where the grid shows one).
+  nav_needed_ = !params_.thesis_planner || (has_goal_ && params_.target_by_path);
+  nav_choice_ = {};
+  if (nav_needed_) nav_.start(grid, centre, params_.nav);
+  if (!params_.thesis_planner) return;
   planning::RewardSources sources;
   sources.obstacles = map.obstacles().span();
   sources.exploration = map.exploration().span();
@@ -39,6 +42,11 @@ StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
     nav_choice_ = nav_.choose(has_goal_ ? &goal_ : nullptr, params_.rewards.goal_standoff_m);
     has_exploration = nav_choice_.kind == worldmap::NavGoalKind::kFrontier;
     has_goal = nav_choice_.kind == worldmap::NavGoalKind::kTarget;
+  } else if (nav_needed_) {
+    // The thesis's planner with a confirmed target: by path when the grid has one to a cell
+    // at the stand-off, else by the value function's cones as before.
+    nav_choice_ = nav_.choose_target(goal_, params_.rewards.goal_standoff_m);
+    path_mode_ = nav_choice_.kind == worldmap::NavGoalKind::kTarget;
   }
   if (!has_exploration && !has_goal) {
     // Turn round and look once more before giving up: the sector behind the robot is seen
@@ -48,7 +56,7 @@ StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
         turned_round_ && core::distance_m({here.x_m, here.y_m}, turned_round_at_) < 0.5F;
     return turned_here ? StepOutcome::kNothingLeft : StepOutcome::kTurnRound;
   }
-  if (params_.thesis_planner) chooser_.start(value_, navigable, here, params_.step);
+  if (!path_mode_) chooser_.start(value_, navigable, here, params_.step);
   return StepOutcome::kChoosing;
 }
 
@@ -89,7 +97,7 @@ planning::StepDecision StepPlanner::step_on_path(const core::Pose2& here,
 StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& look_pose,
                                     const mapping::StarPolygon& navigable,
                                     Breadcrumbs& breadcrumbs) {
-  if (params_.thesis_planner) {
+  if (!path_mode_) {
     decision_ = chooser_.decision();
   } else if (has_goal_ && core::distance_m({here.x_m, here.y_m}, goal_) <=
                               params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m) {
@@ -137,7 +145,7 @@ StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& 
 bool StepPlanner::begin_next_on_look(const core::Pose2& here, const core::Pose2& look_pose,
                                      const mapping::StarPolygon& navigable) {
   if (!navigable.contains(core::to_robot(look_pose, {here.x_m, here.y_m}))) return false;
-  if (!params_.thesis_planner) {
+  if (path_mode_) {
     decision_ = step_on_path(here, look_pose, navigable);
     return true;
   }
@@ -160,7 +168,7 @@ bool StepPlanner::begin_next_on_look(const core::Pose2& here, const core::Pose2&
 }
 
 StepOutcome StepPlanner::end_next_on_look() {
-  if (params_.thesis_planner) decision_ = chooser_.decision();
+  if (!path_mode_) decision_ = chooser_.decision();
   return decision_.kind == planning::StepKind::kMove ? StepOutcome::kMove
                                                      : StepOutcome::kNoSafeStep;
 }

@@ -277,3 +277,53 @@ TEST(FrontierStepPlanner, AGridWithNothingReachableTurnsRoundThenEnds) {
   planner.turned_round_at({0.0F, 0.0F});
   CHECK(plan(origin, disc(0.6F), nullptr) == StepOutcome::kNothingLeft);
 }
+
+TEST_GROUP(ThesisPlannerTargetByPath) {
+  const MissionParams params = thesis_params();
+  StepPlanner planner{params};
+  GlobalMap map;
+  Breadcrumbs crumbs;
+  const Pose2 origin{};
+
+  void setup() override {
+    planner.clear();
+    free_square();
+  }
+  StepOutcome plan(const Point2* goal) {
+    planner.start_value(map, g_grid, goal, {0.0F, 0.0F}, 1);
+    while (!planner.value_done()) planner.value_unit();
+    const StepOutcome begun = planner.begin_choice(origin, disc(0.6F), true, goal != nullptr);
+    if (begun != StepOutcome::kChoosing) return begun;
+    while (!planner.choice_done()) planner.choose_heading();
+    return planner.end_choice(origin, origin, disc(0.6F), crumbs);
+  }
+};
+
+TEST(ThesisPlannerTargetByPath, AConfirmedTargetWithAPathOnTheGridIsApproachedAlongIt) {
+  CHECK(params.target_by_path);
+  const Point2 target{1.3F, 0.9F};
+  CHECK(plan(&target) == StepOutcome::kMove);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kTarget);
+  // The step is the path's, cut to the look's polygon (0.6 m): longer than one action of the
+  // value function, on toward the stand-off cell.
+  const Point2 t = planner.target();
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) <= 0.6F + 1e-5F);
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) > params.value.step_m);
+  const Point2 g = planner.nav_choice().goal;
+  CHECK(boticelli::core::distance_m(t, g) < boticelli::core::distance_m({0.0F, 0.0F}, g));
+}
+
+TEST(ThesisPlannerTargetByPath, WithoutAPathToTheStandOffTheValueFunctionChoosesTheStep) {
+  g_grid.configure({});  // nothing known: no path anywhere
+  const Point2 target{1.3F, 0.9F};
+  CHECK(plan(&target) == StepOutcome::kMove);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kNone);
+  // A step of the value function: one action's length at most.
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) <= params.value.step_m + 1e-5F);
+}
+
+TEST(ThesisPlannerTargetByPath, NoTargetNoWavefront) {
+  CHECK(plan(nullptr) == StepOutcome::kMove);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kNone);
+  CHECK_FALSE(planner.nav().done());
+}

@@ -89,6 +89,10 @@ class NavPlanner {
   // when its path stops shortening; kNone when no reachable frontier is left. Fills path().
   NavChoice choose(const core::Point2* target, float standoff_m);
 
+  // After done(): only the target's stand-off (choose()'s first rule), kNone when no cell of
+  // the stand-off band is reachable; frontiers and the kept goal are left alone. Fills path().
+  NavChoice choose_target(core::Point2 target, float standoff_m);
+
   // The path to the chosen goal, robot first (cell centres, mission frame).
   [[nodiscard]] std::span<const core::Point2> path() const { return path_.span(); }
   [[nodiscard]] std::span<const Frontier> frontiers() const { return frontiers_.span(); }
@@ -125,6 +129,9 @@ class NavPlanner {
   [[nodiscard]] bool is_frontier(std::size_t index) const;
   [[nodiscard]] bool blacklisted(core::Point2 p) const;
   void trace_path(std::size_t goal_index);
+  // The cheapest reachable passable cell standing off `target` by standoff_m − target_band_m
+  // … standoff_m (its index in `best`), or kUnreached.
+  std::uint32_t standoff_cell(core::Point2 target, float standoff_m, std::size_t& best) const;
   bool push(std::uint32_t cost, std::uint32_t index);
 
   const GridMap* map_ = nullptr;

@@ -62,6 +62,9 @@ struct MissionParams {
   // Where to go (BoardConfig::thesis_planner): frontier goals on the world memory, or the
   // thesis's reward cones.
   bool thesis_planner = true;
+  // With the thesis's planner: a confirmed target whose stand-off the grid shows a path to is
+  // approached along that path (else by the cones).
+  bool target_by_path = true;
   worldmap::GridMapParams grid;
   worldmap::LookFusionParams fusion;
   worldmap::NavParams nav;

@@ -46,13 +46,13 @@ class StepPlanner {
   void start_value(const mapping::GlobalMap& map, const worldmap::GridMap& grid,
                    const core::Point2* goal, core::Point2 centre, std::uint32_t seed);
   [[nodiscard]] bool value_done() const {
-    return params_.thesis_planner ? value_.done() : nav_.done();
+    return (!params_.thesis_planner || value_.done()) && (!nav_needed_ || nav_.done());
   }
   void value_unit() {
-    if (params_.thesis_planner) {
-      (void)value_.run_unit(params_.vi_work_per_unit);
-    } else {
+    if (nav_needed_ && !nav_.done()) {
       (void)nav_.run_unit();
+    } else if (params_.thesis_planner) {
+      (void)value_.run_unit(params_.vi_work_per_unit);
     }
   }
 
@@ -64,9 +64,9 @@ class StepPlanner {
   // One heading of the choice per call, until choice_done() (the thesis planner; the path's
   // step is found in end_choice()).
   void choose_heading() {
-    if (params_.thesis_planner) (void)chooser_.run_unit();
+    if (!path_mode_) (void)chooser_.run_unit();
   }
-  [[nodiscard]] bool choice_done() const { return !params_.thesis_planner || chooser_.done(); }
+  [[nodiscard]] bool choice_done() const { return path_mode_ || chooser_.done(); }
   // The chosen step: kAtGoal, kMove when the whole step lies in the look's navigable polygon
   // (seen from `look_pose`), else the place counts as visited once more and the robot backs off
   // along its breadcrumbs (kBackOff) from the second such cycle in a row, or looks again
@@ -110,7 +110,9 @@ class StepPlanner {
   planning::ValueIteration value_;
   worldmap::NavPlanner nav_;
   worldmap::NavChoice nav_choice_{};
-  bool has_goal_ = false;  // the target's estimate, for the nav planner
+  bool nav_needed_ = false;  // this plan runs the wavefront
+  bool path_mode_ = false;   // this plan's step follows the wavefront's path
+  bool has_goal_ = false;    // the target's estimate, for the nav planner
   core::Point2 goal_{};
   planning::Trail trail_;
   planning::StepChooser chooser_;
