@@ -284,6 +284,7 @@ TEST_GROUP(ThesisPlannerTargetByPath) {
   GlobalMap map;
   Breadcrumbs crumbs;
   const Pose2 origin{};
+  const StarPolygon look = disc(0.6F);  // the chooser keeps it: it must outlive the choice
 
   void setup() override {
     planner.clear();
@@ -292,10 +293,10 @@ TEST_GROUP(ThesisPlannerTargetByPath) {
   StepOutcome plan(const Point2* goal) {
     planner.start_value(map, g_grid, goal, {0.0F, 0.0F}, 1);
     while (!planner.value_done()) planner.value_unit();
-    const StepOutcome begun = planner.begin_choice(origin, disc(0.6F), true, goal != nullptr);
+    const StepOutcome begun = planner.begin_choice(origin, look, true, goal != nullptr);
     if (begun != StepOutcome::kChoosing) return begun;
     while (!planner.choice_done()) planner.choose_heading();
-    return planner.end_choice(origin, origin, disc(0.6F), crumbs);
+    return planner.end_choice(origin, origin, look, crumbs);
   }
 };
 
