@@ -11,6 +11,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "board_config.h"  // boards/rpi4: its device keys
@@ -54,6 +55,11 @@ struct Rpi4Keys {
 
 bool same_config(const BoardConfig& a, const BoardConfig& b) {
   return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// The text `key` (a path or a name) holds in `schema`'s bindings.
+const DeviceName& key_text(const ConfigSchema& schema, const ConfigKey& key) {
+  return *schema.find(key.table, key.name)->text;
 }
 
 }  // namespace
@@ -140,6 +146,91 @@ TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
     STRCMP_CONTAINS(c.why, error);
     CHECK_TEXT(same_config(before, k.config), c.line3);
   }
+}
+
+// Every range-checked key of the board and the rpi4 devices: its maximum is accepted and the
+// next value above it refused, with the range in the message and the value not set.
+TEST(ConfigFile, EveryNumberKeyRefusesAValueAboveItsMaximumAndAcceptsTheMaximum) {
+  const Rpi4Keys keys;
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < keys.schema.size(); ++i) {
+    const ConfigKey& key = keys.schema[i];
+    if (key.kind != ConfigKind::kWhole && key.kind != ConfigKind::kNumber) continue;
+    char at_max[64];
+    char above[64];
+    if (key.kind == ConfigKind::kWhole) {
+      const auto max = static_cast<long long>(key.max);
+      std::snprintf(at_max, sizeof at_max, "%lld", max);
+      std::snprintf(above, sizeof above, "%lld", max + key.multiple_of);
+    } else {
+      std::snprintf(at_max, sizeof at_max, "%.17g", key.max);
+      std::snprintf(above, sizeof above, "%.17g", key.max + 0.5);
+    }
+    const std::string head = std::string("[") + key.table + "]\n" + key.name + " = ";
+    Rpi4Keys k;
+    char error[320] = "";
+    CHECK_TRUE_TEXT(
+        apply_config_text(head + at_max + "\n", "max.conf", k.schema, error, sizeof error), error);
+    Rpi4Keys fresh;
+    const BoardConfig before = fresh.config;
+    CHECK_FALSE_TEXT(
+        apply_config_text(head + above + "\n", "max.conf", fresh.schema, error, sizeof error),
+        (head + above).c_str());
+    const std::string message = error;
+    const std::string said = std::string(key.table) + "." + key.name + " = ";
+    CHECK_TEXT(message.rfind("max.conf:2: " + said, 0) == 0, message.c_str());
+    STRCMP_CONTAINS(" is out of range (", error);
+    CHECK_TEXT(same_config(before, fresh.config), (head + above).c_str());
+    ++checked;
+  }
+  CHECK(checked >= 20);
+}
+
+// The camera's height has its own limit: the low-resolution frame's 240 rows times 4, less
+// than the width's 1280 (a height between the two is refused at start, not at the first frame).
+TEST(ConfigFile, ACameraHeightAboveItsMaximumIsRefusedEvenWhenBelowTheWidthsMaximum) {
+  Rpi4Keys k;
+  char error[320] = "";
+  CHECK_TRUE_TEXT(
+      apply_config_text("[camera]\nheight_px = 960\n", "h.conf", k.schema, error, sizeof error),
+      error);
+  CHECK_EQUAL(960U, k.config.camera_height_px);
+  Rpi4Keys fresh;
+  CHECK_FALSE(apply_config_text("[camera]\nheight_px = 1000\n", "h.conf", fresh.schema, error,
+                                sizeof error));
+  STRCMP_EQUAL("h.conf:2: camera.height_px = 1000 is out of range (120 to 960)", error);
+  CHECK_EQUAL(480U, fresh.config.camera_height_px);
+}
+
+// A text key holds its value and the NUL after it: 63 bytes fit the 64-byte array, 64 do not.
+TEST(ConfigFile, ATextKeyOfExactlyItsCapacityIsRefusedAndOneByteLessIsAccepted) {
+  const Rpi4Keys keys;
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < keys.schema.size(); ++i) {
+    const ConfigKey& key = keys.schema[i];
+    if (key.kind != ConfigKind::kPath && key.kind != ConfigKind::kName) continue;
+    const std::size_t capacity = std::tuple_size_v<DeviceName>;
+    const std::string lead = key.kind == ConfigKind::kPath ? "/" : "d";
+    const std::string fits = lead + std::string(capacity - 2, 'd');
+    const std::string full = lead + std::string(capacity - 1, 'd');
+    const std::string head = std::string("[") + key.table + "]\n" + key.name + " = \"";
+    Rpi4Keys k;
+    char error[320] = "";
+    CHECK_TRUE_TEXT(
+        apply_config_text(head + fits + "\"\n", "t.conf", k.schema, error, sizeof error), error);
+    STRCMP_EQUAL(fits.c_str(), key_text(k.schema, key).data());
+    Rpi4Keys fresh;
+    const std::string was = key_text(fresh.schema, key).data();
+    CHECK_FALSE_TEXT(
+        apply_config_text(head + full + "\"\n", "t.conf", fresh.schema, error, sizeof error),
+        key.name);
+    const std::string why =
+        std::string("t.conf:2: ") + key.table + "." + key.name + " must be 1 to 63 bytes long";
+    STRCMP_EQUAL(why.c_str(), error);
+    STRCMP_EQUAL(was.c_str(), key_text(fresh.schema, key).data());
+    ++checked;
+  }
+  CHECK(checked >= 3);
 }
 
 // The watchdog's timeout stays where a hang restarts the service before the board resets
