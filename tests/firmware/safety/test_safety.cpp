@@ -202,3 +202,13 @@ TEST(Safety, EngagingALatchThatIsAlreadyEngagedStopsTheBaseAgainAndKeepsTheFirst
   CHECK(safety.cause() == StopCause::kButton);
   CHECK_EQUAL(2, base.stops);
 }
+
+TEST(Safety, ClearingWhenNoStopIsLatchedLeavesABaseThatStoppedForAFaultStopped) {
+  base.health_ = boticelli::hal::BaseHealth::kStopped;  // the base stopped itself: a fault
+  CHECK(safety.clear() == nullptr);                     // clear-estop with nothing latched
+  CHECK_FALSE(safety.awaiting_resume());
+  CHECK_FALSE(safety.holds());
+  CHECK(safety.resume() == nullptr);  // nothing waits for it: the base is not asked to resume
+  CHECK_EQUAL(0, base.resume_calls);
+  CHECK(base.health() == boticelli::hal::BaseHealth::kStopped);
+}
