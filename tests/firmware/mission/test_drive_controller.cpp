@@ -363,3 +363,17 @@ TEST(DriveController, ATurnInPlaceFacesTheHeadingAndEndsAtRestWhereItStarted) {
   CHECK(distance_m({d.base.pose.x_m, d.base.pose.y_m}, {1.0F, 1.0F}) < 1e-4F);
   CHECK(std::fabs(d.base.w_rad_s) <= d.controller.params().settle_rate_rad_s);
 }
+
+TEST(DriveController, ABasePushedPastTheEndOfItsStepIsStoppedNotDrivenOn) {
+  for (const float past_m : {0.02F, 0.3F, 2.0F}) {  // beyond the end along the step's line
+    DriveController controller;
+    controller.configure(DriveParams{});
+    controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 0);
+    (void)controller.update({0.0F, 0.0F, 0.0F}, 0.0F, 0.0F, kDt_us);  // facing it already
+    CHECK(controller.status() == DriveStatus::kDriving);
+    const DriveCommand c = controller.update({1.0F + past_m, 0.0F, 0.0F}, 0.3F, 0.0F, 2 * kDt_us);
+    CHECK(controller.status() == DriveStatus::kStopping);
+    DOUBLES_EQUAL(0.0, static_cast<double>(c.v_m_s), 0.0);
+    DOUBLES_EQUAL(0.0, static_cast<double>(c.omega_rad_s), 0.0);
+  }
+}
