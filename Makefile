@@ -11,7 +11,7 @@ FUZZ_SECONDS ?= 60
 .PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze deps-kernel test-kernel run test check \
         bench bench-build format format-check sim asan rpi4 armhf fuzz-build test-sim test-asan \
         test-rpi4 test-fuzz fuzz \
-        analyze mutants clean
+        analyze mutants mutation-score clean
 
 help:
 	@echo "make run       install deps, build the sim preset, run the firmware on the sim board"
@@ -26,6 +26,7 @@ help:
 	@echo "make fuzz      run every libFuzzer target for FUZZ_SECONDS (default 60) each"
 	@echo "make analyze   clang-tidy and cppcheck over the tree (zero findings expected)"
 	@echo "make mutants   apply each tools/mutants patch to a scratch copy; all must be caught"
+	@echo "make mutation-score FILES=... N=30 SEED=1   machine-made mutants: caught / survived per file"
 
 deps:
 	@toolchain/install-deps.sh
@@ -105,6 +106,15 @@ analyze: deps-analyze deps-cross
 
 mutants: deps
 	JOBS=$(JOBS) tools/mutants/run.sh
+
+# Mutation score (docs/testing.md): N machine-made mutants per file of FILES, sampled with SEED,
+# each built and tested in a scratch copy against the binaries tools/mutation_map.txt names.
+# Not part of make test. JSON=1 prints JSON instead of the table.
+FILES ?= firmware/safety/safety.cpp
+N ?= 30
+SEED ?= 1
+mutation-score: deps
+	JOBS=$(JOBS) python3 tools/mutation_score.py --n $(N) --seed $(SEED) $(if $(JSON),--json) $(FILES)
 
 # The checks that read the code instead of running it (docs/testing.md).
 check: deps
