@@ -377,3 +377,32 @@ TEST(DriveController, ABasePushedPastTheEndOfItsStepIsStoppedNotDrivenOn) {
     DOUBLES_EQUAL(0.0, static_cast<double>(c.omega_rad_s), 0.0);
   }
 }
+
+TEST(DriveController, ABaseThatDoesNotMoveTimesOutAfterTheTurnFromItsOwnHeading) {
+  d.base.stuck = true;
+  d.base.pose = {0.0F, 0.0F, 1.0F};  // facing 1 rad; the end is a quarter turn to its left
+  const float heading = 1.0F + 1.5708F;
+  d.start({std::cos(heading), std::sin(heading)});
+  const DriveParams& p = d.controller.params();
+  const float nominal_s = 1.5708F / p.max_turn_rate_rad_s + 1.0F / p.max_speed_m_s +
+                          2.0F * p.max_speed_m_s / p.accel_m_s2 + 1.0F;
+  d.run(120.0F);
+  STRCMP_EQUAL("step timed out", d.controller.failure());
+  const float took_s = static_cast<float>(d.log.periods) * kDt_s;
+  CHECK(took_s >= nominal_s * p.timeout_factor - 0.05F);
+  CHECK(took_s <= nominal_s * p.timeout_factor + 0.05F);
+}
+
+TEST(DriveController, ATurnInPlaceOnABaseThatDoesNotMoveTimesOutAfterItsNominalTimeTimesTheFactor) {
+  d.base.stuck = true;
+  d.base.pose = {0.0F, 0.0F, 0.5F};
+  d.controller.start_turn(d.base.pose, 0.5F + 1.5708F, d.now_us);
+  const DriveParams& p = d.controller.params();
+  const float nominal_s = 1.5708F / p.max_turn_rate_rad_s + 1.0F;  // the turn, then 1 s
+  d.run(120.0F);
+  CHECK(d.controller.status() == DriveStatus::kFailed);
+  STRCMP_EQUAL("step timed out", d.controller.failure());
+  const float took_s = static_cast<float>(d.log.periods) * kDt_s;
+  CHECK(took_s >= nominal_s * p.timeout_factor - 0.05F);
+  CHECK(took_s <= nominal_s * p.timeout_factor + 0.05F);
+}
