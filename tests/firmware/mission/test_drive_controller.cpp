@@ -406,3 +406,48 @@ TEST(DriveController, ATurnInPlaceOnABaseThatDoesNotMoveTimesOutAfterItsNominalT
   CHECK(took_s >= nominal_s * p.timeout_factor - 0.05F);
   CHECK(took_s <= nominal_s * p.timeout_factor + 0.05F);
 }
+
+TEST(DriveController, ATurnEndsFacingTheHeadingWhileStillTurningSlowerThanTenTimesTheSettleRate) {
+  const DriveParams p{};
+  const float limit = 10.0F * p.settle_rate_rad_s;  // 0.2 rad/s
+  for (const float omega : {0.75F * limit, 1.5F * limit}) {
+    DriveController controller;
+    controller.configure(p);
+    controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 0);
+    (void)controller.update({0.0F, 0.0F, 0.0F}, 0.0F, omega, kDt_us);  // facing, still turning
+    CHECK(controller.status() == (omega <= limit ? DriveStatus::kDriving : DriveStatus::kTurning));
+  }
+}
+
+TEST(DriveController, WithinFiveCentimetresOfTheEndItSteersToTheStepsHeadingNotToTheEndPoint) {
+  // 1 cm left of the line, facing along it: far from the end it turns towards the end point,
+  // within 5 cm it holds the heading (turning there would swing the base round the point).
+  for (const float left_m : {0.04F, 0.07F}) {
+    DriveController controller;
+    controller.configure(DriveParams{});
+    controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 0);
+    (void)controller.update({0.0F, 0.0F, 0.0F}, 0.0F, 0.0F, kDt_us);
+    CHECK(controller.status() == DriveStatus::kDriving);
+    const DriveCommand c = controller.update({1.0F - left_m, 0.01F, 0.0F}, 0.1F, 0.0F, 2 * kDt_us);
+    CHECK(c.v_m_s > 0.0F);
+    if (left_m < 0.05F) {
+      DOUBLES_EQUAL(0.0, static_cast<double>(c.omega_rad_s), 0.0);
+    } else {
+      CHECK(c.omega_rad_s < -0.1F);  // right, towards the end point
+    }
+  }
+}
+
+TEST(DriveController, AtExactlyThePositionToleranceFromTheEndTheStepIsDone) {
+  DriveParams p{};
+  p.position_tolerance_m = 0.25F;  // exact in binary, as are the positions below
+  DriveController controller;
+  controller.configure(p);
+  controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 0);
+  (void)controller.update({0.0F, 0.0F, 0.0F}, 0.0F, 0.0F, kDt_us);
+  (void)controller.update({0.5F, 0.0F, 0.0F}, 0.2F, 0.0F, 2 * kDt_us);
+  CHECK(controller.status() == DriveStatus::kDriving);  // 0.5 m to go
+  const DriveCommand c = controller.update({0.75F, 0.0F, 0.0F}, 0.2F, 0.0F, 3 * kDt_us);
+  CHECK(controller.status() == DriveStatus::kStopping);
+  DOUBLES_EQUAL(0.0, static_cast<double>(c.v_m_s), 0.0);
+}
