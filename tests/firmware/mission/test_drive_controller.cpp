@@ -451,3 +451,39 @@ TEST(DriveController, AtExactlyThePositionToleranceFromTheEndTheStepIsDone) {
   CHECK(controller.status() == DriveStatus::kStopping);
   DOUBLES_EQUAL(0.0, static_cast<double>(c.v_m_s), 0.0);
 }
+
+TEST(DriveController, ThePeriodThatEndsTheTurnCommandsRestSoTheLegStartsFromIt) {
+  DriveController controller;
+  controller.configure(DriveParams{});
+  controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 0);
+  const DriveCommand c = controller.update({0.0F, 0.0F, 0.01F}, 0.0F, 0.0F, kDt_us);
+  CHECK(controller.status() == DriveStatus::kDriving);
+  DOUBLES_EQUAL(0.0, static_cast<double>(c.v_m_s), 0.0);
+  DOUBLES_EQUAL(0.0, static_cast<double>(c.omega_rad_s), 0.0);
+}
+
+TEST(DriveController, ThePeriodThatFindsTheBaseOffTheStepsLineCommandsAStop) {
+  DriveController controller;
+  controller.configure(DriveParams{});
+  controller.start({0.0F, 0.0F, 0.0F}, {2.0F, 0.0F}, 0);
+  (void)controller.update({0.0F, 0.0F, 0.0F}, 0.0F, 0.0F, kDt_us);
+  const DriveCommand c = controller.update({1.0F, 0.1F, 0.0F}, 0.3F, 0.0F, 2 * kDt_us);
+  CHECK(controller.status() == DriveStatus::kStopping);
+  DOUBLES_EQUAL(0.0, static_cast<double>(c.v_m_s), 0.0);
+  DOUBLES_EQUAL(0.0, static_cast<double>(c.omega_rad_s), 0.0);
+}
+
+TEST(DriveController, ANewTurnForgetsTheFailureOfTheStepBeforeIt) {
+  DriveController controller;
+  controller.configure(DriveParams{});
+  controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 0);
+  controller.abort("operator");
+  (void)controller.update({0.0F, 0.0F, 0.0F}, 0.0F, 0.0F, kDt_us);
+  CHECK(controller.status() == DriveStatus::kFailed);
+  controller.start_turn({0.0F, 0.0F, 0.0F}, 1.0F, 2 * kDt_us);
+  STRCMP_EQUAL("", controller.failure());
+  controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 3 * kDt_us);
+  controller.abort("operator");
+  controller.start({0.0F, 0.0F, 0.0F}, {1.0F, 0.0F}, 4 * kDt_us);
+  STRCMP_EQUAL("", controller.failure());
+}
