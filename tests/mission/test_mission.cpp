@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "algo/core/geometry.h"
+#include "firmware/common/board_config.h"
 #include "firmware/executive/executive.h"
 #include "firmware/app/firmware_main.h"
 #include "hal/sim/world.h"
@@ -43,6 +44,7 @@ struct MissionRun {
   double target_error_m = -1.0;
   bool telemetry_confirmed = false;     // a TLM line reported the target confirmed
   boticelli::core::Pose2 final_pose{};  // the robot's true pose when the firmware returned
+  boticelli::core::Point2 target{};     // the true target (its foot on the floor)
 };
 
 std::string slurp(const std::string& path) {
@@ -86,6 +88,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(argv.size()), argv.data(),
                                                      g_board, hooks);
   run.final_pose = g_board.robot_pose();
+  run.target = {g_board.target_m().x(), g_board.target_m().y()};
   std::fflush(stdout);
   dup2(saved, 1);
   dup2(saved_in, 0);
@@ -133,6 +136,15 @@ void check_found_safely(const MissionRun& r) {
   CHECK_TEXT(r.check.max_gap_s <= 0.1001, "a trace row at least every 0.1 s");
   CHECK_TEXT(r.target_error_m >= 0.0 && r.target_error_m <= 0.3, r.mission_line.c_str());
   CHECK_TEXT(r.telemetry_confirmed, "telemetry shows the confirmed target");
+  // Where the robot stopped, not only where it thinks the target is: within the stand-off
+  // (and its arrival tolerance) of the estimate, which is within 0.3 m of the truth, with
+  // 0.1 m for the odometry.
+  const boticelli::firmware::BoardConfig defaults;
+  const float stopped_m =
+      boticelli::core::distance_m({r.final_pose.x_m, r.final_pose.y_m}, r.target);
+  const std::string why =
+      r.mission_line + " stopped " + std::to_string(stopped_m) + " m from the true target";
+  CHECK_TEXT(stopped_m <= defaults.goal_standoff_m + 0.05F + 0.3F + 0.1F, why.c_str());
 }
 
 }  // namespace
