@@ -429,8 +429,8 @@ void Mission::control_drive(std::uint64_t now_us) {
   const core::Pose2 here = pose_.pose();
   planner_.visited({here.x_m, here.y_m});
   // The robot's disc stood everywhere along the move: nothing stands there.
-  map_.swept({drive_from_.x_m, drive_from_.y_m}, {here.x_m, here.y_m}, config_.robot_radius_m,
-             params_.fusion.free_delta);
+  (void)map_.swept({drive_from_.x_m, drive_from_.y_m}, {here.x_m, here.y_m},
+                   config_.robot_radius_m);
   if (tracker_.confirmed()) {
     const Eigen::Vector3f& g = tracker_.estimate_m();
     if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=

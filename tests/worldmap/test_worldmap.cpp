@@ -152,6 +152,8 @@ TEST(LookFusion, TheFreePolygonIsFreeAndTheEvidenceBehindItsBoundaryOccupied) {
   CHECK(g_map.state(g_map.cell_of({2.6F, -0.5F})) == wm::CellState::kFree);
   CHECK(g_map.state(g_map.cell_of({3.2F, -1.0F})) == wm::CellState::kUnknown);
   CHECK(g_map.state(g_map.cell_of({2.0F, 0.32F})) == wm::CellState::kOccupied);
+  // The strip between the polygon's boundary (1 m) and the evidence (1.32 m) was in view.
+  CHECK(g_map.state(g_map.cell_of({2.0F, 0.17F})) == wm::CellState::kFree);
   CHECK(g_map.state(g_map.cell_of({2.0F, -2.3F})) == wm::CellState::kUnknown);
   CHECK(g_fusion.free_cells() > 1000);
   CHECK(g_fusion.occupied_cells() >= 2);

@@ -8,6 +8,7 @@ namespace boticelli::firmware::mission {
 void MapStage::start(const MissionState& state, const worldmap::GridMapParams& grid) {
   map_.clear();
   grid_.configure(grid);
+  swept_.clear();
   has_prior_look_ = false;  // a resumed mission's first look has none
   for (const core::Point2& p : state.obstacles) (void)map_.obstacles().push_back(p);
   for (const core::Point2& p : state.exploration) (void)map_.exploration().push_back(p);
@@ -65,6 +66,14 @@ void MapStage::fuse(const core::Pose2& look_pose, const FuseParams& params,
   // only draw the robot into a corner: move it clear, toward where the robot looked from.
   (void)map_.clear_exploration({look_pose.x_m, look_pose.y_m}, params.robot_radius_m, radius,
                                params.points);
+}
+
+void MapStage::begin_grid(const core::Pose2& look_pose, const worldmap::LookFusionParams& params) {
+  for (const Swept& s : swept_) {
+    worldmap::sweep_disc(grid_, s.from, s.to, s.radius_m, params.free_delta);
+  }
+  swept_.clear();
+  fusion_.start(grid_, look_pose, builder_.map().free, builder_.evidence(), params);
 }
 
 void MapStage::save(MissionState& state) const {

@@ -117,3 +117,25 @@ TEST(MapStage, ASightingWithinTheLookRadiusAndTheStandOffGetsNoPoint) {
   look_at(pose, &candidate);
   CHECK_EQUAL(0U, near(stage->global().exploration(), {0.75F, 0.0F}, 0.3F));
 }
+
+TEST(MapStage, AMovesSweptDiscIsWrittenIntoTheGridWithTheNextLookNotBefore) {
+  stage->start(*state, {});
+  CHECK(stage->swept({0.0F, 0.0F}, {1.0F, 0.0F}, 0.2F));
+  const auto free_at = [&](float x, float y) {
+    return stage->grid().state(stage->grid().cell_of({x, y})) ==
+           boticelli::worldmap::CellState::kFree;
+  };
+  CHECK_FALSE(free_at(0.5F, 0.1F));  // noted on the mission task, written in the background
+  look_at({5.0F, 5.0F, 0.0F}, nullptr);
+  stage->begin_grid({5.0F, 5.0F, 0.0F}, {});
+  while (!stage->grid_done()) stage->grid_unit();
+  CHECK(free_at(0.5F, 0.1F));
+  CHECK(free_at(1.1F, 0.0F));
+  CHECK_FALSE(free_at(0.5F, 0.35F));
+  // Written once: a restart forgets what was noted.
+  CHECK(stage->swept({0.0F, 2.0F}, {1.0F, 2.0F}, 0.2F));
+  stage->start(*state, {});
+  stage->begin_grid({5.0F, 5.0F, 0.0F}, {});
+  while (!stage->grid_done()) stage->grid_unit();
+  CHECK_FALSE(free_at(0.5F, 2.0F));
+}

@@ -71,7 +71,7 @@ class NavPlanner {
   NavPlanner(const NavPlanner&) = delete;
   NavPlanner& operator=(const NavPlanner&) = delete;
 
-  // A new mission: no goal, nothing blacklisted.
+  // A mission (re)starts: no goal, nothing blacklisted.
   void reset();
   // A plan from `robot` (mission frame) on `map` (which must not change until done()).
   void start(const GridMap& map, core::Point2 robot, const NavParams& params);

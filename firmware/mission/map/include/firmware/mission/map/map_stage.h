@@ -43,16 +43,16 @@ class MapStage {
   // exploration point at the stand-off; exploration points the robot cannot reach moved clear.
   void fuse(const core::Pose2& look_pose, const FuseParams& params,
             const Eigen::Vector3f* candidate);
-  // The look's free polygon and the evidence backing it into the grid, in units: start, then
-  // grid_unit() until grid_done().
-  void begin_grid(const core::Pose2& look_pose, const worldmap::LookFusionParams& params) {
-    fusion_.start(grid_, look_pose, builder_.map().free, builder_.evidence(), params);
-  }
+  // The moves swept since the last look, then the look's free polygon and the evidence
+  // backing it, into the grid (background), in units: start, then grid_unit() until
+  // grid_done().
+  void begin_grid(const core::Pose2& look_pose, const worldmap::LookFusionParams& params);
   void grid_unit() { (void)fusion_.run_unit(); }
   [[nodiscard]] bool grid_done() const { return fusion_.done(); }
-  // The robot's disc drove from `from` to `to`: those cells are free.
-  void swept(core::Point2 from, core::Point2 to, float radius_m, int delta) {
-    worldmap::sweep_disc(grid_, from, to, radius_m, delta);
+  // The robot's disc (radius_m) drove from `from` to `to`: those cells are free. Only noted
+  // here (the mission task calls it); begin_grid() writes them. False if the note was full.
+  bool swept(core::Point2 from, core::Point2 to, float radius_m) {
+    return swept_.push_back({from, to, radius_m});
   }
   [[nodiscard]] const worldmap::GridMap& grid() const { return grid_; }
   // Copies the global lists into the state (as many as it holds).
@@ -71,6 +71,12 @@ class MapStage {
   mapping::GlobalMap map_;
   worldmap::GridMap grid_;
   worldmap::LookFusion fusion_;
+  struct Swept {
+    core::Point2 from;
+    core::Point2 to;
+    float radius_m;
+  };
+  core::FixedVector<Swept, 16> swept_;  // moves since the last look (a few steps a look)
   core::FixedVector<core::Point2, mapping::kMaxObstaclePoints> cycle_obstacles_;
   core::FixedVector<core::Point2, mapping::kMaxExplorationPoints> cycle_exploration_;
 };
