@@ -16,6 +16,7 @@
 #include "firmware/executive/host_timing_text.h"
 #include "firmware/common/log.h"
 #include "firmware/mission/mission.h"
+#include "firmware/telemetry/map_export.h"
 #include "firmware/telemetry/trace_writer.h"
 #include "firmware/state/mission_state.h"
 #include "firmware/app/options.h"
@@ -412,6 +413,15 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
   console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
               mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
+  {
+    // The world memory: what it holds and costs, and how the frontier search went.
+    const MapCounts m = mission.map_counts();
+    console.log(LogLevel::kInfo,
+                "mission map planner=%s grid_tiles=%u grid_bytes=%u free_m2=%.2f occupied_m2=%.2f "
+                "grid_dropped=%u blacklisted=%u",
+                mission.planner_name(), m.grid_tiles, m.grid_bytes, static_cast<double>(m.free_m2),
+                static_cast<double>(m.occupied_m2), m.grid_dropped, m.blacklisted);
+  }
   if (mission.guard_truncated_looks() > 0) {
     console.log(LogLevel::kWarn, "mission guard_truncated_looks=%u (a full list dropped readings)",
                 static_cast<unsigned>(mission.guard_truncated_looks()));
@@ -441,6 +451,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
     hal.clock.sleep_until_us(hal.clock.now_us() + 2000U);
   }
   mission.finish_saving();
+  if (options.map_prefix != nullptr &&
+      !write_map_files(mission.grid(), options.map_prefix, error, sizeof error)) {
+    slog.log(LogLevel::kError, "%s", error);
+  }
   if (rt.saver.failures() > 0) {
     rt.saver.last_error(error, sizeof error);
     slog.log(LogLevel::kError, "%llu state saves failed, last: %s",

@@ -65,6 +65,8 @@ const char* usage_text() {
          "  --max-cycles N      stop after N Look-Think-Drive cycles (default: no limit)\n"
          "  --snapshots DIR     write a picture of the map after each cycle into DIR\n"
          "  --trace FILE        write the robot's path as CSV to FILE\n"
+         "  --map PREFIX        at the end, write the world memory (grid) as PREFIX.pgm and\n"
+         "                      PREFIX.yaml (ROS map_server's format)\n"
          "  --console KIND      stdio (default), pty, or the PATH of a serial device\n"
          "  --config FILE       read the configuration from FILE (default on the robot:\n"
          "                      /etc/boticelli/boticelli.conf, if it exists)\n"
@@ -122,6 +124,10 @@ ParseResult parse_options(int argc, const char* const* argv, bool simulated, Opt
       if (!value(out.snapshots_dir)) return fail("option ", arg, " needs a DIR");
     } else if (std::strcmp(arg, "--trace") == 0) {
       if (!value(out.trace_file)) return fail("option ", arg, " needs a FILE");
+    } else if (std::strcmp(arg, "--map") == 0) {
+      if (!value(out.map_prefix) || *out.map_prefix == '\0') {
+        return fail("option ", arg, " needs a PREFIX");
+      }
     } else if (std::strcmp(arg, "--config") == 0) {
       if (!value(out.config_file) || *out.config_file == '\0') {
         return fail("option ", arg, " needs a FILE");

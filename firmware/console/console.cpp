@@ -23,7 +23,7 @@ const Console::Command Console::kCommands[] = {
      &Console::cmd_stats},
     {"pose", "", "robot pose in the world frame", &Console::cmd_pose},
     {"model", "", "the occupancy ALN in the text format", &Console::cmd_model},
-    {"map", "", "navigation polygon and point list sizes", &Console::cmd_map},
+    {"map", "", "world memory (grid) summary, frontiers, goal, polygon, target", &Console::cmd_map},
     {"pause", "", "pause the background work (mission)", &Console::cmd_pause},
     {"resume", "", "after pause or clear-estop: the background work and the base go on",
      &Console::cmd_resume},
@@ -257,6 +257,18 @@ void append_target(TextBufferBase& out, const TargetEstimate& t) {
 
 }  // namespace
 
+const char* goal_kind_name(GoalKind kind) {
+  switch (kind) {
+    case GoalKind::kNone:
+      return "none";
+    case GoalKind::kFrontier:
+      return "frontier";
+    case GoalKind::kTarget:
+      return "target";
+  }
+  return "unknown";
+}
+
 const char* target_status_name(TargetStatus status) {
   switch (status) {
     case TargetStatus::kNone:
@@ -403,6 +415,15 @@ void Console::cmd_map(const Words& w) {
   const MapCounts m = view_.map_counts();
   reply_.appendf("map polygon_vertices=%u obstacle_points=%u exploration_points=%u",
                  m.polygon_vertices, m.obstacle_points, m.exploration_points);
+  reply_.appendf(" grid_tiles=%u grid_bytes=%u free_m2=%.2f occupied_m2=%.2f grid_dropped=%u",
+                 m.grid_tiles, m.grid_bytes, static_cast<double>(m.free_m2),
+                 static_cast<double>(m.occupied_m2), m.grid_dropped);
+  reply_.appendf(" frontiers=%u blacklisted=%u goal=%s", m.frontiers, m.blacklisted,
+                 goal_kind_name(m.goal));
+  if (m.goal != GoalKind::kNone) {
+    reply_.appendf(" goal_x_m=%.3f goal_y_m=%.3f goal_path_m=%.2f", static_cast<double>(m.goal_x_m),
+                   static_cast<double>(m.goal_y_m), static_cast<double>(m.goal_path_m));
+  }
   append_target(reply_, view_.target());
   reply_.append("\r\nOK\r\n");
   emit(reply_.view());

@@ -174,6 +174,22 @@ MapCounts Mission::map_counts() const {
   m.polygon_vertices = static_cast<std::uint32_t>(map_.local().free.vertex_count());
   m.obstacle_points = static_cast<std::uint32_t>(map_.global().obstacles().size());
   m.exploration_points = static_cast<std::uint32_t>(map_.global().exploration().size());
+  const worldmap::GridMap& grid = map_.grid();
+  const float cell_m2 = grid.cell_m() * grid.cell_m();
+  m.grid_tiles = static_cast<std::uint32_t>(grid.tiles_used());
+  m.grid_bytes = static_cast<std::uint32_t>(grid.bytes());
+  m.free_m2 = static_cast<float>(grid.free_cells()) * cell_m2;
+  m.occupied_m2 = static_cast<float>(grid.occupied_cells()) * cell_m2;
+  m.grid_dropped = static_cast<std::uint32_t>(grid.dropped());
+  m.frontiers = static_cast<std::uint32_t>(planner_.nav().frontiers().size());
+  m.blacklisted = static_cast<std::uint32_t>(planner_.blacklisted());
+  const worldmap::NavChoice& choice = planner_.nav_choice();
+  m.goal = choice.kind == worldmap::NavGoalKind::kFrontier ? GoalKind::kFrontier
+           : choice.kind == worldmap::NavGoalKind::kTarget ? GoalKind::kTarget
+                                                           : GoalKind::kNone;
+  m.goal_x_m = choice.goal.x_m;
+  m.goal_y_m = choice.goal.y_m;
+  m.goal_path_m = choice.path_m;
   return m;
 }
 

@@ -125,6 +125,35 @@ TEST(GridMap, AnExhaustedPoolOrACellOutsideTheGridIsDroppedAndCounted) {
   LONGS_EQUAL(2, g_map.tiles_used());
 }
 
+TEST(GridMap, TheFreeAndOccupiedCountsMatchAScanOfEveryCell) {
+  std::uint64_t rng = 7;
+  for (int i = 0; i < 4000; ++i) {
+    rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
+    const wm::Cell c{static_cast<int>((rng >> 33) % 90) - 45,
+                     static_cast<int>((rng >> 45) % 90) - 45};
+    (void)g_map.add(c, static_cast<int>((rng >> 20) % 13) - 6);
+  }
+  std::size_t free = 0, occupied = 0;
+  for (int iy = -48; iy < 48; ++iy) {
+    for (int ix = -48; ix < 48; ++ix) {
+      free += g_map.state({ix, iy}) == wm::CellState::kFree ? 1U : 0U;
+      occupied += g_map.state({ix, iy}) == wm::CellState::kOccupied ? 1U : 0U;
+    }
+  }
+  CHECK(free > 100 && occupied > 100);
+  LONGS_EQUAL(free, g_map.free_cells());
+  LONGS_EQUAL(occupied, g_map.occupied_cells());
+  wm::Cell lo, hi;
+  CHECK(g_map.tile_bounds(lo, hi));
+  LONGS_EQUAL(-48, lo.ix);
+  LONGS_EQUAL(-48, lo.iy);
+  LONGS_EQUAL(48, hi.ix);
+  LONGS_EQUAL(48, hi.iy);
+  g_map.clear();
+  LONGS_EQUAL(0, g_map.free_cells());
+  CHECK_FALSE(g_map.tile_bounds(lo, hi));
+}
+
 TEST(GridMap, PointsMapToTheCellsThatHoldThem) {
   const wm::Cell c = g_map.cell_of({-0.01F, 0.07F});
   LONGS_EQUAL(-1, c.ix);

@@ -1,4 +1,5 @@
-// Benchmark suite "mission": the firmware binary run on every shipped world, checked against it.
+// Benchmark suite "mission": the firmware binary run on every shipped and test world, per seed and
+// planner, checked against each world's geometry.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -16,6 +17,8 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <thread>
+#include <atomic>
 #include <vector>
 
 #include "algo/aln/text_format.h"
@@ -26,6 +29,7 @@
 #include "board_config.h"
 #include "firmware/state/mission_state.h"
 #include "firmware/state/persistence.h"
+#include "algo/core/geometry.h"
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
 
@@ -51,6 +55,7 @@ struct MissionLine {
   double think_s = std::numeric_limits<double>::quiet_NaN();
   double plan_s = std::numeric_limits<double>::quiet_NaN();
   std::string longest_line;  // "LOG info mission longest_ms view=… task=…"
+  std::string map_line;      // "LOG info mission map planner=… grid_bytes=… …"
 };
 
 // The longest unit of each kind, as the firmware names them (mission::unit_name).
@@ -93,6 +98,8 @@ MissionLine parse_output(const std::string& path) {
     } else if (const std::size_t at = line.find("LOG info stopping: "); at != std::string::npos) {
       m.end_reason = line.substr(at + 19);
       std::replace(m.end_reason.begin(), m.end_reason.end(), '"', '\'');
+    } else if (line.find("LOG info mission map ") != std::string::npos) {
+      m.map_line = line;
     } else if (line.find("LOG info mission longest_ms ") != std::string::npos) {
       m.longest_line = line;
     } else if (line.find("LOG info mission cpu ") != std::string::npos) {
@@ -172,6 +179,169 @@ std::size_t grid_bytes(const hal::sim::World& w) {
 
 hal::sim::World g_world;
 
+constexpr double kReversalStrideM = 0.25;  // the path is read in stretches this long [m]
+constexpr double kReversalCos = -0.7071;   // a turn of more than 135° between two stretches
+constexpr double kObstacleOffM = 0.3;      // an occupied cell farther than this from a surface
+
+// Times the direction of travel reversed: the true path resampled every kReversalStrideM of
+// travel, and a reversal where one stretch's direction and the next differ by more than 135°
+// (driving back the way it came; a turn in place between two steps counts as its outcome).
+std::size_t reversals(const std::vector<hal::sim::TraceRow>& rows) {
+  struct Mark {
+    double x, y;
+  };
+  std::vector<Mark> marks;
+  if (rows.empty()) return 0;
+  marks.push_back({rows[0].x_m, rows[0].y_m});
+  for (const hal::sim::TraceRow& r : rows) {
+    if (std::hypot(r.x_m - marks.back().x, r.y_m - marks.back().y) >= kReversalStrideM) {
+      marks.push_back({r.x_m, r.y_m});
+    }
+  }
+  std::size_t count = 0;
+  for (std::size_t i = 2; i < marks.size(); ++i) {
+    const double ax = marks[i - 1].x - marks[i - 2].x, ay = marks[i - 1].y - marks[i - 2].y;
+    const double bx = marks[i].x - marks[i - 1].x, by = marks[i].y - marks[i - 1].y;
+    const double c = (ax * bx + ay * by) / (std::hypot(ax, ay) * std::hypot(bx, by));
+    count += c < kReversalCos ? 1U : 0U;
+  }
+  return count;
+}
+
+// The mission frame in the world: the first trace row's true pose composed with the inverse
+// of its odometry pose (the odo_* columns; the frame is the odometry's at the base's start).
+bool mission_frame(const std::string& trace, core::Pose2& origin) {
+  const std::string text = read_file(trace);
+  const std::size_t eol = text.find('\n');
+  if (eol == std::string::npos) return false;
+  std::vector<std::string> names;
+  std::vector<double> values;
+  std::size_t at = 0;
+  const std::string header = text.substr(0, eol);
+  while (at <= header.size()) {
+    const std::size_t comma = std::min(header.find(',', at), header.size());
+    names.push_back(header.substr(at, comma - at));
+    at = comma + 1;
+  }
+  const std::size_t eol2 = text.find('\n', eol + 1);
+  const std::string row =
+      text.substr(eol + 1, eol2 == std::string::npos ? std::string::npos : eol2 - eol - 1);
+  at = 0;
+  while (at <= row.size()) {
+    const std::size_t comma = std::min(row.find(',', at), row.size());
+    values.push_back(std::strtod(row.substr(at, comma - at).c_str(), nullptr));
+    at = comma + 1;
+  }
+  const auto value = [&](const char* name, double& v) {
+    for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) {
+      if (names[i] == name) {
+        v = values[i];
+        return true;
+      }
+    }
+    return false;
+  };
+  double x = 0, y = 0, yaw = 0, ox = 0, oy = 0, oyaw = 0;
+  if (!value("x_m", x) || !value("y_m", y) || !value("yaw_rad", yaw) || !value("odo_x_m", ox) ||
+      !value("odo_y_m", oy) || !value("odo_yaw_rad", oyaw)) {
+    return false;
+  }
+  const double ryaw = yaw - oyaw;
+  const double c = std::cos(ryaw), s = std::sin(ryaw);
+  origin = {static_cast<float>(x - (c * ox - s * oy)), static_cast<float>(y - (s * ox + c * oy)),
+            static_cast<float>(ryaw)};
+  return true;
+}
+
+// The map the firmware wrote (--map PREFIX: PGM + map_server YAML) against the world: occupied
+// cells, and how many lie more than kObstacleOffM from any true surface in the robot's height.
+struct MapCheck {
+  bool ok = false;
+  std::size_t occupied = 0;
+  std::size_t off = 0;
+};
+
+MapCheck check_map(const std::string& prefix, const core::Pose2& origin, float height_m) {
+  MapCheck out;
+  const std::string yaml = read_file(prefix + ".yaml");
+  const std::string pgm = read_file(prefix + ".pgm");
+  double cell = 0, ox = 0, oy = 0;
+  const std::size_t r = yaml.find("resolution: ");
+  const std::size_t o = yaml.find("origin: [");
+  if (r == std::string::npos || o == std::string::npos ||
+      std::sscanf(yaml.c_str() + r, "resolution: %lf", &cell) != 1 ||
+      std::sscanf(yaml.c_str() + o, "origin: [%lf, %lf", &ox, &oy) != 2 || cell <= 0) {
+    return out;
+  }
+  int width = 0, height = 0, maxval = 0, header = 0;
+  if (std::sscanf(pgm.c_str(), "P5\n%d %d\n%d\n%n", &width, &height, &maxval, &header) != 3 ||
+      width <= 0 || height <= 0 ||
+      pgm.size() != static_cast<std::size_t>(header) + static_cast<std::size_t>(width * height)) {
+    return out;
+  }
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      if (static_cast<unsigned char>(pgm[static_cast<std::size_t>(header + row * width + col)]) !=
+          0) {
+        continue;
+      }
+      ++out.occupied;
+      const core::Point2 p{static_cast<float>(ox + (col + 0.5) * cell),
+                           static_cast<float>(oy + (height - 1 - row + 0.5) * cell)};
+      const core::Point2 w = core::to_world(origin, p);
+      out.off += disc_clearance_m(g_world, w.x_m, w.y_m, 0.0F, height_m) >
+                         static_cast<float>(kObstacleOffM)
+                     ? 1U
+                     : 0U;
+    }
+  }
+  out.ok = true;
+  return out;
+}
+
+// One firmware run: a world of a set, a seed and a planner.
+struct Run {
+  std::string set;    // "shipped" or "tests"
+  std::string world;  // its path in the repository
+  std::string name;   // its file name without .sdf
+  std::string path;   // where it is read from
+  long seed = 1;
+  std::string planner;  // "thesis" or "frontier"
+  std::string dir;      // the run's outputs
+  int exit_code = -1;
+  bool timed_out = false;
+  double cpu_s = 0.0;
+  double wall_s = 0.0;
+};
+
+// Per set and planner, over its runs.
+struct Tally {
+  std::size_t runs = 0;
+  std::size_t found = 0;
+  std::size_t contacts = 0;
+  double spl_sum = 0.0;
+  double found_sim_s = 0.0;
+};
+
+std::vector<long> seed_list() {
+  std::vector<long> seeds;
+  const char* list = std::getenv("BOTICELLI_MISSION_SEEDS");
+  if (list == nullptr || *list == '\0') {
+    const long one = env_long("BOTICELLI_MISSION_SEED", 0);
+    if (one > 0) return {one};
+    return {1, 2, 3};
+  }
+  const char* p = list;
+  while (*p != '\0') {
+    char* end = nullptr;
+    const long v = std::strtol(p, &end, 10);
+    if (end == p) break;
+    if (v > 0) seeds.push_back(v);
+    p = *end == ',' ? end + 1 : end;
+  }
+  return seeds.empty() ? std::vector<long>{1} : seeds;
+}
+
 int run() {
   const std::string bin_dir = own_directory();
   const std::string firmware_bin = bin_dir + "/boticelli";
@@ -181,10 +351,27 @@ int run() {
     return 1;
   }
   const long max_cycles = env_long("BOTICELLI_MISSION_CYCLES", 60);
-  const long seed = env_long("BOTICELLI_MISSION_SEED", 1);
+  const std::vector<long> seeds = seed_list();
   const double timeout_s = static_cast<double>(env_long("BOTICELLI_MISSION_TIMEOUT_S", 900));
+  const long jobs = env_long("BOTICELLI_MISSION_JOBS",
+                             std::max(1L, static_cast<long>(std::thread::hardware_concurrency())));
   const bool keep = std::getenv("BOTICELLI_MISSION_KEEP") != nullptr;
   const firmware::BoardConfig config = boards::sim::make_config();
+  const std::string default_planner = config.thesis_planner ? "thesis" : "frontier";
+  std::vector<std::string> planners;
+  {
+    const char* list = std::getenv("BOTICELLI_MISSION_PLANNERS");
+    for (const char* p : {"thesis", "frontier"}) {
+      if ((list == nullptr || *list == '\0') ? default_planner == p : listed(list, p)) {
+        planners.emplace_back(p);
+      }
+    }
+    if (planners.empty()) {
+      std::fprintf(stderr,
+                   "mission: BOTICELLI_MISSION_PLANNERS lists neither thesis nor frontier\n");
+      return 1;
+    }
+  }
 
   char tmp_template[] = "/tmp/boticelli-mission-XXXXXX";
   const char* tmp = ::mkdtemp(tmp_template);
@@ -193,65 +380,119 @@ int run() {
                  std::strerror(errno));
     return 1;
   }
+  for (const std::string& planner : planners) {
+    const std::string conf = std::string(tmp) + "/" + planner + ".conf";
+    FILE* f = std::fopen(conf.c_str(), "w");
+    if (f == nullptr) {
+      std::fprintf(stderr, "mission: cannot write %s\n", conf.c_str());
+      return 1;
+    }
+    std::fprintf(f, "[mission]\nthesis_planner = %s\n", planner == "thesis" ? "true" : "false");
+    std::fclose(f);
+  }
 
-  const std::string folder = worlds_dir("BOTICELLI_MISSION_WORLDS_DIR", BOTICELLI_WORLDS_DIR);
-  const std::vector<std::string> names = world_names(folder, "BOTICELLI_MISSION_WORLDS", kSuite);
-  std::size_t worlds = 0;
-  std::size_t with_target = 0;
-  std::size_t successes = 0;
-  double spl_sum = 0.0;
-  for (const std::string& name : names) {
-    const std::string world_path = std::string(folder).append("/").append(name).append(".sdf");
+  // The worlds: both sets, or the one folder BOTICELLI_MISSION_WORLDS_DIR names.
+  struct Set {
+    const char* name;
+    std::string dir;
+    std::string prefix;  // the folder's path in the repository
+  };
+  std::vector<Set> sets;
+  if (const char* d = std::getenv("BOTICELLI_MISSION_WORLDS_DIR"); d != nullptr && *d != '\0') {
+    sets.push_back({"custom", d, d});
+  } else {
+    sets.push_back({"shipped", BOTICELLI_WORLDS_DIR, "boards/sim/worlds"});
+    sets.push_back({"tests", BOTICELLI_TEST_WORLDS_DIR, "tests/worlds"});
+  }
+  std::vector<Run> runs;
+  for (const Set& set : sets) {
+    for (const std::string& name : world_names(set.dir, "BOTICELLI_MISSION_WORLDS", kSuite)) {
+      const std::string path = set.dir + "/" + name + ".sdf";
+      char error[256] = "";
+      if (!hal::sim::load_world(path.c_str(), g_world, error, sizeof error)) {
+        std::fprintf(stderr, "mission: %s\n", error);
+        continue;
+      }
+      bool has_target = false;
+      for (std::size_t i = 0; i < g_world.surface_count; ++i) {
+        has_target = has_target || g_world.surfaces[i].target_face != hal::sim::kNoFace;
+      }
+      if (!has_target) {
+        JsonLine(kSuite, name.c_str())
+            .text("world", path.c_str())
+            .text("skipped", "no target")
+            .emit();
+        continue;
+      }
+      for (const std::string& planner : planners) {
+        for (const long seed : seeds) {
+          Run r;
+          r.set = set.name;
+          r.world = set.prefix + "/" + name + ".sdf";
+          r.name = name;
+          r.path = path;
+          r.seed = seed;
+          r.planner = planner;
+          r.dir = std::string(tmp) + "/" + set.name + "-" + name + "-" + planner + "-" +
+                  std::to_string(seed);
+          runs.push_back(r);
+        }
+      }
+    }
+  }
+
+  // The runs, `jobs` at a time (each a process; the host's cores are the limit).
+  std::atomic<std::size_t> next{0};
+  const auto worker = [&]() {
+    for (std::size_t i = next++; i < runs.size(); i = next++) {
+      Run& r = runs[i];
+      ::mkdir(r.dir.c_str(), 0755);
+      const std::vector<std::string> args = {firmware_bin,
+                                             "--world",
+                                             r.path,
+                                             "--seed",
+                                             std::to_string(r.seed),
+                                             "--max-cycles",
+                                             std::to_string(max_cycles),
+                                             "--config",
+                                             std::string(tmp) + "/" + r.planner + ".conf",
+                                             "--trace",
+                                             r.dir + "/trace.csv",
+                                             "--map",
+                                             r.dir + "/map",
+                                             "--console",
+                                             "stdio",
+                                             "--state",
+                                             r.dir + "/state"};
+      const double t0 = wall_s();
+      r.exit_code = run_firmware(args, r.dir + "/console.txt", r.dir + "/stderr.txt", timeout_s,
+                                 r.timed_out, r.cpu_s);
+      r.wall_s = wall_s() - t0;
+    }
+  };
+  {
+    std::vector<std::thread> threads;
+    for (long j = 0; j < std::min<long>(jobs, static_cast<long>(runs.size())); ++j) {
+      threads.emplace_back(worker);
+    }
+    for (std::thread& t : threads) t.join();
+  }
+
+  std::vector<std::pair<std::string, Tally>> tallies;  // "set planner" → tally
+  for (const Run& r : runs) {
     char error[256] = "";
-    if (!hal::sim::load_world(world_path.c_str(), g_world, error, sizeof error)) {
-      std::fprintf(stderr, "mission: %s\n", error);
-      continue;
-    }
-    ++worlds;
-    bool has_target = false;
-    for (std::size_t i = 0; i < g_world.surface_count; ++i) {
-      has_target = has_target || g_world.surfaces[i].target_face != hal::sim::kNoFace;
-    }
-    if (!has_target) {
-      JsonLine(kSuite, name.c_str()).text("skipped", "no target").emit();
-      continue;
-    }
-    ++with_target;
-    const std::string dir = std::string(tmp) + "/" + name;
-    ::mkdir(dir.c_str(), 0755);
-    const std::string trace = dir + "/trace.csv";
-    const std::string out = dir + "/console.txt";
-    const std::string err = dir + "/stderr.txt";
-    const std::string state_dir = dir + "/state";
-    const std::vector<std::string> args = {firmware_bin,
-                                           "--world",
-                                           world_path,
-                                           "--seed",
-                                           std::to_string(seed),
-                                           "--max-cycles",
-                                           std::to_string(max_cycles),
-                                           "--trace",
-                                           trace,
-                                           "--console",
-                                           "stdio",
-                                           "--state",
-                                           state_dir};
-    bool timed_out = false;
-    double cpu_s = 0.0;
-    const double t0 = wall_s();
-    const int exit_code = run_firmware(args, out, err, timeout_s, timed_out, cpu_s);
-    const double wall = wall_s() - t0;
-    const MissionLine m = parse_output(out);
+    if (!hal::sim::load_world(r.path.c_str(), g_world, error, sizeof error)) continue;
+    const MissionLine m = parse_output(r.dir + "/console.txt");
 
     // The trace against the world's geometry (true poses; the robot's cylinder).
     std::vector<hal::sim::TraceRow> rows;
     std::string trace_error;
     hal::sim::TraceCheck check{};
-    const bool trace_ok = hal::sim::read_trace(trace.c_str(), rows, trace_error);
+    const bool trace_ok = hal::sim::read_trace((r.dir + "/trace.csv").c_str(), rows, trace_error);
     if (trace_ok) {
       check = hal::sim::check_trace(g_world, rows, config.robot_radius_m, config.robot_height_m);
     } else {
-      std::fprintf(stderr, "mission: %s: %s\n", name.c_str(), trace_error.c_str());
+      std::fprintf(stderr, "mission: %s: %s\n", r.world.c_str(), trace_error.c_str());
     }
     const core::Point2 start{g_world.start.x_m, g_world.start.y_m};
     const core::Point2 goal{g_world.target_point_m.x(), g_world.target_point_m.y()};
@@ -263,24 +504,47 @@ int run() {
     if (success && std::isfinite(shortest) && std::isfinite(path)) {
       spl = std::max(path, shortest) > 0.0 ? shortest / std::max(path, shortest) : 1.0;
     }
-    successes += success ? 1U : 0U;
-    spl_sum += spl;
     const double compute_s = m.look_s + m.think_s + m.plan_s;
-    const ModelSize size = model_size(state_dir);
+    const ModelSize size = model_size(r.dir + "/state");
+    core::Pose2 origin{};
+    MapCheck map_check{};
+    if (mission_frame(r.dir + "/trace.csv", origin)) {
+      map_check = check_map(r.dir + "/map", origin, config.robot_height_m);
+    }
+    const double free_m2 = field(m.map_line, "free_m2");
 
-    JsonLine line(kSuite, name.c_str());
-    line.text("result", m.result.c_str())
+    const std::string key = r.set + " " + r.planner;
+    auto it =
+        std::find_if(tallies.begin(), tallies.end(), [&](const auto& t) { return t.first == key; });
+    if (it == tallies.end()) {
+      tallies.emplace_back(key, Tally{});
+      it = tallies.end() - 1;
+    }
+    Tally& t = it->second;
+    ++t.runs;
+    t.found += success ? 1U : 0U;
+    t.contacts += trace_ok ? check.collisions : 1U;
+    t.spl_sum += spl;
+    t.found_sim_s += success ? m.sim_time_s : 0.0;
+
+    JsonLine line(kSuite, r.name.c_str());
+    line.text("world", r.world.c_str())
+        .text("set", r.set.c_str())
+        .integer("seed", r.seed)
+        .text("planner", r.planner.c_str())
+        .flag("default", r.planner == default_planner)
+        .text("result", m.result.c_str())
         .text("end_reason", m.end_reason.c_str())
-        .integer("exit_code", exit_code)
-        .flag("timed_out", timed_out)
+        .integer("exit_code", r.exit_code)
+        .flag("timed_out", r.timed_out)
         .integer("cycles", m.cycles)
         .num("path_length_m", path)
         .num("shortest_m", shortest)
         .num("spl", spl)
         .num("sim_time_s", m.sim_time_s)
-        .num("wall_time_s", wall)
+        .num("wall_time_s", r.wall_s)
         .num("firmware_wall_time_s", m.wall_time_s)
-        .num("process_cpu_s", cpu_s)
+        .num("process_cpu_s", r.cpu_s)
         .integer("collisions", trace_ok ? static_cast<std::int64_t>(check.collisions) : -1)
         .integer("firmware_collisions", m.collisions)
         .num("min_clearance_m",
@@ -288,15 +552,27 @@ int run() {
         .num("max_trace_gap_s",
              trace_ok ? check.max_gap_s : std::numeric_limits<double>::quiet_NaN())
         .integer("trace_rows", static_cast<std::int64_t>(check.rows))
+        .integer("reversals", trace_ok ? static_cast<std::int64_t>(reversals(rows)) : -1)
         .num("target_error_m", m.target_error_m)
+        .num("map_bytes", field(m.map_line, "grid_bytes"))
+        .num("map_free_m2", free_m2)
+        .num("path_per_m2_seen",
+             free_m2 > 0.0 ? path / free_m2 : std::numeric_limits<double>::quiet_NaN())
+        .integer("map_occupied_cells",
+                 map_check.ok ? static_cast<std::int64_t>(map_check.occupied) : -1)
+        .num("map_obstacles_off_share",
+             map_check.ok && map_check.occupied > 0
+                 ? static_cast<double>(map_check.off) / static_cast<double>(map_check.occupied)
+                 : std::numeric_limits<double>::quiet_NaN())
+        .num("blacklisted", field(m.map_line, "blacklisted"))
         .num("look_cpu_s", m.look_s)
         .num("think_cpu_s", m.think_s)
         .num("plan_cpu_s", m.plan_s)
         .num("compute_share_of_sim_time", m.sim_time_s > 0.0
                                               ? compute_s / m.sim_time_s
                                               : std::numeric_limits<double>::quiet_NaN())
-        .num("wall_per_sim_s",
-             m.sim_time_s > 0.0 ? wall / m.sim_time_s : std::numeric_limits<double>::quiet_NaN());
+        .num("wall_per_sim_s", m.sim_time_s > 0.0 ? r.wall_s / m.sim_time_s
+                                                  : std::numeric_limits<double>::quiet_NaN());
     if (size.ok) {
       line.integer("model_pieces", static_cast<std::int64_t>(size.pieces))
           .integer("model_bytes", static_cast<std::int64_t>(size.binary_bytes))
@@ -309,31 +585,47 @@ int run() {
       line.num((std::string("longest_") + unit + "_ms").c_str(), field(m.longest_line, unit));
     }
     line.emit();
-    if (!m.found_line || !m.found_cpu) {
-      std::fprintf(stderr, "mission: %s: %s%s (console output in %s)\n", name.c_str(),
-                   m.found_line ? "" : "no MISSION line ", m.found_cpu ? "" : "no cpu line",
-                   out.c_str());
+    if (!m.found_line || !m.found_cpu || m.map_line.empty()) {
+      std::fprintf(stderr, "mission: %s seed %ld %s: %s%s%s (console output in %s)\n",
+                   r.world.c_str(), r.seed, r.planner.c_str(),
+                   m.found_line ? "" : "no MISSION line ", m.found_cpu ? "" : "no cpu line ",
+                   m.map_line.empty() ? "no map line" : "", (r.dir + "/console.txt").c_str());
     }
-    if (!keep) remove_tree(dir);
+    if (!keep) remove_tree(r.dir);
   }
   if (!keep) {
+    for (const std::string& planner : planners) {
+      ::unlink((std::string(tmp) + "/" + planner + ".conf").c_str());
+    }
     ::rmdir(tmp);
   } else {
     std::fprintf(stderr, "mission: outputs kept in %s\n", tmp);
   }
-  JsonLine(kSuite, "summary")
-      .integer("worlds", static_cast<std::int64_t>(worlds))
-      .integer("with_target", static_cast<std::int64_t>(with_target))
-      .integer("found", static_cast<std::int64_t>(successes))
-      .num("mean_spl", with_target > 0 ? spl_sum / static_cast<double>(with_target) : 0.0)
-      .integer("max_cycles", max_cycles)
-      .integer("seed", seed)
-      .emit();
+  std::string seed_text;
+  for (const long s : seeds) seed_text += (seed_text.empty() ? "" : ",") + std::to_string(s);
+  for (const auto& [key, t] : tallies) {
+    const std::size_t space = key.find(' ');
+    const std::string set = key.substr(0, space);
+    const std::string planner = key.substr(space + 1);
+    JsonLine(kSuite, "summary")
+        .text("set", set.c_str())
+        .text("planner", planner.c_str())
+        .flag("default", planner == default_planner)
+        .text("seeds", seed_text.c_str())
+        .integer("runs", static_cast<std::int64_t>(t.runs))
+        .integer("found", static_cast<std::int64_t>(t.found))
+        .integer("contacts", static_cast<std::int64_t>(t.contacts))
+        .num("mean_spl", t.runs > 0 ? t.spl_sum / static_cast<double>(t.runs) : 0.0)
+        .num("mean_sim_time_to_find_s", t.found > 0 ? t.found_sim_s / static_cast<double>(t.found)
+                                                    : std::numeric_limits<double>::quiet_NaN())
+        .integer("max_cycles", max_cycles)
+        .emit();
+  }
   return 0;
 }
 
 [[maybe_unused]] const bool g_registered = register_suite(
-    {kSuite, "firmware binary on every shipped world: SPL, collisions, CPU split", &run});
+    {kSuite, "firmware binary on every shipped and test world, per seed and planner", &run});
 
 }  // namespace
 }  // namespace boticelli::bench

@@ -16,6 +16,8 @@ void GridMap::clear() {
   directory_.fill(kNoTile);
   tiles_used_ = 0;
   dropped_ = 0;
+  free_cells_ = 0;
+  occupied_cells_ = 0;
 }
 
 Cell GridMap::cell_of(core::Point2 p) const {
@@ -50,7 +52,32 @@ bool GridMap::add(Cell c, int delta) {
     tiles_[static_cast<std::size_t>(t)].fill(0);
   }
   std::int8_t& v = tiles_[static_cast<std::size_t>(t)][cell_index(c)];
+  const CellState before = state_of(v);
   v = static_cast<std::int8_t>(std::clamp(v + delta, -kMaxLogOdds, kMaxLogOdds));
+  const CellState after = state_of(v);
+  if (after != before) {
+    free_cells_ -= before == CellState::kFree ? 1U : 0U;
+    occupied_cells_ -= before == CellState::kOccupied ? 1U : 0U;
+    free_cells_ += after == CellState::kFree ? 1U : 0U;
+    occupied_cells_ += after == CellState::kOccupied ? 1U : 0U;
+  }
+  return true;
+}
+
+bool GridMap::tile_bounds(Cell& lo, Cell& hi) const {
+  int tx0 = kDirectoryTiles, ty0 = kDirectoryTiles, tx1 = -1, ty1 = -1;
+  for (int ty = 0; ty < kDirectoryTiles; ++ty) {
+    for (int tx = 0; tx < kDirectoryTiles; ++tx) {
+      if (directory_[static_cast<std::size_t>(ty * kDirectoryTiles + tx)] == kNoTile) continue;
+      tx0 = std::min(tx0, tx);
+      ty0 = std::min(ty0, ty);
+      tx1 = std::max(tx1, tx);
+      ty1 = std::max(ty1, ty);
+    }
+  }
+  if (tx1 < 0) return false;
+  lo = {tx0 * kTileCells - kGridCells / 2, ty0 * kTileCells - kGridCells / 2};
+  hi = {(tx1 + 1) * kTileCells - kGridCells / 2, (ty1 + 1) * kTileCells - kGridCells / 2};
   return true;
 }
 

@@ -24,6 +24,18 @@ TEST(Options, ReadsEveryDesignOption) {
   CHECK(options.console == ConsoleKind::kPty);
 }
 
+TEST(Options, TakesAMapPrefixAndRefusesAnEmptyOne) {
+  const char* argv[] = {"boticelli", "--map", "out/end"};
+  CHECK(parse_options(3, argv, false, options).ok);
+  STRCMP_EQUAL("out/end", options.map_prefix);
+  const char* empty[] = {"boticelli", "--map", ""};
+  const ParseResult r = parse_options(3, empty, false, options);
+  CHECK_FALSE(r.ok);
+  STRCMP_EQUAL("option '--map' needs a PREFIX", r.error);
+  const char* missing[] = {"boticelli", "--map"};
+  CHECK_FALSE(parse_options(2, missing, false, options).ok);
+}
+
 TEST(Options, TakesASerialDeviceAsConsolePath) {
   const char* argv[] = {"boticelli", "--console", "/dev/ttyAMA0"};
   CHECK(parse_options(3, argv, false, options).ok);

@@ -49,7 +49,8 @@ class FakeView final : public MissionView {
     held = false;
     if (source != nullptr) source->release();
   }
-  MapCounts map_counts() const override { return {12, 34, 5}; }
+  MapCounts map_counts() const override { return counts; }
+  MapCounts counts{12, 34, 5};
   TargetEstimate target() const override { return target_value; }
   std::uint64_t mission_log_begin() const override { return log_dropped; }
   std::uint64_t mission_log_end() const override { return log_dropped + log.size(); }
@@ -305,9 +306,33 @@ TEST(Console, ReportsStatusPoseAndMap) {
   reply = command("pose");
   STRCMP_EQUAL("pose x_m=1.250 y_m=-0.500 yaw_rad=0.7500", reply.at(0).c_str());
   reply = command("map");
-  STRCMP_EQUAL("map polygon_vertices=12 obstacle_points=34 exploration_points=5 target=none",
-               reply.at(0).c_str());
+  STRCMP_EQUAL(
+      "map polygon_vertices=12 obstacle_points=34 exploration_points=5 grid_tiles=0 grid_bytes=0 "
+      "free_m2=0.00 occupied_m2=0.00 grid_dropped=0 frontiers=0 blacklisted=0 goal=none "
+      "target=none",
+      reply.at(0).c_str());
   CHECK_EQUAL("OK", reply.back());
+}
+
+TEST(Console, MapSummarisesTheWorldMemoryAndTheGoalOnIt) {
+  view.counts.grid_tiles = 40;
+  view.counts.grid_bytes = 18432;
+  view.counts.free_m2 = 21.5F;
+  view.counts.occupied_m2 = 1.25F;
+  view.counts.grid_dropped = 3;
+  view.counts.frontiers = 4;
+  view.counts.blacklisted = 1;
+  view.counts.goal = GoalKind::kFrontier;
+  view.counts.goal_x_m = 2.5F;
+  view.counts.goal_y_m = -1.0F;
+  view.counts.goal_path_m = 3.75F;
+  STRCMP_EQUAL(
+      "map polygon_vertices=12 obstacle_points=34 exploration_points=5 grid_tiles=40 "
+      "grid_bytes=18432 free_m2=21.50 occupied_m2=1.25 grid_dropped=3 frontiers=4 blacklisted=1 "
+      "goal=frontier goal_x_m=2.500 goal_y_m=-1.000 goal_path_m=3.75 target=none",
+      command("map").at(0).c_str());
+  view.counts.goal = GoalKind::kTarget;
+  STRCMP_CONTAINS(" goal=target goal_x_m=2.500 ", command("map").at(0).c_str());
 }
 
 TEST(Console, ReportsTheTargetEstimateOnceTheMissionHasOne) {
@@ -316,8 +341,9 @@ TEST(Console, ReportsTheTargetEstimateOnceTheMissionHasOne) {
                   command("status").at(0).c_str());
   view.target_value = {TargetStatus::kConfirmed, 3, 2.25F, -1.5F, 0.35F};
   STRCMP_EQUAL(
-      "map polygon_vertices=12 obstacle_points=34 exploration_points=5 target=confirmed "
-      "target_x_m=2.250 target_y_m=-1.500 target_z_m=0.350 sightings=3",
+      "map polygon_vertices=12 obstacle_points=34 exploration_points=5 grid_tiles=0 grid_bytes=0 "
+      "free_m2=0.00 occupied_m2=0.00 grid_dropped=0 frontiers=0 blacklisted=0 goal=none "
+      "target=confirmed target_x_m=2.250 target_y_m=-1.500 target_z_m=0.350 sightings=3",
       command("map").at(0).c_str());
   CHECK_EQUAL("OK", command("set telemetry_ms 100").at(0));
   port.clear_written();

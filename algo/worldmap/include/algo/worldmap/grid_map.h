@@ -69,6 +69,12 @@ class GridMap {
 
   [[nodiscard]] std::size_t tiles_used() const { return tiles_used_; }
   [[nodiscard]] std::size_t dropped() const { return dropped_; }
+  // Cells now free / occupied (kept as cells change: no scan).
+  [[nodiscard]] std::size_t free_cells() const { return free_cells_; }
+  [[nodiscard]] std::size_t occupied_cells() const { return occupied_cells_; }
+  // The smallest cell box holding every tile in use (false when no tile is): what a picture
+  // or an export of the map needs to cover. `lo` inclusive, `hi` exclusive.
+  bool tile_bounds(Cell& lo, Cell& hi) const;
   // The map's memory: the tiles in use and the directory [bytes].
   [[nodiscard]] std::size_t bytes() const {
     return tiles_used_ * sizeof(Tile) + sizeof(directory_);
@@ -93,6 +99,8 @@ class GridMap {
   std::array<Tile, kMaxTiles> tiles_{};
   std::size_t tiles_used_ = 0;
   std::size_t dropped_ = 0;
+  std::size_t free_cells_ = 0;
+  std::size_t occupied_cells_ = 0;
 };
 
 }  // namespace boticelli::worldmap

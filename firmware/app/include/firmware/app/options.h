@@ -18,6 +18,7 @@ struct Options {
   std::uint64_t max_cycles = 0;               // --max-cycles N; 0 = no limit
   const char* snapshots_dir = nullptr;        // --snapshots DIR
   const char* trace_file = nullptr;           // --trace FILE
+  const char* map_prefix = nullptr;           // --map PREFIX: PREFIX.pgm/.yaml at the end
   ConsoleKind console = ConsoleKind::kStdio;  // --console stdio|pty|PATH
   const char* console_path = nullptr;         // the PATH of --console PATH
   const char* state_dir = nullptr;            // --state DIR

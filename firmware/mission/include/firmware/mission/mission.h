@@ -113,6 +113,11 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
     return &state_.log[static_cast<std::size_t>(number - state_.log_dropped)];
   }
   MapCounts map_counts() const override;
+  // The world memory (the grid of everything seen) and the planner that plans on it.
+  [[nodiscard]] const worldmap::GridMap& grid() const { return map_.grid(); }
+  [[nodiscard]] const char* planner_name() const {
+    return params_.thesis_planner ? "thesis" : "frontier";
+  }
   TargetEstimate target() const override;
 
   [[nodiscard]] Result result() const { return result_; }

@@ -9,10 +9,26 @@
 
 namespace boticelli::firmware {
 
+// The navigation goal of the last plan on the grid.
+enum class GoalKind : std::uint8_t { kNone, kFrontier, kTarget };
+const char* goal_kind_name(GoalKind kind);
+
 struct MapCounts {
   std::uint32_t polygon_vertices = 0;    // vertices of the current navigation polygon
   std::uint32_t obstacle_points = 0;     // global obstacle list
   std::uint32_t exploration_points = 0;  // global exploration list
+  // The world memory (the grid of everything seen).
+  std::uint32_t grid_tiles = 0;     // tiles in use
+  std::uint32_t grid_bytes = 0;     // its memory: tiles in use and the directory
+  float free_m2 = 0.0F;             // area of free cells
+  float occupied_m2 = 0.0F;         // area of occupied cells
+  std::uint32_t grid_dropped = 0;   // updates dropped (pool exhausted or off the grid)
+  std::uint32_t frontiers = 0;      // frontier clusters in the last plan on the grid
+  std::uint32_t blacklisted = 0;    // frontier goals given up on (no progress)
+  GoalKind goal = GoalKind::kNone;  // the last plan's goal on the grid
+  float goal_x_m = 0.0F;            // mission frame
+  float goal_y_m = 0.0F;
+  float goal_path_m = 0.0F;  // path length to it on the grid
 };
 
 // The mission's idea of where the target is: none yet, seen once (a candidate not yet
