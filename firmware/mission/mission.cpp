@@ -144,10 +144,8 @@ void Mission::start(std::uint64_t now_us) {
   pose_.anchor(state_.pose);
   tracker_.clear();
   if (state_.has_goal) {
-    // A resumed goal was confirmed before the restart: it stands as two agreeing views.
-    const Eigen::Vector3f g(state_.goal.x_m, state_.goal.y_m, state_.goal_height_m);
-    tracker_.add(g, 1.0F, 0xFFFFFFF0U);
-    tracker_.add(g, 1.0F, 0xFFFFFFF1U);
+    // A resumed goal was confirmed before the restart: it stands as confirmed.
+    tracker_.restore(Eigen::Vector3f(state_.goal.x_m, state_.goal.y_m, state_.goal_height_m));
   }
   // A resumed mission shows its saved model until the first look is fitted.
   model_text_.clear();
@@ -360,14 +358,18 @@ void Mission::control_hold(std::uint64_t now_us) {
   if (phase_ == Phase::kLook) scan_.resume();  // re-issue the interrupted move and wait again
 }
 
-void Mission::begin_look(std::uint64_t now_us) {
+void Mission::begin_look(std::uint64_t now_us, bool glance) {
   phase_ = Phase::kLook;
   // A planned move not begun is void.
   pending_move_ = move_ = Move::kNone;
   look_lists_stale_ = true;  // cleared by the background before the first view
   view_part_ = 0;
   look_pose_ = pose_.pose();
-  scan_.begin(now_us, aim_at_target());
+  const AimedPair aimed = aim_at_target();
+  glance_ = glance && aimed.aimed;
+  look_saw_target_ = false;
+  look_missed_target_ = false;
+  scan_.begin(now_us, aimed, glance_);
   think_step_ = ThinkStep::kBegin;
   plan_step_ = PlanStep::kValueStart;
 }
@@ -398,6 +400,7 @@ void Mission::control_look(std::uint64_t now_us) {
     case ScanEvent::kBusy:
       return;
     case ScanEvent::kDone:
+      if (glance_) return at_standoff(now_us, false);
       phase_ = Phase::kThink;
       return;
     case ScanEvent::kPtuFault:
@@ -409,6 +412,23 @@ void Mission::control_look(std::uint64_t now_us) {
     case ScanEvent::kNoFrame:
       return hold_for_device("no camera frame", hal_.camera.error(), now_us);
   }
+}
+
+void Mission::at_standoff(std::uint64_t now_us, bool planner_at_goal) {
+  const core::Pose2 here = pose_.pose();
+  const Eigen::Vector3f& g = tracker_.estimate_m();
+  const bool near =
+      planner_at_goal || core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
+                             params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m;
+  if (tracker_.confirmed() && near && look_saw_target_) {
+    return finish(Result::kFound, "within the stand-off of the target, seen from there",
+                  Ending::kFinal);
+  }
+  // Not seen from its stand-off: a miss (unless the aimed pair counted it already).
+  const bool revoked = !look_missed_target_ && tracker_.missed();
+  end_cycle(revoked ? "target revoked: not seen from its stand-off"
+                    : "target not seen from its stand-off");
+  if (phase_ != Phase::kDone) begin_look(now_us);
 }
 
 void Mission::drive(Move move) {
@@ -451,8 +471,10 @@ void Mission::control_drive(std::uint64_t now_us) {
     const Eigen::Vector3f& g = tracker_.estimate_m();
     if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
         params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m) {
-      end_cycle("at the target");
-      return finish(Result::kFound, "within the stand-off of the target", Ending::kFinal);
+      // Found only once it is seen again from here: a glance at it first.
+      end_cycle("at the target's stand-off");
+      move_ = Move::kNone;
+      return begin_look(now_us, true);
     }
   }
   const Move done = move_;
@@ -656,16 +678,41 @@ bool Mission::process_view(ViewPart part) {
   const bool done = look_.process(part, view, fixes);
   if (part == ViewPart::kTarget) {
     const auto id = static_cast<std::uint32_t>(state_.cycle * 256U + view.index);
-    add_target_fix(fixes.pair, id);
-    add_target_fix(fixes.across, id);
+    const bool confirmed = tracker_.confirmed();
+    const bool saw_pair = add_target_fix(fixes.pair, id);
+    const bool saw_across = add_target_fix(fixes.across, id);
+    const bool saw = saw_pair || saw_across;
+    look_saw_target_ = look_saw_target_ || saw;
+    // The pair aimed at the confirmed target, in range, with a line of sight the map does
+    // not block, that did not see it: a miss.
+    if (view.aimed && confirmed && !saw && target_in_clear_sight()) {
+      look_missed_target_ = true;
+      if (tracker_.missed()) {
+        state_.add_log(state_.cycle, "target revoked: missing where it should be seen");
+      }
+    }
   }
   return done;
 }
 
-void Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {
-  if (!fix.found) return;
-  tracker_.add(fix_in_world(look_pose_, fix, params_.rig.ptu_height_m), fix.confidence, view,
-               fix.range_error_m);
+bool Mission::target_in_clear_sight() const {
+  const Eigen::Vector3f& g = tracker_.estimate_m();
+  const core::Point2 from{look_pose_.x_m, look_pose_.y_m};
+  const core::Point2 to{g.x(), g.y()};
+  const float d = core::distance_m(from, to);
+  // The target hangs on a surface: the map's last cells before it may be that surface.
+  const float keep = d - params_.target_surface_margin_m;
+  if (keep <= 0.0F) return true;
+  const core::Point2 end{from.x_m + (to.x_m - from.x_m) * keep / d,
+                         from.y_m + (to.y_m - from.y_m) * keep / d};
+  return !map_.grid().segment_blocked(from, end);
+}
+
+bool Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {
+  if (!fix.found) return false;
+  const Eigen::Vector3f p = fix_in_world(look_pose_, fix, params_.rig.ptu_height_m);
+  tracker_.add(p, fix.confidence, view, fix.range_error_m, {look_pose_.x_m, look_pose_.y_m});
+  return tracker_.is_target(p);
 }
 
 void Mission::begin_think() {
@@ -722,8 +769,8 @@ void Mission::after_step_choice() {
   const core::Pose2 here = pose_.pose();
   switch (planner_.end_choice(here, look_pose_, map_.local().navigable, breadcrumbs_)) {
     case StepOutcome::kAtGoal:
-      end_cycle("at the target");
-      return finish(Result::kFound, "within the stand-off of the target", Ending::kFinal);
+      // This look was taken here: it saw the target afresh, or that is a miss.
+      return at_standoff(now_us_, true);
     case StepOutcome::kMove:
       steps_this_look_ = 0;
       return drive(Move::kStep);

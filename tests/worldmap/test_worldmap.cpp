@@ -154,6 +154,15 @@ TEST(GridMap, TheFreeAndOccupiedCountsMatchAScanOfEveryCell) {
   CHECK_FALSE(g_map.tile_bounds(lo, hi));
 }
 
+TEST(GridMap, ASegmentIsBlockedOnlyByAnOccupiedCellOnIt) {
+  CHECK(g_map.add(g_map.cell_of({1.0F, 0.02F}), 10));
+  CHECK(g_map.add(g_map.cell_of({1.0F, 0.5F}), -10));
+  CHECK(g_map.segment_blocked({0.0F, 0.0F}, {2.0F, 0.05F}));
+  CHECK_FALSE(g_map.segment_blocked({0.0F, 0.0F}, {0.97F, 0.0F}));
+  CHECK_FALSE(g_map.segment_blocked({0.0F, 0.2F}, {2.0F, 0.2F}));
+  CHECK(g_map.segment_blocked({1.0F, 0.0F}, {1.0F, 0.0F}));
+}
+
 TEST(GridMap, PointsMapToTheCellsThatHoldThem) {
   const wm::Cell c = g_map.cell_of({-0.01F, 0.07F});
   LONGS_EQUAL(-1, c.ix);

@@ -64,6 +64,17 @@ bool GridMap::add(Cell c, int delta) {
   return true;
 }
 
+bool GridMap::segment_blocked(core::Point2 a, core::Point2 b) const {
+  const float length = core::distance_m(a, b);
+  const int samples = static_cast<int>(std::ceil(length / (0.5F * params_.cell_m)));
+  for (int i = 0; i <= samples; ++i) {
+    const float t = samples > 0 ? static_cast<float>(i) / static_cast<float>(samples) : 0.0F;
+    const core::Point2 p{a.x_m + t * (b.x_m - a.x_m), a.y_m + t * (b.y_m - a.y_m)};
+    if (state(cell_of(p)) == CellState::kOccupied) return true;
+  }
+  return false;
+}
+
 bool GridMap::tile_bounds(Cell& lo, Cell& hi) const {
   int tx0 = kDirectoryTiles, ty0 = kDirectoryTiles, tx1 = -1, ty1 = -1;
   for (int ty = 0; ty < kDirectoryTiles; ++ty) {

@@ -5,9 +5,9 @@
 
 namespace boticelli::firmware::mission {
 
-void LookScan::begin(std::uint64_t now_us, const AimedPair& aimed) {
+void LookScan::begin(std::uint64_t now_us, const AimedPair& aimed, bool only_aimed) {
   aimed_ = aimed;
-  view_ = 0;
+  view_ = only_aimed && aimed.aimed ? scan_views() : 0;
   second_frame_ = false;
   step_ = Step::kMove;
   view_ready_ = false;

@@ -72,6 +72,10 @@ MissionParams make_mission_params(const BoardConfig& c) {
   // within 1 m, weighted by 1/range², which sits near the truth.
   p.target.agree_radius_m = 0.5F;
   p.target.refine_radius_m = 1.0F;
+  // Confirmed only by views from two places (the pans of one look see the same reflection),
+  // and revoked when two views in a row aimed at it with a clear line of sight miss it.
+  p.target.min_baseline_m = 0.2F;
+  p.target.revoke_after_misses = 2;
   // The target's range from its tracked edges (StereoParams): the look bench's fixes come
   // nearer the truth, and every shipped and test world but partition_gap_west (whose gap
   // the exploration misses either way) ends found nearer the target.

@@ -62,8 +62,9 @@ StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
 
 planning::StepDecision StepPlanner::step_on_path(const core::Pose2& here,
                                                  const core::Pose2& look_pose,
-                                                 const mapping::StarPolygon& navigable) const {
+                                                 const mapping::StarPolygon& navigable) {
   planning::StepDecision d;
+  final_approach_ = false;
   const std::span<const core::Point2> path = nav_.path();
   const core::Point2 at{here.x_m, here.y_m};
   std::size_t nearest = 0;
@@ -91,12 +92,33 @@ planning::StepDecision StepPlanner::step_on_path(const core::Pose2& here,
     d.distance_m = dist;
     d.heading_rad = std::atan2(path[j].y_m - at.y_m, path[j].x_m - at.x_m);
   }
+  // The final approach: the stand-off goal (the path's end) near, the way there passable.
+  const bool reaches_end = d.kind == planning::StepKind::kMove && !path.empty() &&
+                           d.target.x_m == path.back().x_m && d.target.y_m == path.back().y_m;
+  if (reaches_end || !has_goal_ || path.empty() ||
+      nav_choice_.kind != worldmap::NavGoalKind::kTarget) {
+    return d;
+  }
+  const core::Point2 end = path.back();
+  const float dist = core::distance_m(at, end);
+  if (dist > params_.final_approach_m || dist < params_.step.min_step_m) return d;
+  for (int i = 1; i <= 20; ++i) {
+    const float t = static_cast<float>(i) / 20.0F;
+    const core::Point2 p{at.x_m + t * (end.x_m - at.x_m), at.y_m + t * (end.y_m - at.y_m)};
+    if (!nav_.passable(p) && core::distance_m(p, at) >= own) return d;
+  }
+  d.kind = planning::StepKind::kMove;
+  d.target = end;
+  d.distance_m = dist;
+  d.heading_rad = std::atan2(end.y_m - at.y_m, end.x_m - at.x_m);
+  final_approach_ = true;
   return d;
 }
 
 StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& look_pose,
                                     const mapping::StarPolygon& navigable,
                                     Breadcrumbs& breadcrumbs) {
+  final_approach_ = false;
   if (!path_mode_) {
     decision_ = chooser_.decision();
   } else if (has_goal_ && core::distance_m({here.x_m, here.y_m}, goal_) <=
@@ -116,7 +138,7 @@ StepOutcome StepPlanner::end_choice(const core::Pose2& here, const core::Pose2& 
                            here.y_m + t * (decision_.target.y_m - here.y_m)};
       inside = navigable.contains(core::to_robot(look_pose, p));
     }
-    if (inside) {
+    if (inside || final_approach_) {
       failed_cycles_ = 0;
       return StepOutcome::kMove;
     }

@@ -6,15 +6,59 @@
 
 namespace boticelli::firmware::mission {
 
+void TargetTracker::restore(const Eigen::Vector3f& goal_world_m) {
+  clear();
+  sightings_[0] = {goal_world_m, 1.0F, 1.0F, 0xFFFFFFF0U, {}};
+  count_ = next_ = 1;
+  confirmed_ = true;
+  support_ = params_.min_views;
+  estimate_ = candidate_ = goal_world_m;
+}
+
+bool TargetTracker::missed() {
+  if (!confirmed_ || params_.revoke_after_misses == 0) return false;
+  if (++misses_ < params_.revoke_after_misses) return false;
+  // Forget the target's sightings (those its estimate was refined from) and look again.
+  const float q2 = params_.refine_radius_m * params_.refine_radius_m;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < count_; ++i) {
+    if ((sightings_[i].point - estimate_).squaredNorm() > q2) sightings_[kept++] = sightings_[i];
+  }
+  count_ = kept;
+  next_ = kept % kMaxSightings;
+  confirmed_ = false;
+  misses_ = 0;
+  ++revocations_;
+  estimate_ = candidate_ = Eigen::Vector3f::Zero();
+  support_ = 0;
+  if (count_ > 0) update_estimate();
+  return true;
+}
+
+bool TargetTracker::has_baseline(const Eigen::Vector3f& centre, float r2) const {
+  if (params_.min_baseline_m <= 0.0F) return true;
+  for (std::size_t j = 0; j < count_; ++j) {
+    if ((sightings_[j].point - centre).squaredNorm() > r2) continue;
+    for (std::size_t k = 0; k < j; ++k) {
+      if ((sightings_[k].point - centre).squaredNorm() <= r2 &&
+          core::distance_m(sightings_[j].from, sightings_[k].from) >= params_.min_baseline_m) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
 void TargetTracker::add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view,
-                        float range_error_m) {
+                        float range_error_m, core::Point2 from) {
   // A non-finite confidence would make the group's weighted mean NaN, and a NaN centre
   // counts every sighting as within the radius.
   if (!point_world_m.allFinite() || !std::isfinite(confidence) || !std::isfinite(range_error_m)) {
     return;
   }
   const float e = std::max(range_error_m, kMinRangeError_m);
-  sightings_[next_] = {point_world_m, confidence, (0.1F + confidence) / (e * e), view};
+  if (is_target(point_world_m)) misses_ = 0;
+  sightings_[next_] = {point_world_m, confidence, (0.1F + confidence) / (e * e), view, from};
   next_ = (next_ + 1) % kMaxSightings;
   if (count_ < kMaxSightings) ++count_;
   update_estimate();
@@ -57,7 +101,7 @@ void TargetTracker::update_estimate() {
   }
   support_ = best_views;
   candidate_ = best;
-  if (best_views >= params_.min_views) {
+  if (best_views >= params_.min_views && has_baseline(best, r2)) {
     confirmed_ = true;
     const float q2 = params_.refine_radius_m * params_.refine_radius_m;
     Eigen::Vector3f centre = best;

@@ -181,6 +181,28 @@ TEST(LookScan, TheScansViewsComeInTurnAndTheAimedPairComesLast) {
   CHECK(control() == ScanEvent::kDone);
 }
 
+TEST(LookScan, AGlanceIsTheAimedPairAloneAndWithoutOneAWholeLook) {
+  params.pan_positions = 2;
+  AimedPair aimed;
+  aimed.aimed = true;
+  aimed.pan_rad = -0.3F;
+  aimed.tilt_rad = 0.05F;
+  scan.begin(now, aimed, true);
+  move_settle_grab(-0.3F, 0.05F);
+  move_settle_grab(-0.3F, 0.05F - phi);
+  CHECK_TRUE(scan.view_ready());
+  CHECK_TRUE(scan.view().aimed);
+  CHECK_EQUAL(2U, scan.view().index);
+  scan.view_processed();
+  expect_move(0.0F, 0.0F);
+  CHECK(control() == ScanEvent::kDone);
+  mock().checkExpectations();
+  // Nothing to aim at: the glance is a whole look, from its first view.
+  scan.begin(now, AimedPair{}, true);
+  move_settle_grab(-1.0F, -0.2F);
+  CHECK_EQUAL(0U, scan.view().index);
+}
+
 TEST(LookScan, AMoveThatNeverCompletesIsAPtuTimeout) {
   scan.begin(now, {});
   expect_move(0.0F, -0.2F);

@@ -279,7 +279,7 @@ TEST(FrontierStepPlanner, AGridWithNothingReachableTurnsRoundThenEnds) {
 }
 
 TEST_GROUP(ThesisPlannerTargetByPath) {
-  const MissionParams params = thesis_params();
+  MissionParams params = thesis_params();  // the planner reads it by reference
   StepPlanner planner{params};
   GlobalMap map;
   Breadcrumbs crumbs;
@@ -302,6 +302,7 @@ TEST_GROUP(ThesisPlannerTargetByPath) {
 
 TEST(ThesisPlannerTargetByPath, AConfirmedTargetWithAPathOnTheGridIsApproachedAlongIt) {
   CHECK(params.target_by_path);
+  params.final_approach_m = 0.0F;  // the path's step alone (the final approach below)
   const Point2 target{1.3F, 0.9F};
   CHECK(plan(&target) == StepOutcome::kMove);
   CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kTarget);
@@ -312,6 +313,28 @@ TEST(ThesisPlannerTargetByPath, AConfirmedTargetWithAPathOnTheGridIsApproachedAl
   CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) > params.value.step_m);
   const Point2 g = planner.nav_choice().goal;
   CHECK(boticelli::core::distance_m(t, g) < boticelli::core::distance_m({0.0F, 0.0F}, g));
+}
+
+TEST(ThesisPlannerTargetByPath, NearTheStandOffTheGridTakesTheRobotThereBeyondThePolygon) {
+  const Point2 target{1.3F, 0.9F};
+  CHECK(plan(&target) == StepOutcome::kMove);
+  // The stand-off cell is within the final approach (1 m): the step ends there, beyond the
+  // look's polygon (0.6 m), the way there being free on the grid.
+  const Point2 t = planner.target();
+  const Point2 g = planner.nav_choice().goal;
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) > 0.6F + 0.05F);
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) <= params.final_approach_m);
+  DOUBLES_EQUAL(g.x_m, t.x_m, 0.051);
+  DOUBLES_EQUAL(g.y_m, t.y_m, 0.051);
+}
+
+TEST(ThesisPlannerTargetByPath, AnObstacleOnTheStraightWayLeavesTheStepToThePolygon) {
+  // A wall across the straight way to the stand-off, the path round it.
+  for (int iy = -4; iy <= 12; ++iy) (void)g_grid.add({10, iy}, 20);
+  const Point2 target{1.3F, 0.1F};
+  CHECK(plan(&target) == StepOutcome::kMove);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kTarget);
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) <= 0.6F + 1e-5F);
 }
 
 TEST(ThesisPlannerTargetByPath, WithoutAPathToTheStandOffTheValueFunctionChoosesTheStep) {

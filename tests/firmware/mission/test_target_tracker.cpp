@@ -128,6 +128,67 @@ TEST(TargetTracker, OnceConfirmedTheEstimateTakesInSightingsScatteredAlongTheLin
   DOUBLES_EQUAL(kTarget.y() + 0.05F, tracker.estimate_m().y(), 0.02);
 }
 
+TEST(TargetTracker, ViewsFromOnePlaceNeverConfirmWhenTwoPlacesAreAskedFor) {
+  TargetTrackerParams p;
+  p.min_baseline_m = 0.2F;
+  tracker.configure(p);
+  // Five pans of one look, from one place (and a turn on the spot: 0.1 m of drift).
+  for (std::uint32_t v = 0; v < 5; ++v) tracker.add(kTarget, 0.9F, v, 0.1F, {0.0F, 0.0F});
+  tracker.add(kTarget, 0.9F, 9, 0.1F, {0.1F, 0.0F});
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(6, tracker.supporting_views());
+  // A sighting from 0.3 m away elsewhere in the room (another group) confirms nothing.
+  tracker.add(kTarget + Eigen::Vector3f(2.0F, 0.0F, 0.0F), 0.9F, 20, 0.1F, {0.0F, 0.3F});
+  CHECK_FALSE(tracker.confirmed());
+  // The same target from 0.3 m away: confirmed.
+  tracker.add(kTarget, 0.9F, 21, 0.1F, {0.0F, 0.3F});
+  CHECK(tracker.confirmed());
+  check_near(kTarget, tracker.estimate_m(), 1e-5F);
+}
+
+TEST(TargetTracker, AConfirmedTargetMissedTwiceInARowIsRevokedAndItsSightingsForgotten) {
+  TargetTrackerParams p;
+  p.revoke_after_misses = 2;
+  tracker.configure(p);
+  const Eigen::Vector3f other = kTarget + Eigen::Vector3f(3.0F, 0.0F, 0.0F);
+  tracker.add(other, 0.9F, 1);  // a lone sighting elsewhere: kept
+  tracker.add(kTarget, 0.9F, 2);
+  tracker.add(kTarget, 0.9F, 3);
+  CHECK(tracker.confirmed());
+  CHECK_FALSE(tracker.missed());
+  tracker.add(kTarget + Eigen::Vector3f(0.1F, 0.0F, 0.0F), 0.9F, 4);  // seen again: count reset
+  UNSIGNED_LONGS_EQUAL(0, tracker.misses());
+  CHECK_FALSE(tracker.missed());
+  CHECK(tracker.missed());
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(1, tracker.revocations());
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  check_near(other, tracker.candidate_m(), 1e-5F);
+  CHECK_FALSE(tracker.missed());  // nothing confirmed: nothing to miss
+  // Seen again from two views afterwards, it is confirmed again.
+  tracker.add(kTarget, 0.9F, 5);
+  tracker.add(kTarget, 0.9F, 6);
+  CHECK(tracker.confirmed());
+}
+
+TEST(TargetTracker, MissesNeverRevokeWhenRevocationIsOff) {
+  tracker.add(kTarget, 0.9F, 1);
+  tracker.add(kTarget, 0.9F, 2);
+  for (int i = 0; i < 10; ++i) CHECK_FALSE(tracker.missed());
+  CHECK(tracker.confirmed());
+}
+
+TEST(TargetTracker, ARestoredGoalIsConfirmedAtOnceAndIsTheTarget) {
+  TargetTrackerParams p;
+  p.min_baseline_m = 0.2F;
+  tracker.configure(p);
+  tracker.restore(kTarget);
+  CHECK(tracker.confirmed());
+  check_near(kTarget, tracker.estimate_m(), 1e-6F);
+  CHECK(tracker.is_target(kTarget + Eigen::Vector3f(0.2F, 0.0F, 0.0F)));
+  CHECK_FALSE(tracker.is_target(kTarget + Eigen::Vector3f(0.3F, 0.0F, 0.0F)));
+}
+
 TEST(TargetTracker, ANonFiniteRangeErrorIsIgnored) {
   tracker.add(kTarget, 0.5F, 1, std::numeric_limits<float>::quiet_NaN());
   UNSIGNED_LONGS_EQUAL(0, tracker.sightings());

@@ -66,6 +66,9 @@ class GridMap {
   // Adds `delta` to the cell's log-odds, clamped to ±kMaxLogOdds. False when the cell is out
   // of bounds or its tile is missing and the pool is exhausted (dropped() counts those).
   bool add(Cell c, int delta);
+  // Whether an occupied cell lies on the segment a→b (sampled every half cell, both ends
+  // included): a line of sight the map says is blocked.
+  [[nodiscard]] bool segment_blocked(core::Point2 a, core::Point2 b) const;
 
   [[nodiscard]] std::size_t tiles_used() const { return tiles_used_; }
   [[nodiscard]] std::size_t dropped() const { return dropped_; }

@@ -167,8 +167,14 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // The cycle's picture (--snapshots): set up, then drawn and encoded a unit at a time.
   enum class SnapshotStep : std::uint8_t { kIdle, kPending, kWriting };
 
-  void begin_look(std::uint64_t now_us);
+  // A look: every view and then the aimed pair; a glance (`glance`, when the target can be
+  // aimed at): the aimed pair alone, to see the target afresh from its stand-off.
+  void begin_look(std::uint64_t now_us, bool glance = false);
   void control_look(std::uint64_t now_us);
+  // At the stand-off of the confirmed target (by the planner's judgement, or by distance):
+  // found when this look saw the target afresh; else a miss (the target may be revoked) and
+  // the mission goes on with a full look.
+  void at_standoff(std::uint64_t now_us, bool planner_at_goal);
   void control_drive(std::uint64_t now_us);
   bool hold_needed();
   void control_hold(std::uint64_t now_us);
@@ -191,7 +197,10 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   bool process_view(ViewPart part);
   // The pair aimed at the target's estimate (or its unconfirmed candidate) after the scan.
   [[nodiscard]] AimedPair aim_at_target() const;
-  void add_target_fix(const stereo::TargetFix& fix, std::uint32_t view);
+  // Adds a fix to the tracker (none when !fix.found); true when it is the confirmed target.
+  bool add_target_fix(const stereo::TargetFix& fix, std::uint32_t view);
+  // Whether the map leaves the line of sight from the look's pose to the target clear.
+  [[nodiscard]] bool target_in_clear_sight() const;
   SliceResult think_slice(SliceBudget& budget);
   SliceResult plan_slice(SliceBudget& budget);
   void begin_think();
@@ -247,6 +256,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint8_t view_part_ = 0;     // the next part of the grabbed view's processing
   bool look_lists_stale_ = false;  // the last look's readings wait for the picture
   TargetTracker tracker_;
+  bool glance_ = false;              // this look is a glance at the target (begin_look)
+  bool look_saw_target_ = false;     // a fix of this look was the confirmed target
+  bool look_missed_target_ = false;  // the aimed pair should have seen it and did not
   std::uint32_t last_pieces_ = 0;
   std::uint32_t guard_truncated_looks_ = 0;
 

@@ -47,8 +47,9 @@ class LookScan {
   LookScan(const LookScan&) = delete;
   LookScan& operator=(const LookScan&) = delete;
 
-  // A new look from its first view; the aimed pair, if any, comes last.
-  void begin(std::uint64_t now_us, const AimedPair& aimed);
+  // A new look from its first view; the aimed pair, if any, comes last. `only_aimed` (with an
+  // aimed pair): the aimed pair alone, a glance to check that the target is there.
+  void begin(std::uint64_t now_us, const AimedPair& aimed, bool only_aimed = false);
   // The mission task's part of the look, every frame.
   ScanEvent control(std::uint64_t now_us, hal::PanTilt& ptu);
   // The camera task: keeps a settled frame when a view wants one.

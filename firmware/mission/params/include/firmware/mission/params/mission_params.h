@@ -39,6 +39,9 @@ struct MissionParams {
   planning::StepParams step;
   DriveParams drive;
   TargetTrackerParams target;
+  // A pair aimed at the confirmed target misses it only when the grid leaves its line of
+  // sight clear up to this short of the target (the surface it hangs on is in the map) [m].
+  float target_surface_margin_m = 0.3F;
   std::uint32_t pan_positions = 15;
   LookRow rows[BoardConfig::kMaxTiltRows]{};
   std::size_t row_count = 0;
@@ -69,6 +72,11 @@ struct MissionParams {
   worldmap::LookFusionParams fusion;
   worldmap::NavParams nav;
   float nav_step_m = 1.0F;  // longest step along the path to a frontier or target goal [m]
+  // The target's stand-off lies near the wall it hangs on, where a look's navigable polygon
+  // (its fit, shrunk by the robot's radius) seldom reaches: a stand-off goal this near is
+  // stepped to when the straight way there is passable on the grid (known free, the robot's
+  // radius and margin from every occupied cell), whatever the polygon says (0: never) [m].
+  float final_approach_m = 1.0F;
 };
 
 // The camera rig the stereo and the sim renderer both use, from the board's declaration.

@@ -101,18 +101,20 @@ class StepPlanner {
  private:
   // The step along the nav planner's path from `here`: the farthest path point within
   // nav_step_m whose straight segment stays in the look's navigable polygon and on passable
-  // cells (kMove), else kNoSafeAction.
+  // cells (kMove), else the final approach to a stand-off goal (final_approach_m), else
+  // kNoSafeAction.
   [[nodiscard]] planning::StepDecision step_on_path(const core::Pose2& here,
                                                     const core::Pose2& look_pose,
-                                                    const mapping::StarPolygon& navigable) const;
+                                                    const mapping::StarPolygon& navigable);
 
   const MissionParams& params_;
   planning::ValueIteration value_;
   worldmap::NavPlanner nav_;
   worldmap::NavChoice nav_choice_{};
-  bool nav_needed_ = false;  // this plan runs the wavefront
-  bool path_mode_ = false;   // this plan's step follows the wavefront's path
-  bool has_goal_ = false;    // the target's estimate, for the nav planner
+  bool nav_needed_ = false;      // this plan runs the wavefront
+  bool path_mode_ = false;       // this plan's step follows the wavefront's path
+  bool final_approach_ = false;  // the step is the final approach (grid only) to the stand-off
+  bool has_goal_ = false;        // the target's estimate, for the nav planner
   core::Point2 goal_{};
   planning::Trail trail_;
   planning::StepChooser chooser_;
