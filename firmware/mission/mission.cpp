@@ -809,6 +809,12 @@ void Mission::snapshot_unit() {
       in.goal = &goal;
     }
     in.path = path_.span();
+    in.grid = &map_.grid();
+    core::Point2 grid_goal{};
+    if (planner_.nav_choice().kind != worldmap::NavGoalKind::kNone) {
+      grid_goal = planner_.nav_choice().goal;
+      in.grid_goal = &grid_goal;
+    }
     in.value = &planner_.value();
     in.decision = &planner_.decision();
     in.truth = truth_;

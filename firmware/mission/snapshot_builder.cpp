@@ -40,6 +40,18 @@ float occupancy_at(const void* context, float x_m, float y_m) {
   return std::clamp(m, 0.0F, 1.0F);
 }
 
+float grid_at(const void* context, float x_m, float y_m) {
+  const auto& grid = *static_cast<const worldmap::GridMap*>(context);
+  switch (grid.state(grid.cell_of({x_m, y_m}))) {
+    case worldmap::CellState::kFree:
+      return kGridFree;
+    case worldmap::CellState::kOccupied:
+      return kGridOccupied;
+    default:
+      return kGridUnknown;
+  }
+}
+
 float value_at(const void* context, float x_m, float y_m) {
   return static_cast<const planning::ValueIteration*>(context)->value({x_m, y_m});
 }
@@ -90,6 +102,11 @@ void begin_snapshot(const SnapshotInputs& in, SnapshotWriter& writer) {
   f.exploration_points = in.map->exploration().span();
   if (in.goal != nullptr) f.goal = *in.goal;
   f.path = in.path;
+  if (in.grid != nullptr) {
+    f.grid = &grid_at;
+    f.grid_context = in.grid;
+  }
+  if (in.grid_goal != nullptr) f.grid_goal = *in.grid_goal;
   f.value = &value_at;
   f.value_context = in.value;
   if (in.decision->kind == planning::StepKind::kMove) f.step_end = in.decision->target;

@@ -184,6 +184,13 @@ void SnapshotWriter::draw(Stage stage) {
         unit_work_.field_rows = end - field_row_;
       }
       return;
+    case Stage::kGridField:
+      if (f.grid != nullptr) {
+        const int end = std::min(kFieldCells, field_row_ + kFieldBandRows);
+        sample_field(panel_map(f.view, 2), f.grid, f.grid_context, field_, field_row_, end);
+        unit_work_.field_rows = end - field_row_;
+      }
+      return;
     case Stage::kValueField:
       if (f.value != nullptr) {
         const int end = std::min(kFieldCells, field_row_ + kFieldBandRows);
@@ -195,10 +202,13 @@ void SnapshotWriter::draw(Stage stage) {
       draw_occupancy(c, panel_map(f.view, 1), f, field_);
       return;
     case Stage::kNavigation:
-      draw_navigation(c, panel_map(f.view, 2), f, 0);
+      draw_navigation(c, panel_map(f.view, 2), f, 0, field_);
+      return;
+    case Stage::kNavigationFree:
+      draw_navigation(c, panel_map(f.view, 2), f, 1, field_);
       return;
     case Stage::kNavigationMarks:
-      draw_navigation(c, panel_map(f.view, 2), f, 1);
+      draw_navigation(c, panel_map(f.view, 2), f, 2, field_);
       return;
     case Stage::kValue:
       draw_value(c, panel_map(f.view, 3), f, field_);
@@ -253,8 +263,9 @@ bool SnapshotWriter::run_unit() {
       if (clear_row_ >= kHeightPx) stage_ = Stage::kTitle;
       return false;
     case Stage::kOccupancyField:
+    case Stage::kGridField:
     case Stage::kValueField:
-      // The sampled fields (the model, the value function) a band of rows at a time.
+      // The sampled fields (the model, the grid, the value function) a band of rows at a time.
       draw(stage_);
       field_row_ += kFieldBandRows;
       if (field_row_ >= kFieldCells) {
@@ -271,6 +282,7 @@ bool SnapshotWriter::run_unit() {
     case Stage::kTitle:
     case Stage::kOccupancy:
     case Stage::kNavigation:
+    case Stage::kNavigationFree:
     case Stage::kNavigationMarks:
     case Stage::kValue:
     case Stage::kAxes:

@@ -25,6 +25,9 @@ inline constexpr Rgb kPath{60, 60, 60};
 inline constexpr Rgb kContour{255, 220, 0};
 inline constexpr Rgb kStep{255, 255, 255};
 inline constexpr Rgb kNoData{128, 128, 128};
+inline constexpr Rgb kGridFreeFill{232, 232, 232};   // the world memory's free cells
+inline constexpr Rgb kGridOccupiedFill{70, 70, 70};  // ... and its occupied ones
+inline constexpr Rgb kGridGoal{150, 0, 200};         // the last plan's goal on the grid
 
 // The 3x5 bitmap font (snapshot_canvas.cpp) drawn at kTextScale.
 inline constexpr int kTextScale = 2;                    // each font pixel is 2x2 picture pixels

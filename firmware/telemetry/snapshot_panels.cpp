@@ -276,10 +276,26 @@ void draw_occupancy(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const 
   legend.item(kContour, "CONTOUR");
 }
 
-void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int part) {
+void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int part,
+                     const float* grid_field) {
+  constexpr int kN = SnapshotWriter::kFieldCells;
   if (part == 0) {
+    // The world memory under everything: free cells pale, occupied ones dark, unknown white.
     c.set_clip(m.plot());
     c.fill(m.plot(), Rgb{255, 255, 255});
+    if (f.grid != nullptr) {
+      for (int j = 0; j < kN; ++j) {
+        for (int i = 0; i < kN; ++i) {
+          const float g = grid_field[j * kN + i];
+          if (g == kGridFree) fill_field_cell(c, m, i, j, kGridFreeFill);
+          if (g == kGridOccupied) fill_field_cell(c, m, i, j, kGridOccupiedFill);
+        }
+      }
+    }
+    return;
+  }
+  if (part == 1) {
+    c.set_clip(m.plot());
     fill_polygon(c, m, f.free_polygon, kFreeFill);
     return;
   }
@@ -299,6 +315,12 @@ void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int p
     const float v = m.v(f.goal->y_m);
     c.disc(u, v, 5.0F, kGoal);
   }
+  if (f.grid_goal) {
+    const float u = m.u(f.grid_goal->x_m);
+    const float v = m.v(f.grid_goal->y_m);
+    c.line(u - 6.0F, v - 6.0F, u + 6.0F, v + 6.0F, kGridGoal);
+    c.line(u - 6.0F, v + 6.0F, u + 6.0F, v - 6.0F, kGridGoal);
+  }
   const float u = m.u(f.robot.x_m);
   const float v = m.v(f.robot.y_m);
   const float r = std::max(3.0F, f.robot_radius_m * m.px_per_m);
@@ -311,6 +333,7 @@ void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int p
   legend.item(kExploration, "EXPL");
   legend.item(kGoal, "GOAL");
   legend.item(kPath, "PATH");
+  if (f.grid != nullptr) legend.item(kGridOccupiedFill, "MAP");
 }
 
 // `field` holds the panel's samples of f.value already (sample_field).

@@ -52,9 +52,10 @@ void draw_readings(Canvas& c, const PanelMap& m, const SnapshotFrame& f, std::si
                    std::size_t end);
 // `field` holds the panel's samples of f.occupancy already (sample_field).
 void draw_occupancy(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const float* field);
-// Part 0: the plot and the free polygon's fill; part 1: the title and everything drawn over
-// the fill.
-void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int part);
+// Part 0: the plot and the world memory's cells (`grid_field`: f.grid sampled already); part
+// 1: the free polygon's fill; part 2: the title and everything drawn over the fill.
+void draw_navigation(Canvas& c, const PanelMap& m, const SnapshotFrame& f, int part,
+                     const float* grid_field);
 // `field` holds the panel's samples of f.value already (sample_field).
 void draw_value(Canvas& c, const PanelMap& m, const SnapshotFrame& f, const float* field);
 

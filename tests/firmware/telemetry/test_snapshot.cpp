@@ -22,6 +22,9 @@
 #include "CppUTest/TestHarness.h"
 
 using boticelli::core::Point2;
+using boticelli::firmware::kGridFree;
+using boticelli::firmware::kGridOccupied;
+using boticelli::firmware::kGridUnknown;
 using boticelli::firmware::SnapshotCircle;
 using boticelli::firmware::SnapshotExtent;
 using boticelli::firmware::SnapshotFrame;
@@ -58,6 +61,12 @@ float goal_value(const void* context, float x_m, float y_m) {
   return -((x_m - goal->x_m) * (x_m - goal->x_m) + (y_m - goal->y_m) * (y_m - goal->y_m));
 }
 constexpr Point2 kGoal{1.0F, 2.0F};
+// The world memory: free inside the walls, occupied on a band along the right wall (x 2.5 to
+// 2.9), unknown beyond.
+float room_grid(const void* /*context*/, float x_m, float y_m) {
+  if (y_m < -1.5F || y_m > 2.5F || x_m < -1.5F || x_m > 2.9F) return kGridUnknown;
+  return x_m > 2.5F ? kGridOccupied : kGridFree;
+}
 
 SnapshotFrame synthetic_frame(std::uint32_t cycle) {
   SnapshotFrame f;
@@ -77,6 +86,8 @@ SnapshotFrame synthetic_frame(std::uint32_t cycle) {
   f.value = goal_value;
   f.value_context = &kGoal;
   f.step_end = Point2{0.3F, 0.4F};
+  f.grid = room_grid;
+  f.grid_goal = Point2{-0.5F, 2.2F};
   f.truth_polygons = kTruthPolygons;
   f.truth_circles = kTruthCircles;
   return f;
@@ -181,6 +192,12 @@ TEST(SnapshotWriter, TheRobotObstacleGoalAndTruthWallHaveTheirColoursInThePictur
   CHECK((Colour{0, 200, 200}) == image.at(pixel(2, {1.0F, 2.0F})));
   CHECK((Colour{170, 220, 170}) == image.at(pixel(2, {1.0F, -0.5F})));
   CHECK((Colour{225, 240, 225}) == image.at(pixel(2, {-1.2F, 0.5F})));
+  // Under the polygons the world memory: free pale, occupied dark, unknown white, and the
+  // plan's goal on it a cross.
+  CHECK((Colour{232, 232, 232}) == image.at(pixel(2, {2.4F, 0.0F})));
+  CHECK((Colour{70, 70, 70}) == image.at(pixel(2, {2.7F, 0.0F})));
+  CHECK((Colour{255, 255, 255}) == image.at(pixel(2, {2.95F, -1.8F})));
+  CHECK((Colour{150, 0, 200}) == image.at(pixel(2, {-0.5F, 2.2F})));
   // The true wall, thin, in every panel (here the left wall at y = 0.7 m).
   for (int panel = 0; panel < 4; ++panel) {
     CHECK((Colour{255, 0, 255}) == image.at(pixel(panel, {-1.5F, 0.7F})));
@@ -254,15 +271,17 @@ TEST(SnapshotWriter, WrittenInStepsThePictureIsTheSameAndNoFileShowsBeforeTheLas
   }
   CHECK_TRUE_TEXT(g_writer.ok(), g_writer.error());
   CHECK_FALSE(g_writer.busy());
-  // The paper in bands of kBandRows rows, title, readings, ten field bands, occupancy,
-  // navigation in two parts, ten bands, value, axes, open, the rows in bands of kBandRows,
-  // finish.
+  // The paper in bands of kBandRows rows, title, readings, ten field bands, occupancy, ten
+  // bands of the grid, navigation in three parts, ten bands, value, axes, open, the rows in
+  // bands of kBandRows, finish.
   const auto field_bands =
       static_cast<std::size_t>((SnapshotWriter::kFieldCells + SnapshotWriter::kFieldBandRows - 1) /
                                SnapshotWriter::kFieldBandRows);
   const auto row_bands = static_cast<std::size_t>(
       (SnapshotWriter::kHeightPx + SnapshotWriter::kBandRows - 1) / SnapshotWriter::kBandRows);
-  CHECK_EQUAL(row_bands + 2U + field_bands + 3U + field_bands + 3U + row_bands + 1U, steps);
+  CHECK_EQUAL(
+      row_bands + 2U + field_bands + 1U + field_bands + 3U + field_bands + 3U + row_bands + 1U,
+      steps);
   Image stepped;
   CHECK_TRUE(read_png(dir + "/cycle-000004.png", stepped));
   CHECK(whole.rgb == stepped.rgb);
@@ -333,11 +352,12 @@ TEST(SnapshotWriter, NoStepDoesMoreThanItsShareOfTheWorkHoweverFullThePicture) {
   }
   CHECK_TRUE(done);
   CHECK_TRUE_TEXT(g_writer.ok(), g_writer.error());
-  // The counts are the whole picture's work: every pixel painted, every row encoded, both
-  // fields sampled whole; and the fullest step is near its share (the measure is real).
+  // The counts are the whole picture's work: every pixel painted, every row encoded, the three
+  // fields (occupancy, grid, value) sampled whole; and the fullest step is near its share (the
+  // measure is real).
   CHECK(pixels >= static_cast<std::uint64_t>(SnapshotWriter::kWidthPx) * SnapshotWriter::kHeightPx);
   CHECK_EQUAL(SnapshotWriter::kHeightPx, rows);
-  CHECK_EQUAL(2 * SnapshotWriter::kFieldCells, field_rows);
+  CHECK_EQUAL(3 * SnapshotWriter::kFieldCells, field_rows);
   CHECK(most_pixels > SnapshotWriter::kMaxUnitPixels / 2);
 }
 

@@ -7,6 +7,7 @@
 #include <span>
 
 #include "algo/core/geometry.h"
+#include "algo/worldmap/grid_map.h"
 #include "algo/mapping/local_model_builder.h"
 #include "algo/mapping/map_points.h"
 #include "algo/planning/planner.h"
@@ -26,7 +27,9 @@ struct SnapshotInputs {
   const LookReadings* readings = nullptr;
   const mapping::LocalModelBuilder* builder = nullptr;
   const mapping::GlobalMap* map = nullptr;
-  const core::Point2* goal = nullptr;  // confirmed target, or nullptr
+  const core::Point2* goal = nullptr;       // confirmed target, or nullptr
+  const worldmap::GridMap* grid = nullptr;  // the world memory, or nullptr
+  const core::Point2* grid_goal = nullptr;  // the last plan's goal on it, or nullptr
   std::span<const core::Point2> path;
   const planning::ValueIteration* value = nullptr;
   const planning::StepDecision* decision = nullptr;

@@ -35,6 +35,10 @@ struct SnapshotExtent {
 
 // A scalar field on the floor, world frame [m] in, value out; `context` is passed back as given.
 using SnapshotField = float (*)(const void* context, float x_m, float y_m);
+// What SnapshotFrame::grid returns for a cell.
+inline constexpr float kGridUnknown = 0.0F;
+inline constexpr float kGridFree = 1.0F;
+inline constexpr float kGridOccupied = 2.0F;
 
 // Everything one picture shows. Plain data: the spans and the state name are only read during
 // write(), nothing is kept. Polygons are world-frame vertex lists, closed implicitly.
@@ -58,6 +62,11 @@ struct SnapshotFrame {
   std::span<const core::Point2> exploration_points{};
   std::optional<core::Point2> goal{};
   std::span<const core::Point2> path{};  // the robot's path so far
+  // Under it, the world memory: a cell's state at a floor point (kGridUnknown, kGridFree,
+  // kGridOccupied), and the last plan's goal on it (a frontier or the target's stand-off).
+  SnapshotField grid = nullptr;
+  const void* grid_context = nullptr;
+  std::optional<core::Point2> grid_goal{};
   // Panel 4: the value function V(x, y) (§5.5) and the chosen step's end.
   SnapshotField value = nullptr;
   const void* value_context = nullptr;
@@ -167,7 +176,9 @@ class SnapshotWriter {
     kReadings,
     kOccupancyField,
     kOccupancy,
+    kGridField,
     kNavigation,
+    kNavigationFree,
     kNavigationMarks,
     kValueField,
     kValue,
