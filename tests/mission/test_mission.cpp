@@ -294,29 +294,6 @@ TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnythin
   }
 }
 
-namespace {
-// Times the robot drove back the way it came: the true path read in 0.25 m stretches, and a
-// reversal where one stretch turns more than 135° from the one before (the mission bench's
-// `reversals`).
-std::size_t reversals(const std::vector<sim::TraceRow>& rows) {
-  std::vector<std::pair<double, double>> marks = {{rows.front().x_m, rows.front().y_m}};
-  for (const sim::TraceRow& r : rows) {
-    if (std::hypot(r.x_m - marks.back().first, r.y_m - marks.back().second) >= 0.25) {
-      marks.emplace_back(r.x_m, r.y_m);
-    }
-  }
-  std::size_t count = 0;
-  for (std::size_t i = 2; i < marks.size(); ++i) {
-    const double ax = marks[i - 1].first - marks[i - 2].first;
-    const double ay = marks[i - 1].second - marks[i - 2].second;
-    const double bx = marks[i].first - marks[i - 1].first;
-    const double by = marks[i].second - marks[i - 1].second;
-    count += (ax * bx + ay * by) / (std::hypot(ax, ay) * std::hypot(bx, by)) < -0.7071 ? 1U : 0U;
-  }
-  return count;
-}
-}  // namespace
-
 // A 6 x 6 m room of this test's own: the target on the north wall is seen from the start over
 // a row of low crates that bars the straight way, with one gap at the row's east end. The
 // robot goes round by the grid's path and steps to the target's stand-off by the grid when
@@ -326,7 +303,7 @@ TEST(MissionRooms, AFarTargetBehindARowOfCratesIsReachedRoundItWithoutDrivingBac
   const std::string world = std::string(BOTICELLI_TEST_WORLDS_DIR) + "/barred_far_target.sdf";
   const MissionRun r = run_mission(world.c_str(), "1");
   check_found_safely(r);
-  const std::size_t back = reversals(r.trace);
+  const std::size_t back = sim::count_reversals(r.trace);
   const std::string what = r.mission_line + ", " + std::to_string(back) + " reversals";
   CHECK_TEXT(back <= 3, what.c_str());
 }

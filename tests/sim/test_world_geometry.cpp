@@ -97,6 +97,30 @@ TEST_GROUP(WorldGeometry){void setup() override{g_error[0] = '\0';
 }
 ;
 
+TEST(WorldGeometry, ReversalsCountOnlyTheTimesThePathTurnsBackOnItself) {
+  std::vector<TraceRow> rows;
+  const auto at = [&rows](double x, double y) {
+    TraceRow r{};
+    r.x_m = x;
+    r.y_m = y;
+    rows.push_back(r);
+  };
+  // East 1 m, a right angle north 1 m (no reversal), back south 1 m (one), in 5 cm rows.
+  for (int i = 0; i <= 20; ++i) at(0.05 * i, 0.0);
+  for (int i = 1; i <= 20; ++i) at(1.0, 0.05 * i);
+  for (int i = 1; i <= 20; ++i) at(1.0, 1.0 - 0.05 * i);
+  LONGS_EQUAL(1, boticelli::hal::sim::count_reversals(rows));
+  // Jitter within a stretch (a turn in place, 1 cm back and forth) is no reversal.
+  for (int i = 0; i < 10; ++i) at(1.0 + 0.01 * (i % 2), 0.0);
+  LONGS_EQUAL(1, boticelli::hal::sim::count_reversals(rows));
+  // Then west along y = 0 (a right angle from south: none), east and west again: two more.
+  for (int k = 0; k < 3; ++k) {
+    for (int i = 1; i <= 20; ++i) at(k % 2 == 0 ? 1.0 - 0.05 * i : 0.05 * i, 0.0);
+  }
+  LONGS_EQUAL(3, boticelli::hal::sim::count_reversals(rows));
+  LONGS_EQUAL(0, boticelli::hal::sim::count_reversals({}));
+}
+
 TEST(WorldGeometry, ClearanceToARotatedBoxIsTheDistanceToItsTurnedOutline) {
   const double yaw = 0.5;
   CHECK_TEXT(parse(small_world(box("crate", "2 1 0.5 0 0 0.5", "1.0 0.4 1"), "-2 -2 0 0 0 0")),

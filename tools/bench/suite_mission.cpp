@@ -179,34 +179,7 @@ std::size_t grid_bytes(const hal::sim::World& w) {
 
 hal::sim::World g_world;
 
-constexpr double kReversalStrideM = 0.25;  // the path is read in stretches this long [m]
-constexpr double kReversalCos = -0.7071;   // a turn of more than 135° between two stretches
-constexpr double kObstacleOffM = 0.3;      // an occupied cell farther than this from a surface
-
-// Times the direction of travel reversed: the true path resampled every kReversalStrideM of
-// travel, and a reversal where one stretch's direction and the next differ by more than 135°
-// (driving back the way it came; a turn in place between two steps counts as its outcome).
-std::size_t reversals(const std::vector<hal::sim::TraceRow>& rows) {
-  struct Mark {
-    double x, y;
-  };
-  std::vector<Mark> marks;
-  if (rows.empty()) return 0;
-  marks.push_back({rows[0].x_m, rows[0].y_m});
-  for (const hal::sim::TraceRow& r : rows) {
-    if (std::hypot(r.x_m - marks.back().x, r.y_m - marks.back().y) >= kReversalStrideM) {
-      marks.push_back({r.x_m, r.y_m});
-    }
-  }
-  std::size_t count = 0;
-  for (std::size_t i = 2; i < marks.size(); ++i) {
-    const double ax = marks[i - 1].x - marks[i - 2].x, ay = marks[i - 1].y - marks[i - 2].y;
-    const double bx = marks[i].x - marks[i - 1].x, by = marks[i].y - marks[i - 1].y;
-    const double c = (ax * bx + ay * by) / (std::hypot(ax, ay) * std::hypot(bx, by));
-    count += c < kReversalCos ? 1U : 0U;
-  }
-  return count;
-}
+constexpr double kObstacleOffM = 0.3;  // an occupied cell farther than this from a surface
 
 // The mission frame in the world: the first trace row's true pose composed with the inverse
 // of its odometry pose (the odo_* columns; the frame is the odometry's at the base's start).
@@ -552,7 +525,8 @@ int run() {
         .num("max_trace_gap_s",
              trace_ok ? check.max_gap_s : std::numeric_limits<double>::quiet_NaN())
         .integer("trace_rows", static_cast<std::int64_t>(check.rows))
-        .integer("reversals", trace_ok ? static_cast<std::int64_t>(reversals(rows)) : -1)
+        .integer("reversals",
+                 trace_ok ? static_cast<std::int64_t>(hal::sim::count_reversals(rows)) : -1)
         .num("target_error_m", m.target_error_m)
         .num("map_bytes", field(m.map_line, "grid_bytes"))
         .num("map_free_m2", free_m2)

@@ -260,6 +260,28 @@ bool read_trace(const char* path, std::vector<TraceRow>& rows, std::string& erro
   return true;
 }
 
+std::size_t count_reversals(const std::vector<TraceRow>& rows, double stride_m,
+                            double min_turn_rad) {
+  if (rows.empty()) return 0;
+  struct Mark {
+    double x, y;
+  };
+  std::vector<Mark> marks = {{rows.front().x_m, rows.front().y_m}};
+  for (const TraceRow& r : rows) {
+    if (std::hypot(r.x_m - marks.back().x, r.y_m - marks.back().y) >= stride_m) {
+      marks.push_back({r.x_m, r.y_m});
+    }
+  }
+  const double cos_limit = std::cos(min_turn_rad);
+  std::size_t count = 0;
+  for (std::size_t i = 2; i < marks.size(); ++i) {
+    const double ax = marks[i - 1].x - marks[i - 2].x, ay = marks[i - 1].y - marks[i - 2].y;
+    const double bx = marks[i].x - marks[i - 1].x, by = marks[i].y - marks[i - 1].y;
+    count += (ax * bx + ay * by) / (std::hypot(ax, ay) * std::hypot(bx, by)) < cos_limit ? 1U : 0U;
+  }
+  return count;
+}
+
 TraceCheck check_trace(const World& world, const std::vector<TraceRow>& rows, float radius_m,
                        float height_m) {
   const ClearanceField field(world, radius_m, height_m);

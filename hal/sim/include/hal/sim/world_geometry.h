@@ -59,6 +59,12 @@ struct TraceCheck {
 TraceCheck check_trace(const World& world, const std::vector<TraceRow>& rows, float radius_m,
                        float height_m);
 
+// Times a trace drove back the way it came: its true path read in stretches of stride_m of
+// travel, a reversal wherever one stretch's direction turns from the one before by more than
+// min_turn_rad (a turn in place between two steps counts as its outcome).
+std::size_t count_reversals(const std::vector<TraceRow>& rows, double stride_m = 0.25,
+                            double min_turn_rad = 2.35619449);
+
 // Length [m] of the shortest collision-free path of the robot's disc from `start` to any point
 // within goal_radius_m of `goal`: Dijkstra over a 2.5 cm grid (aligned on the start) with
 // 16-neighbour moves whose edges are proven free (the clearance's 1-Lipschitz bound, or a
