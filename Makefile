@@ -8,7 +8,8 @@ ARGS ?=
 SUITE ?= all
 FUZZ_SECONDS ?= 60
 
-.PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze deps-kernel test-kernel run test check \
+.PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze deps-kernel deps-box test-kernel \
+        test-robot run test check \
         bench bench-build format format-check sim asan rpi4 armhf fuzz-build test-sim test-asan \
         test-rpi4 test-fuzz fuzz \
         analyze mutants mutation-score clean
@@ -22,6 +23,7 @@ help:
 	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
 	@echo "make package-rpi4 / make deploy HOST=user@robot   build the arm64 .deb / install it over ssh"
+	@echo "make test-robot  the .deb as a service on a virtual robot computer under qemu (not in make test)"
 	@echo "make format    clang-format every C++ file; make format-check only reports"
 	@echo "make fuzz      run every libFuzzer target for FUZZ_SECONDS (default 60) each"
 	@echo "make analyze   clang-tidy and cppcheck over the tree (zero findings expected)"
@@ -40,6 +42,8 @@ deps-analyze:
 	@toolchain/install-deps.sh --analyze
 deps-kernel:
 	@toolchain/install-deps.sh --kernel
+deps-box:
+	@toolchain/install-deps.sh --box
 
 # configure+build one preset: $(call build,PRESET)
 define build
@@ -140,15 +144,28 @@ format-check:
 	@git ls-files '*.h' '*.hpp' '*.cpp' | xargs clang-format --dry-run --Werror
 
 # The rpi4 .deb (CPack, arm64) and its installation on the robot over ssh (docs/flashing.md).
-.PHONY: package-rpi4 deploy
+# PACKAGE=linux-amd64 installs the same board built natively instead (the robot computer in
+# a box, docs/testing.md); SSHFLAGS go to both scp and ssh (e.g. -F FILE, -p PORT for scp: -P).
+PACKAGE ?= rpi4
+SSHFLAGS ?=
+.PHONY: package-rpi4 package-linux-amd64 deploy
 package-rpi4: rpi4
 	cd build/rpi4 && cpack -G DEB
+package-linux-amd64: deps
+	$(call build,linux-amd64)
+	cd build/linux-amd64 && cpack -G DEB
 deploy:
-	@test -n "$(HOST)" || { echo "usage: make deploy HOST=user@robot" >&2; exit 2; }
-	@$(MAKE) package-rpi4
-	deb=$$(ls -t build/rpi4/boticelli_*_arm64.deb | head -n1) && \
-	  scp "$$deb" $(HOST):/tmp/ && \
-	  ssh $(HOST) "sudo apt-get install -y --allow-downgrades /tmp/$$(basename $$deb)"
+	@test -n "$(HOST)" || { echo "usage: make deploy HOST=user@robot [PACKAGE=rpi4|linux-amd64]" >&2; exit 2; }
+	@$(MAKE) package-$(PACKAGE)
+	deb=$$(ls -t build/$(PACKAGE)/boticelli_*.deb | head -n1) && \
+	  scp $(SSHFLAGS) "$$deb" $(HOST):/tmp/ && \
+	  ssh $(SSHFLAGS) $(HOST) "sudo apt-get install -y --allow-downgrades /tmp/$$(basename $$deb)"
+
+# The robot computer in a box (tests/box/run.sh, docs/testing.md): boots a Debian 12 amd64
+# box under qemu, deploys the linux-amd64 .deb with make deploy and checks it as an operator
+# would. Not part of make test (about ... minutes, docs/testing.md).
+test-robot: deps-box package-linux-amd64
+	tests/box/run.sh build/linux-amd64 build/box
 
 clean:
 	rm -rf build

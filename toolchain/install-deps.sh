@@ -13,9 +13,14 @@
 #                                        busybox, can-utils, the kernel headers) and Debian's
 #                                        amd64 kernel and kernel source packages, fetched with
 #                                        apt-get download into the kernel cache (below)
+#   toolchain/install-deps.sh --box      also --kernel, and the robot computer in a box
+#                                        (make test-robot): mmdebstrap, picocom, socat, ssh;
+#                                        builds the box's Debian 12 image into the box cache
 #
 # The kernel cache is $BOTICELLI_KERNEL_CACHE, by default ~/.cache/boticelli-kernel (so fresh
 # clones share it); it holds the two .deb files (about 210 MB), never installed into the host.
+# The box cache is $BOTICELLI_BOX_CACHE, by default ~/.cache/boticelli-box: a 2 GiB disk image
+# made by toolchain/build-box.sh from Debian's packages and the kernel cache's kernel.
 # Idempotent: when everything is present it prints nothing and exits 0.
 set -euo pipefail
 
@@ -24,6 +29,7 @@ want_bench=0
 want_armhf=0
 want_analyze=0
 want_kernel=0
+want_box=0
 for arg in "$@"; do
   case "$arg" in
     --cross) want_cross=1 ;;
@@ -31,7 +37,8 @@ for arg in "$@"; do
     --armhf) want_armhf=1 ;;
     --analyze) want_analyze=1 ;;
     --kernel) want_kernel=1 ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --box) want_kernel=1; want_box=1 ;;
+    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "install-deps: unknown option '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -61,6 +68,9 @@ analyze_pkgs=(clang-tidy-14 cppcheck)
 # bus; binutils (objcopy) reads the modules' dependencies; xz-utils unpacks the kernel source.
 # The headers of the image's kernel ABI (for the out-of-tree gpio-sim module) are added below.
 kernel_pkgs=(qemu-system-x86 busybox-static cpio can-utils binutils xz-utils)
+# The box (tests/box): mmdebstrap builds its image (e2fsprogs makes the file system), ssh
+# reaches it, picocom and socat speak on its console's pty.
+box_pkgs=(mmdebstrap e2fsprogs openssh-client picocom socat)
 
 pkgs=("${host_pkgs[@]}")
 [ "$want_cross" = 1 ] && pkgs+=("${cross_pkgs[@]}")
@@ -68,11 +78,15 @@ pkgs=("${host_pkgs[@]}")
 [ "$want_bench" = 1 ] && pkgs+=("${bench_pkgs[@]}")
 [ "$want_analyze" = 1 ] && pkgs+=("${analyze_pkgs[@]}")
 [ "$want_kernel" = 1 ] && pkgs+=("${kernel_pkgs[@]}")
+[ "$want_box" = 1 ] && pkgs+=("${box_pkgs[@]}")
 
 repo=$(cd "$(dirname "$0")/.." && pwd)
 if [ -n "${HOME:-}" ]; then default_cache=${XDG_CACHE_HOME:-$HOME/.cache}/boticelli-kernel
 else default_cache=$repo/build/kernel-cache; fi
 kernel_cache=${BOTICELLI_KERNEL_CACHE:-$default_cache}
+if [ -n "${HOME:-}" ]; then default_box=${XDG_CACHE_HOME:-$HOME/.cache}/boticelli-box
+else default_box=$repo/build/box-cache; fi
+box_cache=${BOTICELLI_BOX_CACHE:-$default_box}
 pkg_installed() {
   [ "$(dpkg-query -W -f='${db:Status-Status}' "$1" 2>/dev/null || true)" = installed ]
 }
@@ -105,7 +119,15 @@ for p in "${pkgs[@]}"; do
 done
 need_kernel=0
 if [ "$want_kernel" = 1 ] && ! kernel_ready; then need_kernel=1; fi
-[ "${#missing[@]}" = 0 ] && [ "$need_kernel" = 0 ] && exit 0
+# The box image is (re)built by its own script, which checks its stamp first.
+build_box() {
+  [ "$want_box" = 1 ] || return 0
+  "$repo/toolchain/build-box.sh" "$kernel_cache" "$box_cache"
+}
+if [ "${#missing[@]}" = 0 ] && [ "$need_kernel" = 0 ]; then
+  build_box
+  exit 0
+fi
 
 sudo=()
 if [ "$(id -u)" != 0 ]; then
@@ -176,4 +198,5 @@ if [ "$need_kernel" = 1 ]; then
     exit 1
   fi
 fi
+build_box
 echo "install-deps: done"

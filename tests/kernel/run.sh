@@ -64,29 +64,9 @@ if [ ! -f "$kdir/.unpacked" ]; then
 fi
 modules=$kdir/lib/modules/$kver
 
-# 2. gpio-sim, built out of tree once per version: Debian's config does not build it. It
-# needs irq_sim (CONFIG_IRQ_SIM is off too, so it is compiled into the same module), and in
-# 6.1 irq_to_desc is not exported: its one call becomes generic_handle_irq.
+# 2. gpio-sim, built out of tree once per version (Debian's config does not build it).
 gsim=$cache/gpio-sim-$pkgver
-if [ ! -f "$gsim/gpio-sim.ko" ]; then
-  rm -rf "$gsim" && mkdir -p "$gsim/src"
-  series=$(basename "$source_deb" | sed 's/^linux-source-\([0-9.]*\)_.*/\1/')
-  dpkg-deb --fsys-tarfile "$source_deb" |
-    tar -xO "./usr/src/linux-source-$series.tar.xz" |
-    tar -xJ -C "$gsim/src" --strip-components=1 --wildcards \
-      "linux-source-$series/drivers/gpio/gpio-sim.c" \
-      "linux-source-$series/drivers/gpio/gpiolib*.h" \
-      "linux-source-$series/kernel/irq/irq_sim.c"
-  cp "$gsim"/src/drivers/gpio/gpio-sim.c "$gsim/gpio-sim-main.c"
-  cp "$gsim"/src/drivers/gpio/gpiolib*.h "$gsim/"
-  sed 's/handle_simple_irq(irq_to_desc(irqnum))/generic_handle_irq(irqnum)/' \
-    "$gsim/src/kernel/irq/irq_sim.c" >"$gsim/irq_sim.c"
-  grep -q 'generic_handle_irq(irqnum)' "$gsim/irq_sim.c" ||
-    fail "irq_sim.c of $pkgver no longer has the call this script replaces"
-  printf 'obj-m := gpio-sim.o\ngpio-sim-y := gpio-sim-main.o irq_sim.o\n' >"$gsim/Kbuild"
-  make -s -C "$headers" M="$gsim" modules >"$gsim/build.log" 2>&1 ||
-    { tail -n 20 "$gsim/build.log" >&2; fail "building gpio-sim failed"; }
-fi
+"$here/gpio-sim.sh" "$source_deb" "$headers" "$gsim" || fail "no gpio-sim module"
 
 # 3. The initramfs: busybox, the test program and candump with their shared libraries, the
 # modules' dependency closure, and the guest's init.

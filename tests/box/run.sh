@@ -1,0 +1,461 @@
+#!/usr/bin/env bash
+# The robot computer in a box: boots the Debian 12 box under qemu, deploys the .deb and checks the service as an operator would.
+#
+#   tests/box/run.sh BUILD_DIR WORK_DIR
+#
+# BUILD_DIR is the linux-amd64 preset's build (its .deb and bin/boticelli-box-devices);
+# WORK_DIR gets the box's logs (serial0.log: the box's own console, qemu.log), the ssh
+# configuration and the results. The box image comes from the box cache that
+# toolchain/install-deps.sh --box fills; qemu runs it with -snapshot, so every run starts
+# from the same disk. Each check prints one line, `PASS name (detail)` or `FAIL name: why`;
+# the last line is `N passed, N failed`. Exit 0 when every check passed, 1 otherwise, 77
+# when qemu cannot run here. docs/testing.md, "The robot computer in a box", says what
+# each check does.
+# Commands for the box are strings run by its shell (ssh): expanded here or there on purpose.
+# shellcheck disable=SC2029,SC2016
+set -euo pipefail
+
+[ "$#" = 2 ] || { echo "usage: $0 BUILD_DIR WORK_DIR" >&2; exit 2; }
+build=$(cd "$1" && pwd)
+mkdir -p "$2"
+work=$(cd "$2" && pwd)
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+if [ -n "${HOME:-}" ]; then default_box=${XDG_CACHE_HOME:-$HOME/.cache}/boticelli-box
+else default_box=$repo/build/box-cache; fi
+box=${BOTICELLI_BOX_CACHE:-$default_box}
+port=${BOTICELLI_BOX_SSH_PORT:-2251}
+
+die() {
+  echo "test-robot: $*" >&2
+  exit 1
+}
+now() { date +%s.%N; }
+since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+t_start=$(now)
+
+command -v qemu-system-x86_64 >/dev/null ||
+  { echo "SKIPPED: qemu-system-x86_64 is not installed (toolchain/install-deps.sh --box)"; exit 77; }
+[ "$(uname -m)" = x86_64 ] || { echo "SKIPPED: the box is amd64 and this host is $(uname -m)"; exit 77; }
+for f in root.img vmlinuz initrd.img id_ed25519 .built; do
+  [ -f "$box/$f" ] || die "$box/$f is missing (toolchain/install-deps.sh --box builds the box)"
+done
+devices=$build/bin/boticelli-box-devices
+[ -x "$devices" ] || die "$devices is missing (make package-linux-amd64 builds it)"
+deb=$(find "$build" -maxdepth 1 -name 'boticelli_*_amd64.deb' -printf '%T@ %p\n' | sort -rn |
+  head -n1 | cut -d' ' -f2-)
+[ -n "$deb" ] || die "no boticelli_*_amd64.deb in $build (make package-linux-amd64)"
+
+# ---------------------------------------------------------------------------------------
+# The checks' bookkeeping: one line each.
+passed=0
+failed=0
+results=$work/results.txt
+: >"$results"
+pass() {
+  echo "PASS $1${2:+ ($2)}" | tee -a "$results"
+  passed=$((passed + 1))
+}
+fail() {
+  echo "FAIL $1: $2" | tee -a "$results"
+  failed=$((failed + 1))
+}
+
+# ---------------------------------------------------------------------------------------
+# The box: qemu with the box's disk (writes kept in memory), Debian's kernel, the i6300esb
+# hardware watchdog, ttyS0 the box's own console (a log file), ttyS1 the robot's console
+# UART on a host pty, ttyS2 the PTU adapter on the PTU emulator's pty, and ssh on a
+# user-mode network that reaches nothing but the host's forwarded port.
+qemu_pid=
+ptu_pid=
+cleanup() {
+  if [ -n "$qemu_pid" ]; then kill "$qemu_pid" 2>/dev/null || true; fi
+  if [ -n "$ptu_pid" ]; then kill "$ptu_pid" 2>/dev/null || true; fi
+  exec 3>&- 2>/dev/null || true
+}
+trap cleanup EXIT
+
+"$devices" ptu "$work/ptu-tty" >"$work/ptu.log" 2>&1 &
+ptu_pid=$!
+for _ in $(seq 50); do [ -e "$work/ptu-tty" ] && break; sleep 0.1; done
+[ -e "$work/ptu-tty" ] || die "the PTU emulator did not start: $(cat "$work/ptu.log")"
+
+rm -f "$work/serial0.log" "$work/qemu.log"
+boot_start=$(now)
+nice qemu-system-x86_64 -accel tcg -m 1024M -smp 2 -display none -vga none \
+  -kernel "$box/vmlinuz" -initrd "$box/initrd.img" \
+  -append "root=/dev/vda rw console=ttyS0 quiet systemd.show_status=0" \
+  -drive "file=$box/root.img,if=virtio,format=raw,snapshot=on" \
+  -serial "file:$work/serial0.log" \
+  -chardev pty,id=console -serial chardev:console \
+  -chardev "serial,id=ptu,path=$work/ptu-tty" -serial chardev:ptu \
+  -device i6300esb -watchdog-action reset \
+  -nic "user,model=virtio-net-pci,restrict=on,hostfwd=tcp:127.0.0.1:$port-:22" \
+  </dev/null >"$work/qemu.log" 2>&1 &
+qemu_pid=$!
+pty=
+for _ in $(seq 100); do
+  pty=$(sed -n 's/.*char device redirected to \(\/dev\/pts\/[0-9]*\) (label console).*/\1/p' "$work/qemu.log")
+  [ -n "$pty" ] && break
+  kill -0 "$qemu_pid" 2>/dev/null || die "qemu stopped: $(cat "$work/qemu.log")"
+  sleep 0.1
+done
+[ -n "$pty" ] || die "qemu named no pty for the console: $(cat "$work/qemu.log")"
+
+cat >"$work/ssh_config" <<EOF
+Host box
+  HostName 127.0.0.1
+  Port $port
+  User robot
+  IdentityFile $box/id_ed25519
+  IdentitiesOnly yes
+  StrictHostKeyChecking no
+  UserKnownHostsFile /dev/null
+  LogLevel ERROR
+  ConnectTimeout 10
+  ServerAliveInterval 5
+  ServerAliveCountMax 6
+EOF
+ssh_flags=(-F "$work/ssh_config")
+bx() { ssh "${ssh_flags[@]}" box "$@"; }
+
+wait_ssh() { # SECONDS: until the box answers over ssh
+  local end=$(($(date +%s) + $1))
+  while [ "$(date +%s)" -lt "$end" ]; do
+    bx true 2>/dev/null && return 0
+    kill -0 "$qemu_pid" 2>/dev/null || die "qemu stopped: $(tail -n 5 "$work/qemu.log")"
+    sleep 2
+  done
+  return 1
+}
+wait_ssh 600 || die "no ssh from the box after 600 s (the box's console: $work/serial0.log)"
+boot_s=$(since "$boot_start")
+echo "test-robot: the box is up (ssh) ${boot_s} s after qemu started; console on $pty"
+
+# The base: the ODrive emulator as a unit of the box (it comes back after a reset).
+scp "${ssh_flags[@]}" -q "$devices" box:/tmp/ || die "cannot copy the device emulator into the box"
+bx 'sudo install -m 0755 /tmp/boticelli-box-devices /usr/local/bin/ &&
+  printf "%s\n" "[Unit]" "Description=ODrive emulator on can0" "After=box-devices.service" \
+    "Requires=box-devices.service" "[Service]" \
+    "ExecStart=/usr/local/bin/boticelli-box-devices odrive can0" \
+    "[Install]" "WantedBy=multi-user.target" |
+  sudo tee /etc/systemd/system/box-odrive.service >/dev/null &&
+  sudo systemctl daemon-reload && sudo systemctl enable --now box-odrive.service' >/dev/null 2>&1 ||
+  die "the ODrive emulator does not run in the box"
+
+# ---------------------------------------------------------------------------------------
+# Helpers of the checks.
+unit_prop() { bx systemctl show -P "$1" boticelli.service; }
+main_pid() { unit_prop MainPID; }
+active_state() { unit_prop ActiveState; }
+# Frames the firmware sends the ODrives that make the wheels turn, over SECONDS (candump -L:
+# "(t) can0 ID#DATA"): Set_Axis_State (0x07) to closed loop (8) and Set_Input_Vel (0x0D) with
+# a velocity other than 0, for node 0 or 1.
+motion_frames() { # SECONDS
+  bx "timeout $1 candump -L can0 2>/dev/null | awk '{ split(\$3, f, \"#\"); id = f[1]; v = substr(f[2], 1, 8)
+    if ((id == \"007\" || id == \"027\") && substr(f[2], 1, 2) == \"08\") n++
+    if ((id == \"00D\" || id == \"02D\") && v != \"00000000\" && v != \"00000080\") n++ } END { print n + 0 }'" ||
+    echo "candump failed"
+}
+# Until the unit is active/running with a MainPID other than $2, at most $1 s.
+wait_running() { # SECONDS [OLD_PID]
+  local end=$(($(date +%s) + $1)) state pid
+  while [ "$(date +%s)" -lt "$end" ]; do
+    state=$(bx systemctl show -P ActiveState,SubState,MainPID boticelli.service 2>/dev/null | tr '\n' ' ')
+    read -r a s pid <<<"$state" || true
+    if [ "$a" = active ] && [ "$s" = running ] && [ "$pid" != 0 ] && [ "$pid" != "${2:-}" ]; then
+      return 0
+    fi
+    sleep 1
+  done
+  return 1
+}
+
+# The console: the robot's UART (the box's ttyS1) on the host's pty, with picocom's
+# settings (115200 8N1, no flow control, raw). console CMD prints the reply's lines up to
+# OK or ERR (TLM and LOG lines left out), or "TIMEOUT".
+stty -F "$pty" 115200 cs8 -cstopb -parenb -crtscts -ixon -ixoff raw -echo
+exec 3<>"$pty"
+console() { # COMMAND [SECONDS]
+  local line end=$(($(date +%s) + ${2:-10}))
+  while IFS= read -r -t 0.05 -u 3 _; do :; done
+  printf '%s\r' "$1" >&3
+  while [ "$(date +%s)" -lt "$end" ]; do
+    IFS= read -r -t 1 -u 3 line || continue
+    line=${line%$'\r'}
+    case "$line" in
+      TLM\ * | LOG\ * | '') ;;
+      OK) echo OK; return 0 ;;
+      ERR\ *) echo "$line"; return 0 ;;
+      *) echo "$line" ;;
+    esac
+  done
+  echo TIMEOUT
+  return 1
+}
+status_field() { # FIELD: from the console's status line
+  console status | sed -n "s/^status .*\\b$1=\\([^ ]*\\).*/\\1/p"
+}
+
+# The gpio-sim line LINE's pull (pull-up / pull-down): what the wire does when nothing drives it.
+gpio_pull() { # LINE PULL
+  bx "echo $2 | sudo tee /sys/devices/platform/gpio-sim.*/gpiochip*/sim_gpio$1/pull >/dev/null"
+}
+
+# ---------------------------------------------------------------------------------------
+# 1. Install with make deploy (docs/flashing.md section 2), which must not start the
+# firmware or move the base.
+deploy_log=$work/deploy-install.log
+if make -C "$repo" --no-print-directory deploy HOST=box PACKAGE=linux-amd64 \
+     SSHFLAGS="-F $work/ssh_config" >"$deploy_log" 2>&1; then
+  if grep -q "boticelli: not started" "$deploy_log"; then
+    pass deploy_installs "make deploy; apt says 'not started'"
+  else
+    fail deploy_installs "make deploy succeeded but apt's output lacks 'boticelli: not started' ($deploy_log)"
+  fi
+else
+  fail deploy_installs "make deploy failed: $(tail -n 3 "$deploy_log" | tr '\n' ' ')"
+fi
+state=$(active_state || echo unknown)
+frames=$(motion_frames 3)
+if [ "$state" != inactive ]; then
+  fail install_does_not_start_motion "boticelli.service is '$state' after the install (expected inactive: postinst must not start it)"
+elif [ "$frames" != 0 ]; then
+  fail install_does_not_start_motion "$frames motion frames on can0 in 3 s after the install"
+else
+  pass install_does_not_start_motion "inactive, 0 motion frames on can0 in 3 s"
+fi
+
+# 2. systemctl start returns when the firmware sent READY=1 (Type=notify).
+t0=$(now)
+if bx sudo systemctl start boticelli 2>"$work/start.err"; then
+  ready_s=$(since "$t0")
+  if [ "$(active_state)" = active ]; then
+    pass start_reaches_ready "systemctl start returned after READY=1 in ${ready_s} s"
+  else
+    fail start_reaches_ready "systemctl start returned but the unit is $(active_state)"
+  fi
+else
+  ready_s=
+  fail start_reaches_ready "systemctl start failed: $(cat "$work/start.err") $(bx journalctl -u boticelli -n 5 --no-pager 2>&1 | tr '\n' ' ')"
+fi
+
+# 3. systemctl status shows the mission's state (STATUS=, once a second).
+sleep 2
+status_text=$(unit_prop StatusText || true)
+if [[ "$status_text" =~ state=[a-z]+\ cycle=[0-9]+\ healthy=[01]\ estop=[a-z]+\ target=[a-z]+ ]]; then
+  pass status_shows_mission_state "Status: $status_text"
+else
+  fail status_shows_mission_state "StatusText is '$status_text' (expected state=... cycle=N healthy=N estop=... target=...)"
+fi
+
+# 4. The console answers on the UART: status, and its round trip (median of 5).
+times=()
+reply=
+for _ in 1 2 3 4 5; do
+  t0=$(now)
+  reply=$(console status 10 || true)
+  times+=("$(awk -v a="$t0" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }')")
+done
+round_trip=$(printf '%s\n' "${times[@]}" | sort -n | sed -n 3p)
+if grep -q '^status state=' <<<"$reply" && grep -qx OK <<<"$reply"; then
+  pass console_round_trip "status over the console pty, median ${round_trip} s of 5"
+else
+  fail console_round_trip "no status reply on the console pty (got: $(tr '\n' ' ' <<<"$reply"))"
+fi
+
+# 5. Fault classes of docs/reliability.md the service survives, each with the same process.
+pid=$(main_pid)
+# CAN link down and up: the base is held, then healthy again.
+bx sudo ip link set can0 down
+sleep 3
+down_healthy=$(status_field healthy)
+bx sudo ip link set can0 up
+ok=0
+for _ in $(seq 20); do
+  [ "$(status_field healthy)" = 1 ] && { ok=1; break; }
+  sleep 1
+done
+if [ "$ok" = 1 ] && [ "$(main_pid)" = "$pid" ]; then
+  pass fault_can_link_down_up "healthy=$down_healthy while down, healthy=1 again, same process"
+else
+  fail fault_can_link_down_up "after can0 down/up: healthy=$(status_field healthy), pid $(main_pid) (was $pid), state $(active_state)"
+fi
+# The camera's driver unbound and bound again (the webcam unplugged and plugged in).
+bx 'echo vivid.0 | sudo tee /sys/bus/platform/drivers/vivid/unbind >/dev/null'
+sleep 3
+cam_healthy=$(status_field healthy)
+bx 'echo vivid.0 | sudo tee /sys/bus/platform/drivers/vivid/bind >/dev/null'
+ok=0
+for _ in $(seq 25); do
+  [ "$(status_field healthy)" = 1 ] && { ok=1; break; }
+  sleep 1
+done
+if [ "$ok" = 1 ] && [ "$(main_pid)" = "$pid" ]; then
+  pass fault_camera_reload "healthy=$cam_healthy while gone, healthy=1 again, same process"
+else
+  fail fault_camera_reload "after vivid unbind/bind: healthy=$(status_field healthy), pid $(main_pid) (was $pid), state $(active_state)"
+fi
+# A broken e-stop wire: the normally closed switch's line floats high = pressed: the e-stop
+# latches and the base stays stopped; mended, clear-estop and resume run on.
+gpio_pull 17 pull-up
+sleep 2
+estop=$(status_field estop)
+frames=$(motion_frames 2)
+gpio_pull 17 pull-down
+cleared=$(console clear-estop | tail -n1)
+resumed=$(console resume | tail -n1)
+if [ "$estop" = button ] && [ "$frames" = 0 ] && [ "$(main_pid)" = "$pid" ]; then
+  pass fault_estop_wire_broken "estop=button, 0 motion frames, same process; clear-estop $cleared, resume $resumed"
+else
+  fail fault_estop_wire_broken "with the e-stop line high: estop=$estop, $frames motion frames in 2 s, pid $(main_pid) (was $pid)"
+fi
+
+# 6. journald keeps the firmware's priorities: its warnings and errors in the journal
+# (journalctl -p warning) are exactly those of the console's log ring (log show).
+sleep 1
+ring=$(console "log show" 20 | sed -n 's/^log t_s=[-0-9.]* \(warn\|error\) //p' | sort -u)
+journal=$(bx journalctl -b "_PID=$pid" -p warning -o cat --no-pager | sort -u)
+infos=$(bx journalctl -b "_PID=$pid" -p info -o cat --no-pager | wc -l)
+if [ -z "$ring" ]; then
+  fail journal_priorities "the console's log show has no warning to compare"
+elif [ "$ring" = "$journal" ]; then
+  pass journal_priorities "$(wc -l <<<"$journal") warning/error lines alike in journalctl -p warning and log show, of $infos lines"
+else
+  fail journal_priorities "journalctl -p warning differs from the console's warnings: $(diff <(echo "$ring") <(echo "$journal") | grep '^[<>]' | head -n 6 | tr '\n' ' ')"
+fi
+
+# 7. A hung firmware (SIGSTOP) is killed by systemd's watchdog (WatchdogSec=2s) and restarted.
+restarts=$(unit_prop NRestarts)
+t0=$(now)
+bx sudo systemctl kill -s SIGSTOP boticelli
+if wait_running 30 "$pid"; then
+  hung_s=$(since "$t0")
+  if bx journalctl -u boticelli -b --no-pager | grep -q 'Watchdog timeout'; then
+    pass hung_firmware_restarted "watchdog timeout, running again after ${hung_s} s (NRestarts $restarts -> $(unit_prop NRestarts))"
+  else
+    fail hung_firmware_restarted "restarted, but no 'Watchdog timeout' in the journal"
+  fi
+else
+  fail hung_firmware_restarted "not running again 30 s after SIGSTOP: $(active_state), NRestarts $(unit_prop NRestarts)"
+fi
+
+# 8. The exit codes: a signal ends the mission in order with exit code 3, which the unit
+# does not restart (docs/flashing.md: "3 ... a signal — not restarted").
+pid=$(main_pid)
+restarts=$(unit_prop NRestarts)
+bx sudo kill -TERM "$pid"
+sleep 6
+code=$(unit_prop ExecMainStatus)
+state=$(active_state)
+if [ "$code" = 3 ] && [ "$state" != active ] && [ "$state" != activating ] && [ "$(unit_prop NRestarts)" = "$restarts" ]; then
+  pass signal_exit_3_not_restarted "exit code 3, unit $state, not restarted"
+else
+  fail signal_exit_3_not_restarted "after SIGTERM: exit code $code, unit $state, NRestarts $restarts -> $(unit_prop NRestarts)"
+fi
+
+# 9. An upgrade over a running firmware with a locally changed conffile: prerm stops the
+# firmware, postinst does not start it again, and the local change is kept (the shipped
+# conffile changed too: dpkg's question answered as --force-confold would). The new version
+# is this .deb repacked as VERSION+box1 with one more comment line in its conffile, and is
+# installed with make deploy's two commands.
+bx sudo systemctl reset-failed boticelli >/dev/null 2>&1 || true
+bx sudo systemctl start boticelli 2>/dev/null || true
+uw=$work/upgrade
+rm -rf "$uw" && mkdir -p "$uw"
+dpkg-deb -R "$deb" "$uw/pkg" || die "cannot unpack $deb for the upgrade"
+ver=$(sed -n 's/^Version: //p' "$uw/pkg/DEBIAN/control")
+sed -i "s/^Version: .*/Version: $ver+box1/" "$uw/pkg/DEBIAN/control"
+echo "# (a later version's comment)" >>"$uw/pkg/etc/boticelli/boticelli.conf"
+up=$uw/boticelli_${ver}+box1_amd64.deb
+dpkg-deb -b --root-owner-group "$uw/pkg" "$up" >/dev/null || die "cannot repack the .deb for the upgrade"
+bx "echo '# a local change' | sudo tee -a /etc/boticelli/boticelli.conf >/dev/null"
+before=$(active_state)
+up_log=$work/deploy-upgrade.log
+if scp "${ssh_flags[@]}" -q "$up" box:/tmp/ &&
+   ssh "${ssh_flags[@]}" box "sudo apt-get install -y --allow-downgrades /tmp/$(basename "$up")" >"$up_log" 2>&1; then
+  up_ok=1
+else
+  up_ok=0
+fi
+state=$(active_state)
+frames=$(motion_frames 3)
+version=$(bx dpkg-query -W -f='\${Version}' boticelli)
+if [ "$up_ok" != 1 ]; then
+  fail upgrade_does_not_start_motion "the upgrade failed: $(tail -n 3 "$up_log" | tr '\n' ' ')"
+elif [ "$state" != inactive ] || [ "$frames" != 0 ]; then
+  fail upgrade_does_not_start_motion "after the upgrade (was $before): unit $state, $frames motion frames in 3 s"
+else
+  pass upgrade_does_not_start_motion "was $before, now $version and inactive, 0 motion frames in 3 s"
+fi
+if bx grep -qx "'# a local change'" /etc/boticelli/boticelli.conf &&
+   ! bx grep -q "'a later version'" /etc/boticelli/boticelli.conf; then
+  pass conffile_kept_on_upgrade "the local change kept$(bx test -f /etc/boticelli/boticelli.conf.dpkg-dist && echo ', the new one as boticelli.conf.dpkg-dist')"
+else
+  fail conffile_kept_on_upgrade "the local change to /etc/boticelli/boticelli.conf is gone or the new one replaced it ($up_log)"
+fi
+
+# 10. A hung system: everything starved by a SCHED_FIFO 99 loop on each CPU (real-time
+# throttling off), so neither the firmware nor systemd runs: the hardware watchdog
+# (i6300esb, armed by the firmware at [watchdog] timeout_ms = 12000) resets the box. Then
+# the enabled unit starts at boot: boot-to-READY from the journal.
+bx sudo systemctl start boticelli 2>/dev/null || true
+if [ "$(status_field watchdog)" != armed ]; then
+  fail hardware_watchdog_resets "the console's status says watchdog=$(status_field watchdog), not armed"
+  boot_ready_s=
+else
+  boots=$(grep -c 'Linux version' "$work/serial0.log" || true)
+  t0=$(now)
+  bx 'sudo sh -c "echo -1 >/proc/sys/kernel/sched_rt_runtime_us;
+    for c in 0 1; do nohup taskset -c \$c chrt -f 99 sh -c \"while :; do :; done\" >/dev/null 2>&1 & done"' \
+    >/dev/null 2>&1 || true
+  reset_s=
+  for _ in $(seq 60); do
+    if [ "$(grep -c 'Linux version' "$work/serial0.log" || true)" -gt "$boots" ]; then
+      reset_s=$(since "$t0")
+      break
+    fi
+    sleep 0.5
+  done
+  if [ -z "$reset_s" ]; then
+    fail hardware_watchdog_resets "the hung box was not reset within 30 s"
+  elif awk -v s="$reset_s" 'BEGIN { exit !(s >= 10 && s <= 16) }'; then
+    pass hardware_watchdog_resets "reset ${reset_s} s after the hang (timeout 12 s)"
+  else
+    fail hardware_watchdog_resets "reset ${reset_s} s after the hang (expected 12 s, 10 to 16)"
+  fi
+  boot_ready_s=
+  if wait_ssh 600 && wait_running 120; then
+    boot_ready_s=$(bx "journalctl -b -o short-monotonic --no-pager -u boticelli" |
+      sed -n 's/^\[ *\([0-9.]*\)\].*Started boticelli.service.*/\1/p' | head -n1)
+    if [ -n "$boot_ready_s" ]; then
+      pass enabled_unit_ready_after_reset "READY=1 ${boot_ready_s} s after the kernel started"
+    else
+      fail enabled_unit_ready_after_reset "running, but no 'Started boticelli.service' in this boot's journal"
+    fi
+  else
+    fail enabled_unit_ready_after_reset "the box or the firmware did not come back after the reset: $(active_state 2>&1)"
+  fi
+fi
+
+# 11. apt purge removes what the package made: its files, the conffile, the state
+# directory, the user, the units' enablement; it leaves the group gpio (other users of the
+# GPIO chip may rely on it).
+purge_log=$work/purge.log
+bx sudo apt-get purge -y boticelli >"$purge_log" 2>&1 || true
+left=$(bx 'for p in /usr/bin/boticelli /etc/boticelli /var/lib/boticelli /usr/lib/systemd/system/boticelli.service \
+    /lib/systemd/system/boticelli.service /usr/lib/udev/rules.d/60-boticelli.rules \
+    /lib/udev/rules.d/60-boticelli.rules /usr/share/doc/boticelli; do [ -e "$p" ] && echo "$p"; done
+  find /etc/systemd/system -name "boticelli*" 2>/dev/null
+  getent passwd boticelli >/dev/null && echo "user boticelli"
+  dpkg-query -W -f="\${db:Status-Status}" boticelli 2>/dev/null | grep -v "^not-installed$" | sed "s/^/dpkg: /"
+  true' | tr '\n' ' ')
+if [ -z "$left" ]; then
+  pass purge_removes_everything "files, conffile, state, user and enablement gone"
+else
+  fail purge_removes_everything "left after apt purge: $left"
+fi
+
+echo "test-robot: box up in ${boot_s} s; start to READY ${ready_s:-?} s; boot to READY ${boot_ready_s:-?} s; console round trip ${round_trip:-?} s; total $(since "$t_start") s"
+echo "$passed passed, $failed failed"
+[ "$failed" = 0 ]
