@@ -49,7 +49,7 @@ echo "build-box: building the box's Debian 12 image with kernel $kver in $box (a
 pkgs=(
   systemd systemd-sysv udev dbus kmod iproute2 openssh-server sudo procps less
   initramfs-tools linux-base apt adduser init-system-helpers
-  libgpiod2 libgpiodcxx1 libpng16-16 libtomlplusplus3 libstdc++6 picocom can-utils
+  libgpiod2 libpng16-16 libtomlplusplus3 libstdc++6 picocom can-utils
 )
 sources=/etc/apt/sources.list.d/debian.sources
 [ -f "$sources" ] || sources=/etc/apt/sources.list

@@ -281,11 +281,11 @@ if [ "$ok" = 1 ] && [ "$(main_pid)" = "$pid" ]; then
 else
   fail fault_can_link_down_up "after can0 down/up: healthy=$(status_field healthy), pid $(main_pid) (was $pid), state $(active_state)"
 fi
-# The camera's driver unbound and bound again (the webcam unplugged and plugged in).
-bx 'echo vivid.0 | sudo tee /sys/bus/platform/drivers/vivid/unbind >/dev/null'
+# The camera's module unloaded and loaded again (the webcam unplugged and plugged in).
+bx sudo modprobe -r vivid
 sleep 3
 cam_healthy=$(status_field healthy)
-bx 'echo vivid.0 | sudo tee /sys/bus/platform/drivers/vivid/bind >/dev/null'
+bx sudo modprobe vivid
 ok=0
 for _ in $(seq 25); do
   [ "$(status_field healthy)" = 1 ] && { ok=1; break; }
@@ -294,7 +294,7 @@ done
 if [ "$ok" = 1 ] && [ "$(main_pid)" = "$pid" ]; then
   pass fault_camera_reload "healthy=$cam_healthy while gone, healthy=1 again, same process"
 else
-  fail fault_camera_reload "after vivid unbind/bind: healthy=$(status_field healthy), pid $(main_pid) (was $pid), state $(active_state)"
+  fail fault_camera_reload "after vivid unloaded and loaded: healthy=$(status_field healthy), pid $(main_pid) (was $pid), state $(active_state)"
 fi
 # A broken e-stop wire: the normally closed switch's line floats high = pressed: the e-stop
 # latches and the base stays stopped; mended, clear-estop and resume run on.

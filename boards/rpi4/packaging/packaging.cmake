@@ -69,10 +69,11 @@ set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${BOTICELLI_DEB_ARCH})
 set(CPACK_DEBIAN_PACKAGE_SECTION misc)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
-# Runtime libraries of the rpi4 executable (see `readelf -d boticelli`), and what the
+# Runtime libraries of the rpi4 executable (see `readelf -d boticelli`; Debian 12 ships
+# libgpiodcxx.so.1 in libgpiod2, there is no libgpiodcxx1 package), and what the
 # maintainer scripts and units call.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libgpiodcxx1 (>= 1.6), libpng16-16 (>= 1.6), libtomlplusplus3 (>= 3.3.0), adduser, systemd, init-system-helpers (>= 1.54~), iproute2, udev")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libpng16-16 (>= 1.6), libtomlplusplus3 (>= 3.3.0), adduser, systemd, init-system-helpers (>= 1.54~), iproute2, udev")
 # The console from a laptop or the robot itself, and CAN bring-up checks (docs/flashing.md).
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "picocom, can-utils")
 # A stripped binary in the package, its debug information in boticelli-dbgsym (a .ddeb):
