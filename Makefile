@@ -145,9 +145,15 @@ format-check:
 
 # The rpi4 .deb (CPack, arm64) and its installation on the robot over ssh (docs/flashing.md).
 # PACKAGE=linux-amd64 installs the same board built natively instead (the robot computer in
-# a box, docs/testing.md); SSHFLAGS go to both scp and ssh (e.g. -F FILE, -p PORT for scp: -P).
+# a box, docs/testing.md), DEB=FILE installs that file without building; SSHFLAGS go to both
+# scp and ssh (e.g. -F FILE). Over ssh there is nobody to answer dpkg's question about a
+# locally changed /etc/boticelli/boticelli.conf that the new version changes too (dpkg then
+# fails with "end of file on stdin at conffile prompt" and leaves the package unconfigured):
+# the local file is kept, the new one goes beside it as boticelli.conf.dpkg-dist.
 PACKAGE ?= rpi4
+DEB ?=
 SSHFLAGS ?=
+CONFOLD := -o Dpkg::Options::=--force-confdef -o Dpkg::Options::=--force-confold
 .PHONY: package-rpi4 package-linux-amd64 deploy
 package-rpi4: rpi4
 	cd build/rpi4 && cpack -G DEB
@@ -155,11 +161,11 @@ package-linux-amd64: deps
 	$(call build,linux-amd64)
 	cd build/linux-amd64 && cpack -G DEB
 deploy:
-	@test -n "$(HOST)" || { echo "usage: make deploy HOST=user@robot [PACKAGE=rpi4|linux-amd64]" >&2; exit 2; }
-	@$(MAKE) package-$(PACKAGE)
-	deb=$$(ls -t build/$(PACKAGE)/boticelli_*.deb | head -n1) && \
+	@test -n "$(HOST)" || { echo "usage: make deploy HOST=user@robot [PACKAGE=rpi4|linux-amd64] [DEB=file]" >&2; exit 2; }
+	@$(if $(DEB),test -f "$(DEB)",$(MAKE) package-$(PACKAGE))
+	deb=$(if $(DEB),"$(DEB)",$$(ls -t build/$(PACKAGE)/boticelli_*.deb | head -n1)) && \
 	  scp $(SSHFLAGS) "$$deb" $(HOST):/tmp/ && \
-	  ssh $(SSHFLAGS) $(HOST) "sudo apt-get install -y --allow-downgrades /tmp/$$(basename $$deb)"
+	  ssh $(SSHFLAGS) $(HOST) "sudo apt-get install -y --allow-downgrades $(CONFOLD) /tmp/$$(basename $$deb)"
 
 # The robot computer in a box (tests/box/run.sh, docs/testing.md): boots a Debian 12 amd64
 # box under qemu, deploys the linux-amd64 .deb with make deploy and checks it as an operator

@@ -130,7 +130,7 @@ chroot "$root" passwd -d root >/dev/null
 
 cp "$root/boot/vmlinuz-$kver" "$box/vmlinuz"
 cp "$root/boot/initrd.img-$kver" "$box/initrd.img"
-nice mkfs.ext4 -q -L boticelli-box -d "$root" "$box/root.img" 2G
+nice mkfs.ext4 -q -L boticelli-box -d "$root" "$box/root.img" 2G >/dev/null
 rm -rf "$root"
 echo "$stamp" >"$box/.built"
 echo "build-box: done ($(du -h "$box/root.img" | cut -f1) image)"

@@ -10,7 +10,8 @@
 # from the same disk. Each check prints one line, `PASS name (detail)` or `FAIL name: why`;
 # the last line is `N passed, N failed`. Exit 0 when every check passed, 1 otherwise, 77
 # when qemu cannot run here. docs/testing.md, "The robot computer in a box", says what
-# each check does.
+# each check does. BOTICELLI_BOX_HOLD=1 keeps the box running after the checks (ssh -F
+# WORK_DIR/ssh_config box) until the script is interrupted.
 # Commands for the box are strings run by its shell (ssh): expanded here or there on purpose.
 # shellcheck disable=SC2029,SC2016
 set -euo pipefail
@@ -159,10 +160,12 @@ motion_frames() { # SECONDS
 }
 # Until the unit is active/running with a MainPID other than $2, at most $1 s.
 wait_running() { # SECONDS [OLD_PID]
-  local end=$(($(date +%s) + $1)) state pid
+  local end=$(($(date +%s) + $1)) state a s pid
   while [ "$(date +%s)" -lt "$end" ]; do
-    state=$(bx systemctl show -P ActiveState,SubState,MainPID boticelli.service 2>/dev/null | tr '\n' ' ')
-    read -r a s pid <<<"$state" || true
+    state=$(bx systemctl show -p ActiveState -p SubState -p MainPID boticelli.service 2>/dev/null || true)
+    a=$(sed -n 's/^ActiveState=//p' <<<"$state")
+    s=$(sed -n 's/^SubState=//p' <<<"$state")
+    pid=$(sed -n 's/^MainPID=//p' <<<"$state")
     if [ "$a" = active ] && [ "$s" = running ] && [ "$pid" != 0 ] && [ "$pid" != "${2:-}" ]; then
       return 0
     fi
@@ -363,6 +366,7 @@ fi
 
 # 8. The exit codes: a signal ends the mission in order with exit code 3, which the unit
 # does not restart (docs/flashing.md: "3 ... a signal — not restarted").
+wait_running 30 || true
 pid=$(main_pid)
 restarts=$(unit_prop NRestarts)
 bx sudo kill -TERM "$pid" || true
@@ -379,7 +383,7 @@ fi
 # firmware, postinst does not start it again, and the local change is kept (the shipped
 # conffile changed too: dpkg's question answered as --force-confold would). The new version
 # is this .deb repacked as VERSION+box1 with one more comment line in its conffile, and is
-# installed with make deploy's two commands.
+# installed with make deploy DEB=FILE.
 bx sudo systemctl reset-failed boticelli >/dev/null 2>&1 || true
 bx sudo systemctl start boticelli 2>/dev/null || true
 uw=$work/upgrade
@@ -393,8 +397,8 @@ dpkg-deb -b --root-owner-group "$uw/pkg" "$up" >/dev/null || die "cannot repack 
 bx "echo '# a local change' | sudo tee -a /etc/boticelli/boticelli.conf >/dev/null"
 before=$(active_state)
 up_log=$work/deploy-upgrade.log
-if scp "${ssh_flags[@]}" -q "$up" box:/tmp/ &&
-   ssh "${ssh_flags[@]}" box "sudo apt-get install -y --allow-downgrades /tmp/$(basename "$up")" >"$up_log" 2>&1; then
+if make -C "$repo" --no-print-directory deploy HOST=box DEB="$up" \
+     SSHFLAGS="-F $work/ssh_config" >"$up_log" 2>&1; then
   up_ok=1
 else
   up_ok=0
@@ -477,6 +481,10 @@ else
   fail purge_removes_everything "left after apt purge: $left"
 fi
 
+if [ -n "${BOTICELLI_BOX_HOLD:-}" ]; then
+  echo "test-robot: the box stays up until this is interrupted: ssh -F $work/ssh_config box; console $pty"
+  wait "$qemu_pid" || true
+fi
 echo "test-robot: box up in ${boot_s} s; start to READY ${ready_s:-?} s; boot to READY ${boot_ready_s:-?} s; console round trip ${round_trip:-?} s; total $(since "$t_start") s"
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]
