@@ -69,7 +69,9 @@ fail() {
 # user-mode network that reaches nothing but the host's forwarded port.
 qemu_pid=
 ptu_pid=
+console_pid=
 cleanup() {
+  if [ -n "$console_pid" ]; then kill "$console_pid" 2>/dev/null || true; fi
   if [ -n "$qemu_pid" ]; then kill "$qemu_pid" 2>/dev/null || true; fi
   if [ -n "$ptu_pid" ]; then kill "$ptu_pid" 2>/dev/null || true; fi
   exec 3>&- 2>/dev/null || true
@@ -175,23 +177,27 @@ wait_running() { # SECONDS [OLD_PID]
 }
 
 # The console: the robot's UART (the box's ttyS1) on the host's pty, with picocom's
-# settings (115200 8N1, no flow control, raw). console CMD prints the reply's lines up to
-# OK or ERR (TLM and LOG lines left out), or "TIMEOUT".
+# settings (115200 8N1, no flow control, raw). A reader takes everything the firmware sends
+# into console.log at once, as a wire does (left unread, the pty would hold the UART back,
+# which no real serial line does); console CMD writes CMD and prints the reply's lines up to
+# OK or ERR (TLM and LOG lines left out), or TIMEOUT.
 stty -F "$pty" 115200 cs8 -cstopb -parenb -crtscts -ixon -ixoff raw -echo
-exec 3<>"$pty"
+console_log=$work/console.log
+: >"$console_log"
+cat "$pty" >>"$console_log" &
+console_pid=$!
+exec 3>"$pty"
 console() { # COMMAND [SECONDS]
-  local line end=$(($(date +%s) + ${2:-10}))
-  while IFS= read -r -t 0.05 -u 3 _; do :; done
+  local off reply end=$(($(date +%s) + ${2:-10}))
+  off=$(stat -c %s "$console_log")
   printf '%s\r' "$1" >&3
   while [ "$(date +%s)" -lt "$end" ]; do
-    IFS= read -r -t 1 -u 3 line || continue
-    line=${line%$'\r'}
-    case "$line" in
-      TLM\ * | LOG\ * | '') ;;
-      OK) echo OK; return 0 ;;
-      ERR\ *) echo "$line"; return 0 ;;
-      *) echo "$line" ;;
-    esac
+    reply=$(tail -c "+$((off + 1))" "$console_log" | tr -d '\r' | grep -v -e '^TLM ' -e '^LOG ' -e '^$' || true)
+    if grep -qE '^(OK|ERR )' <<<"$reply"; then
+      sed -n '1,/^\(OK\|ERR \)/p' <<<"$reply"
+      return 0
+    fi
+    sleep 0.05
   done
   echo TIMEOUT
   return 1
@@ -251,7 +257,7 @@ if bx sudo systemctl start boticelli 2>"$work/start.err"; then
   fi
 else
   ready_s=
-  fail start_reaches_ready "systemctl start failed: $(cat "$work/start.err") $(bx journalctl -u boticelli -n 5 --no-pager 2>&1 | tr '\n' ' ')"
+  fail start_reaches_ready "systemctl start failed: $(cat "$work/start.err") $(bx sudo journalctl -u boticelli -n 5 --no-pager 2>&1 | tr '\n' ' ')"
 fi
 
 # 3. systemctl status shows the mission's state (STATUS=, once a second).
@@ -339,8 +345,8 @@ fi
 # (journalctl -p warning) are exactly those of the console's log ring (log show).
 sleep 1
 ring=$(console "log show" 20 | sed -n 's/^log t_s=[-0-9.]* \(warn\|error\) //p' | sort -u)
-journal=$(bx journalctl -b "_PID=$pid" -p warning -o cat --no-pager | sort -u)
-infos=$(bx journalctl -b "_PID=$pid" -p info -o cat --no-pager | wc -l)
+journal=$(bx sudo journalctl -b "_PID=$pid" -p warning -o cat --no-pager | sort -u)
+infos=$(bx sudo journalctl -b "_PID=$pid" -p info -o cat --no-pager | wc -l)
 if [ -z "$ring" ]; then
   fail journal_priorities "the console's log show has no warning to compare"
 elif [ "$ring" = "$journal" ]; then
@@ -355,7 +361,7 @@ t0=$(now)
 bx sudo systemctl kill -s SIGSTOP boticelli || true
 if wait_running 30 "$pid"; then
   hung_s=$(since "$t0")
-  if bx journalctl -u boticelli -b --no-pager | grep -q 'Watchdog timeout'; then
+  if bx sudo journalctl -u boticelli -b --no-pager | grep -q 'Watchdog timeout'; then
     pass hung_firmware_restarted "watchdog timeout, running again after ${hung_s} s (NRestarts $restarts -> $(unit_prop NRestarts))"
   else
     fail hung_firmware_restarted "restarted, but no 'Watchdog timeout' in the journal"
@@ -451,7 +457,7 @@ else
   fi
   boot_ready_s=
   if wait_ssh 600 && wait_running 120; then
-    boot_ready_s=$(bx "journalctl -b -o short-monotonic --no-pager -u boticelli" |
+    boot_ready_s=$(bx "sudo journalctl -b -o short-monotonic --no-pager -u boticelli" |
       sed -n 's/^\[ *\([0-9.]*\)\].*Started boticelli.service.*/\1/p' | head -n1)
     if [ -n "$boot_ready_s" ]; then
       pass enabled_unit_ready_after_reset "READY=1 ${boot_ready_s} s after the kernel started"
