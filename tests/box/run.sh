@@ -72,6 +72,7 @@ ptu_pid=
 console_pid=
 cleanup() {
   if [ -n "$console_pid" ]; then kill "$console_pid" 2>/dev/null || true; fi
+  if [ -n "${qmp_pid:-}" ]; then kill "$qmp_pid" 2>/dev/null || true; fi
   if [ -n "$qemu_pid" ]; then kill "$qemu_pid" 2>/dev/null || true; fi
   if [ -n "$ptu_pid" ]; then kill "$ptu_pid" 2>/dev/null || true; fi
   exec 3>&- 2>/dev/null || true
@@ -92,7 +93,7 @@ nice qemu-system-x86_64 -accel tcg -m 1024M -smp 2 -display none -vga none \
   -serial "file:$work/serial0.log" \
   -chardev pty,id=console -serial chardev:console \
   -chardev "serial,id=ptu,path=$work/ptu-tty" -serial chardev:ptu \
-  -device i6300esb -watchdog-action reset \
+  -device i6300esb -watchdog-action reset -qmp "unix:$work/qmp.sock,server=on,wait=off" \
   -nic "user,model=virtio-net-pci,restrict=on,hostfwd=tcp:127.0.0.1:$port-:22" \
   </dev/null >"$work/qemu.log" 2>&1 &
 qemu_pid=$!
@@ -104,6 +105,11 @@ for _ in $(seq 100); do
   sleep 0.1
 done
 [ -n "$pty" ] || die "qemu named no pty for the console: $(cat "$work/qemu.log")"
+# qemu's events (WATCHDOG, RESET), each with the host's time, into qmp.log.
+qmp_pid=
+(echo '{"execute":"qmp_capabilities"}'; while kill -0 "$qemu_pid" 2>/dev/null; do sleep 5; done) |
+  socat - "UNIX-CONNECT:$work/qmp.sock" >"$work/qmp.log" 2>&1 &
+qmp_pid=$!
 
 cat >"$work/ssh_config" <<EOF
 Host box
@@ -341,18 +347,25 @@ else
   fail fault_estop_wire_broken "with the e-stop line high: estop=$estop, $frames motion frames in 2 s, pid $(main_pid) (was $pid)"
 fi
 
-# 6. journald keeps the firmware's priorities: its warnings and errors in the journal
-# (journalctl -p warning) are exactly those of the console's log ring (log show).
+# 6. journald keeps the firmware's priorities: its warnings and errors (the console's log
+# ring, `log show`, has every line with its level) are exactly what journalctl -p warning
+# lists for the firmware's process, and its info lines are not among them.
 sleep 1
-ring=$(console "log show" 20 | sed -n 's/^log t_s=[-0-9.]* \(warn\|error\) //p' | sort -u)
+ring_all=$(console "log show" 20 || true)
+ring=$(sed -n 's/^log t_s=[-0-9.]* \(warn\|error\) //p' <<<"$ring_all" | sort -u)
+ring_info=$(sed -n 's/^log t_s=[-0-9.]* info //p' <<<"$ring_all" | sort -u)
 journal=$(bx sudo journalctl -b "_PID=$pid" -p warning -o cat --no-pager | sort -u)
-infos=$(bx sudo journalctl -b "_PID=$pid" -p info -o cat --no-pager | wc -l)
+missing=$(comm -23 <(echo "$ring") <(echo "$journal") | sed '/^$/d')
+extra=$(comm -13 <(echo "$ring") <(echo "$journal") | sed '/^$/d')
+info_as_warning=$(comm -12 <(echo "$ring_info") <(echo "$journal") | sed '/^$/d')
 if [ -z "$ring" ]; then
   fail journal_priorities "the console's log show has no warning to compare"
-elif [ "$ring" = "$journal" ]; then
-  pass journal_priorities "$(wc -l <<<"$journal") warning/error lines alike in journalctl -p warning and log show, of $infos lines"
+elif [ -n "$missing" ]; then
+  fail journal_priorities "$(wc -l <<<"$missing") of the console's $(wc -l <<<"$ring") warning/error lines are not in journalctl -p warning, e.g. '$(head -n1 <<<"$missing")' (the firmware's LOG lines reach only the console)"
+elif [ -n "$extra" ] || [ -n "$info_as_warning" ]; then
+  fail journal_priorities "journalctl -p warning lists lines that are not warnings: $(echo "$extra" "$info_as_warning" | head -n 3 | tr '\n' ' ')"
 else
-  fail journal_priorities "journalctl -p warning differs from the console's warnings: $(diff <(echo "$ring") <(echo "$journal") | grep '^[<>]' | head -n 6 | tr '\n' ' ')"
+  pass journal_priorities "$(wc -l <<<"$journal") warning/error lines, the same in journalctl -p warning and log show"
 fi
 
 # 7. A hung firmware (SIGSTOP) is killed by systemd's watchdog (WatchdogSec=2s) and restarted.
@@ -414,10 +427,10 @@ frames=$(motion_frames 3)
 version=$(bx dpkg-query -W -f='\${Version}' boticelli)
 if [ "$up_ok" != 1 ]; then
   fail upgrade_does_not_start_motion "the upgrade failed: $(tail -n 3 "$up_log" | tr '\n' ' ')"
-elif [ "$state" != inactive ] || [ "$frames" != 0 ]; then
+elif { [ "$state" != inactive ] && [ "$state" != failed ]; } || [ "$frames" != 0 ]; then
   fail upgrade_does_not_start_motion "after the upgrade (was $before): unit $state, $frames motion frames in 3 s"
 else
-  pass upgrade_does_not_start_motion "was $before, now $version and inactive, 0 motion frames in 3 s"
+  pass upgrade_does_not_start_motion "was $before, now $version and $state (stopped by prerm), 0 motion frames in 3 s"
 fi
 if bx grep -qx "'# a local change'" /etc/boticelli/boticelli.conf &&
    ! bx grep -q "'a later version'" /etc/boticelli/boticelli.conf; then
@@ -435,30 +448,33 @@ if [ "$(status_field watchdog)" != armed ]; then
   fail hardware_watchdog_resets "the console's status says watchdog=$(status_field watchdog), not armed"
   boot_ready_s=
 else
-  boots=$(grep -c 'Linux version' "$work/serial0.log" || true)
   t0=$(now)
+  # ssh itself is starved once the loops run: the command is left to time out.
   bx 'sudo sh -c "echo -1 >/proc/sys/kernel/sched_rt_runtime_us;
     for c in 0 1; do nohup taskset -c \$c chrt -f 99 sh -c \"while :; do :; done\" >/dev/null 2>&1 & done"' \
-    >/dev/null 2>&1 || true
+    >/dev/null 2>&1 &
   reset_s=
   for _ in $(seq 60); do
-    if [ "$(grep -c 'Linux version' "$work/serial0.log" || true)" -gt "$boots" ]; then
-      reset_s=$(since "$t0")
+    event=$(grep -m1 '"event": *"WATCHDOG"' "$work/qmp.log" || true)
+    if [ -n "$event" ]; then
+      secs=$(sed -n 's/.*"seconds": *\([0-9]*\).*/\1/p' <<<"$event")
+      usecs=$(sed -n 's/.*"microseconds": *\([0-9]*\).*/\1/p' <<<"$event")
+      reset_s=$(awk -v s="$secs" -v u="$usecs" -v a="$t0" 'BEGIN { printf "%.1f", s + u / 1e6 - a }')
       break
     fi
     sleep 0.5
   done
   if [ -z "$reset_s" ]; then
-    fail hardware_watchdog_resets "the hung box was not reset within 30 s"
+    fail hardware_watchdog_resets "the hung box was not reset within 30 s (no WATCHDOG event from qemu)"
   elif awk -v s="$reset_s" 'BEGIN { exit !(s >= 10 && s <= 16) }'; then
-    pass hardware_watchdog_resets "reset ${reset_s} s after the hang (timeout 12 s)"
+    pass hardware_watchdog_resets "reset ${reset_s} s after the hang began (timeout 12 s)"
   else
-    fail hardware_watchdog_resets "reset ${reset_s} s after the hang (expected 12 s, 10 to 16)"
+    fail hardware_watchdog_resets "reset ${reset_s} s after the hang began (expected 12 s, 10 to 16)"
   fi
   boot_ready_s=
   if wait_ssh 600 && wait_running 120; then
     boot_ready_s=$(bx "sudo journalctl -b -o short-monotonic --no-pager -u boticelli" |
-      sed -n 's/^\[ *\([0-9.]*\)\].*Started boticelli.service.*/\1/p' | head -n1)
+      sed -n 's/^\[ *\([0-9]*\.[0-9]\).*\].*Started boticelli.service.*/\1/p' | head -n1)
     if [ -n "$boot_ready_s" ]; then
       pass enabled_unit_ready_after_reset "READY=1 ${boot_ready_s} s after the kernel started"
     else
@@ -471,13 +487,13 @@ fi
 
 # 11. apt purge removes what the package made: its files, the conffile, the state
 # directory, the user, the units' enablement; it leaves the group gpio (other users of the
-# GPIO chip may rely on it).
+# GPIO chip may rely on it). The box's own drop-in for boticelli-can0 is not the package's.
 purge_log=$work/purge.log
 bx sudo apt-get purge -y boticelli >"$purge_log" 2>&1 || true
 left=$(bx 'for p in /usr/bin/boticelli /etc/boticelli /var/lib/boticelli /usr/lib/systemd/system/boticelli.service \
     /lib/systemd/system/boticelli.service /usr/lib/udev/rules.d/60-boticelli.rules \
     /lib/udev/rules.d/60-boticelli.rules /usr/share/doc/boticelli; do [ -e "$p" ] && echo "$p"; done
-  find /etc/systemd/system -name "boticelli*" 2>/dev/null
+  find /etc/systemd/system -name "boticelli*" ! -path "*/boticelli-can0.service.d" 2>/dev/null
   getent passwd boticelli >/dev/null && echo "user boticelli"
   dpkg-query -W -f="\${db:Status-Status}" boticelli 2>/dev/null | grep -v "^not-installed$" | sed "s/^/dpkg: /"
   true' | tr '\n' ' ')
