@@ -169,7 +169,7 @@ deploy:
 
 # The robot computer in a box (tests/box/run.sh, docs/testing.md): boots a Debian 12 amd64
 # box under qemu, deploys the linux-amd64 .deb with make deploy and checks it as an operator
-# would. Not part of make test (about ... minutes, docs/testing.md).
+# would. Not part of make test (over six minutes cached, docs/testing.md).
 test-robot: deps-box package-linux-amd64
 	tests/box/run.sh build/linux-amd64 build/box
 
