@@ -44,6 +44,27 @@ inline firmware::BoardConfig make_config() {
   return c;
 }
 
+// How far the simulated robot departs from the thesis's perfect one ([sim] realism).
+enum class SimRealism : std::uint8_t {
+  kIdeal,      // perfect odometry: the thesis's reproductions
+  kRealistic,  // the errors of an uncalibrated small base
+};
+// The setting the board starts with (tests, benches and runs without a [sim] table).
+inline constexpr SimRealism kDefaultRealism = SimRealism::kIdeal;
+
+// The base's odometry errors under a realism setting. Realistic: an uncalibrated hobby base
+// (Borenstein & Feng 1996): wheel diameters 0.5 % apart, the effective track 1 % wider than
+// the odometry assumes, each in-place turn 1 % (sd) off, and 1 % (sd) white noise per wheel
+// per 1 ms physics step (it averages out: millimetres over a mission).
+inline void apply_realism(SimRealism realism, hal::sim::BaseParams& b) {
+  const bool real = realism == SimRealism::kRealistic;
+  b.wheel_scale_left = real ? 1.0025F : 1.0F;
+  b.wheel_scale_right = real ? 0.9975F : 1.0F;
+  b.track_scale = real ? 1.01F : 1.0F;
+  b.turn_scrub = real ? 0.01F : 0.0F;
+  b.odometry_noise = real ? 0.01F : 0.0F;
+}
+
 // Everything only the simulation needs.
 struct SimSettings {
   float camera_fps = 30.0F;           // frame rate in simulated time
@@ -62,6 +83,7 @@ inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t s
   s.physics.base.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
   // The ODrives' watchdog, as configured on the robot: 0.2 s without a setpoint stops them.
   s.physics.base.command_timeout_us = 200000;
+  apply_realism(kDefaultRealism, s.physics.base);
   return s;
 }
 

@@ -56,7 +56,7 @@ SimBoard::~SimBoard() {
 
 bool SimBoard::reset_config(firmware::ConfigSchema& schema) {
   config_ = make_config();
-  return firmware::add_board_config_keys(schema, config_);
+  return firmware::add_board_config_keys(schema, config_) && add_sim_config_keys(schema, sim_keys_);
 }
 
 bool SimBoard::init(const firmware::Options& options, char* error, std::size_t error_size) {
@@ -79,6 +79,11 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   settings_.physics.base.track_width_m = geometry.physics.base.track_width_m;
   settings_.physics.base.max_speed_m_s = geometry.physics.base.max_speed_m_s;
   settings_.physics.base.max_turn_rate_rad_s = geometry.physics.base.max_turn_rate_rad_s;
+  // The simulator's realism as the configuration file set it (unset keys keep the settings).
+  if (!apply_sim_config(sim_keys_, settings_, why, sizeof why)) {
+    std::snprintf(error, error_size, "configuration: %s", why);
+    return false;
+  }
   rig_.emplace(make_rig_params(config_));
   if (!sim_.init(world_, *rig_, settings_.physics, why, sizeof why)) {
     std::snprintf(error, error_size, "%s: %s", path, why);

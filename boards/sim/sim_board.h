@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "board_config.h"
+#include "sim_config.h"
 #include "firmware/app/board.h"
 #include "hal/hal.h"
 #include "hal/linux/console_port.h"
@@ -39,8 +40,9 @@ class SimBoard final : public firmware::Board,
   SimBoard& operator=(const SimBoard&) = delete;
   const firmware::BoardInfo& info() const override { return kInfo; }
   const firmware::BoardConfig& config() const override { return config_; }
-  // The keys every board has (add_board_config_keys); no device keys, no default file: the
-  // sim board reads a configuration only with --config FILE.
+  // The keys every board has (add_board_config_keys) and the simulator's realism ([sim],
+  // sim_config.h); no device keys, no default file: the sim board reads a configuration only
+  // with --config FILE.
   bool reset_config(firmware::ConfigSchema& schema) override;
   bool init(const firmware::Options& options, char* error, std::size_t error_size) override;
   hal::Hal& hal() override { return hal_; }
@@ -97,6 +99,7 @@ class SimBoard final : public firmware::Board,
 
   firmware::BoardConfig config_;
   SimSettings settings_;
+  SimConfigKeys sim_keys_;  // what the configuration file set in [sim]
   hal::sim::World world_;
   hal::sim::TextureBank textures_;
   std::optional<stereo::RigModel> rig_;

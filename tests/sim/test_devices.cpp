@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "algo/core/angles.h"
 #include "algo/stereo/rig.h"
 #include "hal/sim/base_sim.h"
 #include "hal/sim/camera_sim.h"
@@ -469,4 +470,41 @@ TEST(SimDevices, TheClockReportsHowLateItWokeOnlyWhenItWaitedForTheWallClock) {
   clock.set_speed(0.0);
   clock.sleep_until_us(sim_us += 10000);
   CHECK_EQUAL(-1, clock.last_wake_latency_ns());
+}
+
+TEST(SimDevices, AWiderTrueTrackMakesTurnsShortAndUnequalWheelsBendAStraightDrive) {
+  // Only the track 1 % wider than the odometry assumes: the base truly turns 1 % less.
+  SimParams params;
+  params.base.track_scale = 1.01F;
+  start("rectangular_room", params);
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  make_ready(base, clock);
+  const float yaw0 = g_sim.true_pose().yaw_rad;
+  base.set_velocity(0.0F, 0.5F);
+  clock.sleep_until_us(clock.now_us() + 2000000);
+  base.set_velocity(0.0F, 0.0F);
+  clock.sleep_until_us(clock.now_us() + 1000000);
+  const double odo_turn = base.odometry().yaw_rad;
+  const double true_turn = boticelli::core::wrap_pi(g_sim.true_pose().yaw_rad - yaw0);
+  CHECK(odo_turn > 0.8);
+  DOUBLES_EQUAL(odo_turn / 1.01, true_turn, 1e-4);
+  // Only the wheels 0.5 % apart: a straight drive on the odometry bends the true path by
+  // (right − left) / track per metre (−0.0125 rad/m here), the odometry's heading stays put.
+  SimParams wheels;
+  wheels.base.wheel_scale_left = 1.0025F;
+  wheels.base.wheel_scale_right = 0.9975F;
+  start("rectangular_room", wheels);
+  BaseSim base2(g_sim);
+  ClockSim clock2(g_sim);
+  make_ready(base2, clock2);
+  const float start_yaw = g_sim.true_pose().yaw_rad;
+  base2.set_velocity(0.2F, 0.0F);
+  clock2.sleep_until_us(clock2.now_us() + 4000000);
+  base2.set_velocity(0.0F, 0.0F);
+  clock2.sleep_until_us(clock2.now_us() + 1000000);
+  const double driven_m = base2.odometry().x_m;
+  DOUBLES_EQUAL(0.0, base2.odometry().yaw_rad, 1e-9);
+  DOUBLES_EQUAL(-0.0125 * driven_m, boticelli::core::wrap_pi(g_sim.true_pose().yaw_rad - start_yaw),
+                2e-4);
 }

@@ -59,6 +59,8 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   base_error_ = "not started";
   base_started_ = false;
   odometry_ = Odometry{};
+  in_place_turn_ = false;
+  turn_scrub_factor_ = 1.0;
   collisions_ = 0;
   contacts_ = 0;
   last_collision_model_ = "";
@@ -227,13 +229,25 @@ void SimWorld::step_base(float dt_s) {
   const float dv = b.wheel_accel_m_s2 * dt_s;
   wheel_left_m_s_ += std::clamp(target_left_m_s_ - wheel_left_m_s_, -dv, dv);
   wheel_right_m_s_ += std::clamp(target_right_m_s_ - wheel_right_m_s_, -dv, dv);
-  const double dl = static_cast<double>(wheel_left_m_s_) * static_cast<double>(dt_s);
-  const double dr = static_cast<double>(wheel_right_m_s_) * static_cast<double>(dt_s);
+  // What the encoders count (the commanded rims at the odometry's diameters) [m].
+  const double el = static_cast<double>(wheel_left_m_s_) * static_cast<double>(dt_s);
+  const double er = static_cast<double>(wheel_right_m_s_) * static_cast<double>(dt_s);
+  // Each in-place turn slips by its own random share (scrub on the floor).
+  const bool turning = el * er < 0.0;
+  if (turning && !in_place_turn_) {
+    turn_scrub_factor_ =
+        b.turn_scrub > 0.0F ? 1.0 + static_cast<double>(b.turn_scrub * gaussian()) : 1.0;
+  }
+  in_place_turn_ = turning;
+  // What the ground does: the true diameters and track.
+  const double dl = el * static_cast<double>(b.wheel_scale_left);
+  const double dr = er * static_cast<double>(b.wheel_scale_right);
   if (dl != 0.0 || dr != 0.0) {
     // Exact arc of a differential drive over the step.
     const double track = b.track_width_m;
     const double ds = 0.5 * (dl + dr);
-    const double dyaw = (dr - dl) / track;
+    const double dyaw = (dr - dl) / (track * static_cast<double>(b.track_scale)) *
+                        (turning ? turn_scrub_factor_ : 1.0);
     const double mid = yaw_rad_ + 0.5 * dyaw;
     const double chord = std::fabs(dyaw) > 1e-9 ? ds * std::sin(0.5 * dyaw) / (0.5 * dyaw) : ds;
     const double nx = x_m_ + chord * std::cos(mid);
@@ -256,9 +270,10 @@ void SimWorld::step_base(float dt_s) {
       const bool contact = gap <= b.contact_margin_m;
       if (contact && !contact_) ++contacts_;
       contact_ = contact;
-      // Wheel odometry (noise optional, off by default as in the thesis).
-      double ol = dl;
-      double orr = dr;
+      // Wheel odometry from the encoders at the nominal diameters and track (white noise
+      // optional).
+      double ol = el;
+      double orr = er;
       if (b.odometry_noise > 0.0F) {
         ol *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
         orr *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());

@@ -28,7 +28,14 @@ struct BaseParams {
   float track_width_m = 0.40F;
   float max_speed_m_s = 0.3F;
   float max_turn_rate_rad_s = 0.8F;
-  float wheel_accel_m_s2 = 1.0F;     // velocity ramp at the wheel rim (ODrive vel_ramp)
+  float wheel_accel_m_s2 = 1.0F;  // velocity ramp at the wheel rim (ODrive vel_ramp)
+  // Odometry errors of a real base (Borenstein & Feng 1996, UMBmark): what the wheels do
+  // against what the odometry assumes. The encoders count the commanded wheel turns; the
+  // ground moves by the true diameters and track. 1, 1, 1, 0, 0 is perfect odometry.
+  float wheel_scale_left = 1.0F;     // true left wheel diameter / the odometry's
+  float wheel_scale_right = 1.0F;    // true right wheel diameter / the odometry's
+  float track_scale = 1.0F;          // true effective track width / the odometry's
+  float turn_scrub = 0.0F;           // sd of the share of each in-place turn lost or gained [1]
   float odometry_noise = 0.0F;       // relative sd of each wheel's step distance (0 = off)
   std::uint32_t startup_us = 50000;  // start-up until closed-loop control [µs]
   float contact_margin_m = 0.01F;    // the bumper closes within this gap [m]
@@ -150,6 +157,9 @@ class SimWorld {
   // Robot (true pose, double so long runs do not drift by rounding).
   double x_m_ = 0.0, y_m_ = 0.0, yaw_rad_ = 0.0;
   float wheel_left_m_s_ = 0.0F, wheel_right_m_s_ = 0.0F;
+  // The in-place turn under way (wheels in opposite directions) and its scrub factor.
+  bool in_place_turn_ = false;
+  double turn_scrub_factor_ = 1.0;
   float target_left_m_s_ = 0.0F, target_right_m_s_ = 0.0F;
   BaseHealth base_health_ = BaseHealth::kStopped;
   const char* base_error_ = "not started";
