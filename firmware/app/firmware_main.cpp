@@ -411,8 +411,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   if (watchdog_armed) hal.watchdog.stop();
   hal.status_led.write(false);  // off: the firmware is not running
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
-  console.log(LogLevel::kInfo, "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f",
-              mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s());
+  console.log(LogLevel::kInfo,
+              "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f register_s=%.3f registered=%u",
+              mission.look_cpu_s(), mission.think_cpu_s(), mission.plan_cpu_s(),
+              mission.register_cpu_s(), static_cast<unsigned>(mission.registered_looks()));
   {
     // The world memory: what it holds and costs, and how the frontier search went.
     const MapCounts m = mission.map_counts();

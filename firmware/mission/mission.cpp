@@ -65,6 +65,8 @@ const char* unit_name(Unit unit) {
       return "model";
     case Unit::kMap:
       return "map";
+    case Unit::kRegister:
+      return "register";
     case Unit::kPlanStart:
       return "plan_start";
     case Unit::kValue:
@@ -464,6 +466,7 @@ void Mission::control_drive(std::uint64_t now_us) {
   const bool ok = driver_.status() == DriveStatus::kDone;
   const core::Pose2 here = pose_.pose();
   planner_.visited({here.x_m, here.y_m});
+  pose_.moved(drive_from_, here);  // the odometry's uncertainty grows
   // The robot's disc stood everywhere along the move: nothing stands there.
   (void)map_.swept({drive_from_.x_m, drive_from_.y_m}, {here.x_m, here.y_m},
                    config_.robot_radius_m);
@@ -553,11 +556,11 @@ void Mission::write_trace(std::uint64_t now_us) {
   if (trace_ == nullptr || now_us < next_trace_us_) return;
   next_trace_us_ += params_.trace_period_us;
   if (next_trace_us_ <= now_us) next_trace_us_ = now_us + params_.trace_period_us;
-  const core::Pose2 odo = pose_.pose();
-  const core::Pose2 truth = truth_ != nullptr ? truth_->robot_pose() : odo;
+  const core::Pose2 estimate = pose_.pose();
+  const core::Pose2 truth = truth_ != nullptr ? truth_->robot_pose() : estimate;
   const hal::PanTiltState ptu = hal_.pan_tilt.state();
   trace_->row(static_cast<double>(now_us) * 1e-6, truth, ptu.pan_rad, ptu.tilt_rad,
-              phase_name(phase_), odo);
+              phase_name(phase_), pose_.odometry_pose(), estimate);
 }
 
 // ---------------------------------------------------------------- background
@@ -601,9 +604,22 @@ SliceResult Mission::think_slice(SliceBudget& budget) {
     CpuScope cpu(think_cpu, longest(Unit::kModel));
     map_.run_unit();
   }
+  // The look registered against the grid before anything of it is fused.
   if (think_step_ == ThinkStep::kModel) {
     if (!budget.next_unit()) return SliceResult::kMore;
+    CpuScope cpu(&register_cpu_s_, longest(Unit::kRegister));
+    map_.begin_register(look_pose_, params_.registration);
+    think_step_ = ThinkStep::kRegister;
+  }
+  while (!map_.register_done()) {
+    if (!budget.next_unit()) return SliceResult::kMore;
+    CpuScope cpu(&register_cpu_s_, longest(Unit::kRegister));
+    map_.register_unit();
+  }
+  if (think_step_ == ThinkStep::kRegister) {
+    if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(think_cpu, longest(Unit::kMap));
+    localize();
     after_think();
     think_step_ = ThinkStep::kGrid;
   }
@@ -719,6 +735,13 @@ void Mission::begin_think() {
   think_step_ = ThinkStep::kModel;
   look_.end_look(params_.limits);
   map_.begin(params_.model, look_.readings(), look_pose_);
+}
+
+void Mission::localize() {
+  const worldmap::Registration& r = map_.registration();
+  if (!r.matched) return;
+  look_pose_ = pose_.correct(look_pose_, r);
+  ++registered_looks_;
 }
 
 void Mission::after_think() {

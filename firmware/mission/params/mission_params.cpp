@@ -98,6 +98,9 @@ MissionParams make_mission_params(const BoardConfig& c) {
   // paths keep the robot's radius and margin from occupied cells, as the polygon does.
   p.thesis_planner = c.thesis_planner;
   p.fusion.max_range_m = c.max_range_m;
+  // A look is registered on the evidence the fusion marks occupied, out to the same range.
+  p.registration.max_range_m = c.max_range_m;
+  p.registration.backing_m = p.fusion.backing_m;
   p.nav.robot_radius_m = c.robot_radius_m + c.clearance_margin_m;
   p.nav.min_frontier_m = c.robot_radius_m + c.clearance_margin_m;
 

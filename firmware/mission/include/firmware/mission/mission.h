@@ -45,6 +45,7 @@ enum class Unit : std::uint8_t {
   kView,       // stereo, target and floor cue of one view
   kModel,      // one step of the local model (samples, training, guard, polygon)
   kMap,        // the map points of a look merged into the global lists
+  kRegister,   // one unit of a look's registration against the grid
   kPlanStart,  // the value iteration set up on the global lists
   kValue,      // one slice of value iteration work
   kStep,       // the step chosen on the value function and checked against the polygon
@@ -144,6 +145,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] double look_cpu_s() const { return cpu_s_[0]; }
   [[nodiscard]] double think_cpu_s() const { return cpu_s_[1]; }
   [[nodiscard]] double plan_cpu_s() const { return cpu_s_[2]; }
+  // Looks registered against the grid (a correction applied) and their host CPU time [s].
+  [[nodiscard]] std::uint32_t registered_looks() const { return registered_looks_; }
+  [[nodiscard]] double register_cpu_s() const { return register_cpu_s_; }
   // Looks whose feature guard dropped readings because a fixed list was full (0 expected).
   [[nodiscard]] std::uint32_t guard_truncated_looks() const { return guard_truncated_looks_; }
   // The longest single unit of each kind so far [s of host thread CPU].
@@ -153,7 +157,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
 
  private:
   // The Think phase's background work: the local model's set-up, then its units.
-  enum class ThinkStep : std::uint8_t { kBegin, kModel, kGrid };
+  enum class ThinkStep : std::uint8_t { kBegin, kModel, kRegister, kGrid };
   // The Plan phase's background work.
   enum class PlanStep : std::uint8_t {
     kValueStart,        // the value iteration set up on the global lists
@@ -204,6 +208,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   SliceResult think_slice(SliceBudget& budget);
   SliceResult plan_slice(SliceBudget& budget);
   void begin_think();
+  // The look's registration applied: the look's pose, and the mission's from now on.
+  void localize();
   void after_think();
   void begin_plan();
   // After the value iteration: gives up or turns round when nothing is left to explore, else
@@ -285,6 +291,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   core::Pose2 snapshot_look_pose_{};
 
   double cpu_s_[3] = {0.0, 0.0, 0.0};
+  double register_cpu_s_ = 0.0;
+  std::uint32_t registered_looks_ = 0;
   double longest_s_[static_cast<std::size_t>(Unit::kCount)] = {};
 };
 

@@ -10,6 +10,7 @@
 #include "algo/mapping/map_points.h"
 #include "algo/worldmap/grid_map.h"
 #include "algo/worldmap/look_fusion.h"
+#include "algo/worldmap/scan_matcher.h"
 #include "firmware/mission/look/look_processor.h"
 #include "firmware/state/mission_state.h"
 
@@ -43,6 +44,15 @@ class MapStage {
   // exploration point at the stand-off; exploration points the robot cannot reach moved clear.
   void fuse(const core::Pose2& look_pose, const FuseParams& params,
             const Eigen::Vector3f* candidate);
+  // The look (taken at `look_pose` by odometry) registered against the grid before it is
+  // fused, in units: start, then register_unit() until register_done(); registration() says
+  // where the look was taken and how well that is known.
+  void begin_register(const core::Pose2& look_pose, const worldmap::ScanMatcherParams& params) {
+    matcher_.start(grid_, look_pose, builder_.map().free, builder_.evidence(), params);
+  }
+  void register_unit() { (void)matcher_.run_unit(); }
+  [[nodiscard]] bool register_done() const { return matcher_.done(); }
+  [[nodiscard]] const worldmap::Registration& registration() const { return matcher_.result(); }
   // The moves swept since the last look, then the look's free polygon and the evidence
   // backing it, into the grid (background), in units: start, then grid_unit() until
   // grid_done().
@@ -71,6 +81,7 @@ class MapStage {
   mapping::GlobalMap map_;
   worldmap::GridMap grid_;
   worldmap::LookFusion fusion_;
+  worldmap::ScanMatcher matcher_;
   struct Swept {
     core::Point2 from;
     core::Point2 to;

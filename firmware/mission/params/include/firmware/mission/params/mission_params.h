@@ -16,6 +16,7 @@
 #include "algo/worldmap/grid_map.h"
 #include "algo/worldmap/look_fusion.h"
 #include "algo/worldmap/nav_planner.h"
+#include "algo/worldmap/scan_matcher.h"
 #include "firmware/common/board_config.h"
 #include "firmware/mission/drive/drive_controller.h"
 #include "firmware/mission/target/target_tracker.h"
@@ -70,6 +71,8 @@ struct MissionParams {
   bool target_by_path = true;
   worldmap::GridMapParams grid;
   worldmap::LookFusionParams fusion;
+  // Every look registered against the grid before it is fused; its pose is the mission's.
+  worldmap::ScanMatcherParams registration;
   worldmap::NavParams nav;
   float nav_step_m = 1.0F;  // longest step along the path to a frontier or target goal [m]
   // The target's stand-off lies near the wall it hangs on, where a look's navigable polygon
