@@ -116,14 +116,15 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   return run;
 }
 
-// The odometry columns (the mission frame's pose) of a trace's first or last row.
-void trace_odometry(const std::string& text, bool last, double odo[3]) {
+// The odometry columns (odo_, from column 7) or the estimate's (est_, from column 10; the
+// mission's own pose), both in the mission frame, of a trace's first or last row.
+void trace_odometry(const std::string& text, bool last, double odo[3], int first_column = 7) {
   const std::size_t first_row = text.find('\n') + 1;
   const std::size_t line = last ? text.rfind('\n', text.size() - 2) + 1 : first_row;
   std::stringstream fields(text.substr(line, text.find('\n', line) - line));
   std::string field;
   for (int i = 0; std::getline(fields, field, ','); ++i) {
-    if (i >= 7 && i <= 9) odo[i - 7] = std::atof(field.c_str());
+    if (i >= first_column && i < first_column + 3) odo[i - first_column] = std::atof(field.c_str());
   }
 }
 
@@ -560,21 +561,23 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   check_found_safely(second);
   // Put back where the base came to rest: the true pose when the first run's firmware
   // returned (the trace keeps 4 decimals). Its last trace row may be a frame older: the last
-  // cycle can end mid-drive, and the base rolls on a few mm while it stops.
+  // cycle can end mid-drive, and the base rolls on a few mm while it stops. The board places
+  // the robot at the saved pose, the firmware's estimate (its looks registered): that is
+  // within the estimate's error of the truth, a few cm and tenths of a degree here.
   const sim::TraceRow& resumed = second.trace.front();
   const double rest_x = first.final_pose.x_m;
   const double rest_y = first.final_pose.y_m;
   const double rest_yaw = first.final_pose.yaw_rad;
-  DOUBLES_EQUAL(rest_x, resumed.x_m, 0.0005);
-  DOUBLES_EQUAL(rest_y, resumed.y_m, 0.0005);
-  DOUBLES_EQUAL(0.0, std::remainder(rest_yaw - resumed.yaw_rad, 2.0 * std::numbers::pi), 0.0005);
-  CHECK(std::hypot(stopped.x_m - resumed.x_m, stopped.y_m - resumed.y_m) < 0.05);
-  // The pose in the mission's frame (the trace's odometry columns) carries on too, from the
+  DOUBLES_EQUAL(rest_x, resumed.x_m, 0.05);
+  DOUBLES_EQUAL(rest_y, resumed.y_m, 0.05);
+  DOUBLES_EQUAL(0.0, std::remainder(rest_yaw - resumed.yaw_rad, 2.0 * std::numbers::pi), 0.02);
+  CHECK(std::hypot(stopped.x_m - resumed.x_m, stopped.y_m - resumed.y_m) < 0.1);
+  // The pose in the mission's frame (the trace's estimate columns) carries on too, from the
   // pose saved at shutdown: the map and the goal saved in that frame still fit.
   double before[3] = {0.0, 0.0, 0.0};
   double after[3] = {1.0, 1.0, 1.0};
-  trace_odometry(first.trace_text, true, before);
-  trace_odometry(second.trace_text, false, after);
+  trace_odometry(first.trace_text, true, before, 10);
+  trace_odometry(second.trace_text, false, after, 10);
   CHECK_TEXT(std::hypot(before[0], before[1]) > 0.3, "the first run's frame moved with the robot");
   CHECK(std::hypot(before[0] - saved[0], before[1] - saved[1]) < 0.05);
   DOUBLES_EQUAL(saved[0], after[0], 0.002);
