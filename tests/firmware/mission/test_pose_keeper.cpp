@@ -94,3 +94,68 @@ TEST(PoseKeeper, TheMissionFramesOriginInTheWorldInvertsTheAnchor) {
   const Pose2 via_odometry = boticelli::core::compose(odometry_origin, {0.8F, -0.4F, 1.1F});
   check_pose(via_odometry, via_mission);
 }
+
+namespace {
+
+// A registration that constrains all three directions equally (eigenvalue `information`
+// each) and found the look at `registered`.
+boticelli::worldmap::Registration registration(const Pose2& initial, const Pose2& registered,
+                                               float information, int constrained = 3) {
+  boticelli::worldmap::Registration r;
+  r.matched = true;
+  r.initial = initial;
+  r.refined = registered;
+  r.pose = registered;
+  r.residual_m = 0.03F;
+  r.eigenvalues = Eigen::Vector3f::Constant(information);
+  r.eigenvectors = Eigen::Matrix3f::Identity();
+  r.constrained = constrained;
+  return r;
+}
+
+}  // namespace
+
+TEST(PoseKeeper, ARegistrationMovesThePoseByItsWeightAgainstTheOdometryAndTheOdometryCarriesOn) {
+  keeper.anchor({});
+  // 2 m driven and half a turn turned: the odometry is uncertain by centimetres and degrees.
+  set_odometry(base, 2.0, 0.0, kPi<double> / 2.0);
+  keeper.moved({0.0F, 0.0F, 0.0F}, {2.0F, 0.0F, kPi<float> / 2.0F});
+  const Pose2 before = keeper.pose();
+  const Pose2 found{2.1F, -0.05F, kPi<float> / 2.0F - 0.03F};
+  const Pose2 after = keeper.correct(before, registration(before, found, 200.0F));
+  // Most of the way to the registration (it is the surer), not all of it.
+  CHECK(after.x_m > 2.07F && after.x_m < 2.1F);
+  CHECK(after.y_m < -0.035F && after.y_m > -0.05F);
+  CHECK(after.yaw_rad < kPi<float> / 2.0F - 0.02F);
+  check_pose(after, keeper.pose());
+  // The odometry then carries on from the corrected pose: 1 m straight on.
+  set_odometry(base, 2.0, 1.0, kPi<double> / 2.0);
+  const Pose2 on = boticelli::core::compose(after, {1.0F, 0.0F, 0.0F});
+  check_pose(on, keeper.pose());
+  // The raw odometry in the mission frame is untouched by the correction.
+  check_pose({2.0F, 1.0F, kPi<float> / 2.0F}, keeper.odometry_pose());
+  // The pose is surer after the registration than before it.
+  CHECK(keeper.covariance()(0, 0) < 0.02F * 0.02F * 4.0F);
+}
+
+TEST(PoseKeeper, WithoutMotionOrAlongAnUnconstrainedDirectionTheOdometryStands) {
+  keeper.anchor({});
+  const Pose2 before = keeper.pose();
+  // No motion since the anchor: the pose is known, a registration does not move it.
+  const Pose2 still = keeper.correct(before, registration(before, {0.2F, 0.1F, 0.05F}, 200.0F));
+  DOUBLES_EQUAL(before.x_m, still.x_m, 1e-4);
+  DOUBLES_EQUAL(before.y_m, still.y_m, 1e-4);
+  DOUBLES_EQUAL(before.yaw_rad, still.yaw_rad, 1e-4);
+  // After a move, a registration that constrains only y and heading (a wall along x) moves
+  // neither x nor anything when it is not matched.
+  set_odometry(base, 3.0, 0.0, 0.0);
+  keeper.moved({0.0F, 0.0F, 0.0F}, {3.0F, 0.0F, 0.0F});
+  const Pose2 odo = keeper.pose();
+  boticelli::worldmap::Registration wall = registration(odo, {3.2F, 0.1F, 0.0F}, 200.0F, 2);
+  wall.eigenvalues = Eigen::Vector3f(0.05F, 200.0F, 200.0F);  // x (column 0) unconstrained
+  const Pose2 after = keeper.correct(odo, wall);
+  DOUBLES_EQUAL(3.0, after.x_m, 1e-4);
+  CHECK(after.y_m > 0.05F);
+  wall.matched = false;
+  check_pose(keeper.pose(), keeper.correct(keeper.pose(), wall));
+}
