@@ -42,7 +42,8 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::number("faults", "retry_s", c.device_retry_s, 1.0, 600.0)) &&
          s.add(ConfigKey::flag_key("watchdog", "enabled", c.watchdog_enabled)) &&
          s.add(watchdog_timeout) &&
-         s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner));
+         s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner)) &&
+         s.add(ConfigKey::flag_key("mission", "register_looks", c.register_looks));
 }
 
 }  // namespace boticelli::firmware

@@ -604,14 +604,16 @@ SliceResult Mission::think_slice(SliceBudget& budget) {
     CpuScope cpu(think_cpu, longest(Unit::kModel));
     map_.run_unit();
   }
-  // The look registered against the grid before anything of it is fused.
+  // The look registered against the grid before anything of it is fused (register_looks).
   if (think_step_ == ThinkStep::kModel) {
-    if (!budget.next_unit()) return SliceResult::kMore;
-    CpuScope cpu(&register_cpu_s_, longest(Unit::kRegister));
-    map_.begin_register(look_pose_, params_.registration);
+    if (params_.register_looks) {
+      if (!budget.next_unit()) return SliceResult::kMore;
+      CpuScope cpu(&register_cpu_s_, longest(Unit::kRegister));
+      map_.begin_register(look_pose_, params_.registration);
+    }
     think_step_ = ThinkStep::kRegister;
   }
-  while (!map_.register_done()) {
+  while (params_.register_looks && !map_.register_done()) {
     if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(&register_cpu_s_, longest(Unit::kRegister));
     map_.register_unit();
@@ -619,7 +621,7 @@ SliceResult Mission::think_slice(SliceBudget& budget) {
   if (think_step_ == ThinkStep::kRegister) {
     if (!budget.next_unit()) return SliceResult::kMore;
     CpuScope cpu(think_cpu, longest(Unit::kMap));
-    localize();
+    if (params_.register_looks) localize();
     after_think();
     think_step_ = ThinkStep::kGrid;
   }

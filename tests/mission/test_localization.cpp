@@ -120,7 +120,8 @@ Error error_of(const Row& start, const Pose2& mission, const Pose2& truth) {
       std::fabs(static_cast<double>(boticelli::core::wrap_pi(w.yaw_rad - truth.yaw_rad)))};
 }
 
-constexpr const char* kRealistic = "[sim]\nrealism = \"realistic\"\n";
+constexpr const char* kRealistic =
+    "[sim]\nrealism = \"realistic\"\n[mission]\nregister_looks = true\n";
 
 }  // namespace
 

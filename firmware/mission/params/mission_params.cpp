@@ -97,6 +97,7 @@ MissionParams make_mission_params(const BoardConfig& c) {
   // World memory and navigation: the grid keeps what looks saw out to the camera's range;
   // paths keep the robot's radius and margin from occupied cells, as the polygon does.
   p.thesis_planner = c.thesis_planner;
+  p.register_looks = c.register_looks;
   p.fusion.max_range_m = c.max_range_m;
   // A look is registered on the evidence the fusion marks occupied, out to the same range.
   p.registration.max_range_m = c.max_range_m;

@@ -76,6 +76,11 @@ struct BoardConfig {
   // false, frontier goals by path cost on the world memory's grid (docs/mission.md: on seeds
   // 1-2 of the shipped and test worlds it found 29 of 36 targets, the thesis's planner 30).
   bool thesis_planner = true;
+  // Every look registered against the world memory before it is fused, its corrected pose the
+  // mission's ([mission] register_looks). Off by default: on a realistic base it holds the pose
+  // far better than odometry over long runs, but with perfect odometry its small corrections
+  // are pure error (docs/benchmarks.md, localization).
+  bool register_looks = false;
 };
 
 }  // namespace boticelli::firmware

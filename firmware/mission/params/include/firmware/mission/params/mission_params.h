@@ -71,7 +71,9 @@ struct MissionParams {
   bool target_by_path = true;
   worldmap::GridMapParams grid;
   worldmap::LookFusionParams fusion;
-  // Every look registered against the grid before it is fused; its pose is the mission's.
+  // Every look registered against the grid before it is fused, its pose the mission's
+  // (BoardConfig::register_looks).
+  bool register_looks = false;
   worldmap::ScanMatcherParams registration;
   worldmap::NavParams nav;
   float nav_step_m = 1.0F;  // longest step along the path to a frontier or target goal [m]
