@@ -7,7 +7,8 @@
 #   toolchain/install-deps.sh --armhf    also the 32-bit arm-linux-gnueabihf compiler and
 #                                        the :armhf libraries (armhf preset)
 #   toolchain/install-deps.sh --bench    also the peers the benchmarks compare against
-#                                        (OpenCV, OctoMap); never needed by the firmware
+#                                        (OctoMap; OpenCV comes with the tests' set); never
+#                                        needed by the firmware
 #   toolchain/install-deps.sh --analyze  also clang-tidy and cppcheck (make analyze)
 #   toolchain/install-deps.sh --kernel   also what the kernel-in-the-loop test needs (qemu,
 #                                        busybox, can-utils, the kernel headers) and Debian's
@@ -47,10 +48,13 @@ done
 # world with SDFormat (tests only, never linked into the firmware); clang-14 with its runtime
 # (libFuzzer, sanitizers): the fuzz preset, which make test runs. libtomlplusplus-dev: the
 # configuration file's parser (a shared library, libtomlplusplus3, which the .deb depends on).
+# libopencv-dev, opencv-doc: tests only, never linked into the firmware: the stereo tests run
+# the tracker on the Middlebury "Aloe" pair that opencv-doc ships in its sample data (read with
+# OpenCV's imread), and the camera model is checked against OpenCV's.
 host_pkgs=(
   g++ make cmake ninja-build pkg-config clang-format file systemd clang-14 libclang-rt-14-dev
   libeigen3-dev libcpputest-dev libgpiod-dev libtinyxml2-dev libpng-dev libtomlplusplus-dev
-  libsdformat-dev
+  libsdformat-dev libopencv-dev opencv-doc
 )
 # lintian: the rpi4 preset's test of the .deb (tests/packaging).
 cross_pkgs=(
@@ -62,7 +66,7 @@ armhf_pkgs=(
   g++-arm-linux-gnueabihf
   libcpputest-dev:armhf libgpiod-dev:armhf libtinyxml2-dev:armhf libtomlplusplus-dev:armhf
 )
-bench_pkgs=(libopencv-dev liboctomap-dev)
+bench_pkgs=(liboctomap-dev)
 analyze_pkgs=(clang-tidy-14 cppcheck)
 # tests/kernel: qemu boots Debian's kernel with a busybox initramfs; candump records the CAN
 # bus; binutils (objcopy) reads the modules' dependencies; xz-utils unpacks the kernel source.

@@ -199,6 +199,7 @@ TEST(Image, RepeatedTextureAlongTheLineIsRejectedAsAmbiguous) {
   params.distinctiveness = 1.0F;
   CHECK(track_feature(a, 20, 10, a, segment, params).found);
   params.match_error_thresh = 0.0F;  // nothing is below a zero threshold
+  params.normalized_error_thresh = 0.0F;
   CHECK_FALSE(track_feature(a, 20, 10, a, segment, params).found);
 }
 
@@ -269,6 +270,7 @@ TEST(Image, AShiftedWindowMatchesTheNearSideOfAnOcclusionEdge) {
   scene(b, 50, 54);
   const EpipolarSegment segment{80.0F, 56.0F, 80.0F, 40.0F};  // infinity at 56, near at 40
   TrackParams params;
+  params.normalized_error_thresh = 0.0F;  // E_thresh alone, as the thesis
   const Track centred = track_feature(a, 80, 60, b, segment, params);
   CHECK_FALSE(centred.found);
   CHECK(centred.match_error > params.match_error_thresh);

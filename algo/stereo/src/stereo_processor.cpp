@@ -104,10 +104,11 @@ std::size_t StereoProcessor::process(const image::LowResFrame& first,
     }
     point.range_error_m =
         evidence::range_error_m(point.range_camera_m, baseline, camera.focal_px);  // Eq 3.7
-    point.reading = reading_from_point(
-        point.point_ptu_m,
-        evidence::evidence_from_match_error(track.match_error, params_.match_error_max),  // Eq 3.8
-        pose1.centre_m);
+    const float evidence = std::max(                                               // Eq 3.8
+        evidence::evidence_from_match_error(track.match_error, params_.match_error_max),
+        evidence::evidence_from_normalized_error(track.normalized_error,
+                                                 params_.normalized_error_max));
+    point.reading = reading_from_point(point.point_ptu_m, evidence, pose1.centre_m);
     if (!points_.push_back(point)) {
       break;
     }

@@ -13,6 +13,16 @@ inline float evidence_from_match_error(float match_error, float match_error_max)
   return 1.0F - q * q;
 }
 
+// Eq 3.8 with the match's normalised error n (epipolar tracker: the refined residual over the
+// feature window's own contrast) in place of E: m = 1 − (n/n_max)² for 0 ≤ n < n_max, else 0.
+// For strong texture, whose E exceeds E_max even when the match is right.
+inline float evidence_from_normalized_error(float normalized_error, float normalized_error_max) {
+  if (!(normalized_error >= 0.0F)) {
+    return 0.0F;
+  }
+  return evidence_from_match_error(normalized_error, normalized_error_max);
+}
+
 // Eq 3.7: range error of a one-pixel disparity error, δr = 2r² / (b·F + r), with the
 // range r and the stereo baseline b in metres and the focal length F in pixels (≈ 0.38 m
 // at r = 1 m for b = 2.8 cm, F = 150 px).

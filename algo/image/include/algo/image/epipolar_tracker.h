@@ -23,8 +23,25 @@ struct EpipolarSegment {
 };
 
 struct TrackParams {
-  float band_half_width_px = 1.0F;     // the band is 2·1 + 1 = 3 px wide (§3.4.1)
-  float match_error_thresh = 1500.0F;  // E_thresh: worse best matches are dropped [grey levels²]
+  float band_half_width_px = 1.0F;  // the band is 2·1 + 1 = 3 px wide (§3.4.1)
+  // E_thresh [grey levels²]: a best match with E at or above it is dropped unless the
+  // normalised test below keeps it. E is taken at the best sampled position of the search
+  // (whole rows, and half rows with half_pixel_search). Weak texture's E is mostly noise,
+  // which this absolute limit is sized for.
+  float match_error_thresh = 1500.0F;
+  // The search samples E at half rows as well as at whole rows (at the half rows beside each
+  // whole row that is a local minimum of E; the second frame's two rows averaged). With
+  // whole rows only, a true match whose disparity falls near a half pixel is sampled half a
+  // pixel off at best, where a strong feature's E is many times its E at the match: it fails
+  // E_thresh and loses to a repeat of the texture that falls on a whole row. With half rows
+  // every match is sampled within a quarter pixel.
+  bool half_pixel_search = true;
+  // A match at or above E_thresh is kept if its normalised error after sub-pixel refinement,
+  // Σ (I2 − T − b)² / Σ (T − T̄)² over the 5x5 window (T the feature's window, I2 the second
+  // frame bilinearly sampled at the refined match, b the mean brightness difference), is
+  // below this: strong texture's error relative to its own contrast, whichever fraction of
+  // a pixel the disparity has. 0 disables it (E_thresh alone, the thesis's test).
+  float normalized_error_thresh = 0.3F;
   // A match must beat the best one elsewhere on the line (more than 2 rows away) by this
   // factor; 1 disables it. Rejects repeated texture, the main source of outliers (§3.6).
   float distinctiveness = 0.8F;
@@ -43,14 +60,18 @@ struct Track {
   bool found = false;
   float u_px = 0.0F;  // match in the second frame, sub-pixel
   float v_px = 0.0F;
-  float match_error = 0.0F;      // E at the best integer position (Eq 3.1)
+  float match_error = 0.0F;      // E at the best sampled position (Eq 3.1)
   float runner_up_error = 0.0F;  // best E elsewhere on the line
+  // The refined match's normalised error (see TrackParams::normalized_error_thresh); −1 if
+  // it was not computed (the test is off, or the window left the frame).
+  float normalized_error = -1.0F;
 };
 
 // Searches along the segment, row by row (the motion is close to vertical: |K| ≤ 0.03,
-// App. A), in a band around the line i' = K·j' + B, keeps the best match below E_thresh and
-// refines its row to sub-pixel by a parabola through E at the neighbouring rows; the
-// column is the line's at that row.
+// App. A) and with half_pixel_search every half row, in a band around the line
+// i' = K·j' + B, keeps the best match below E_thresh that is distinctive, and refines its
+// row to sub-pixel by a parabola through E at the neighbouring samples, then along the line
+// (refine_along_line); the column is the line's at that row.
 Track track_feature(const LowResFrame& first, std::uint32_t u1, std::uint32_t v1,
                     const LowResFrame& second, const EpipolarSegment& segment,
                     const TrackParams& params);

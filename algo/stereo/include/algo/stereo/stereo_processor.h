@@ -22,6 +22,9 @@ struct StereoParams {
   image::TrackParams tracking;      // 3 px band, E_thresh, distinctiveness
   image::TargetParams target;       // green triangle on white paper (§3.4.2)
   float match_error_max = 1500.0F;  // E_max of Eq 3.8 [grey levels²], in agreement with E_thresh
+  // n_max of Eq 3.8 on the normalised error, in agreement with the tracker's threshold; a
+  // reading's evidence is the larger of the two (a strong feature's E is above E_max).
+  float normalized_error_max = 0.3F;
   float min_range_m = 0.2F;         // nearest depth searched, from the first optical centre [m]
   bool fast_triangulation = false;  // Eq 3.4 instead of the exact Eq 3.2
   // The target's range from its edges: the triangle's edges are tracked like features
