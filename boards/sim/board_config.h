@@ -20,7 +20,7 @@ inline firmware::BoardConfig make_config() {
   c.focal_px = 600.0F;        // F = 150 px at 160x120, as in the thesis
   c.principal_x_px = 319.5F;  // image centre in rig.h's pixel-centre convention
   c.principal_y_px = 239.5F;
-  c.radial_k1 = -0.02F;  // a cheap webcam's mild barrel distortion
+  c.k1 = -0.02F;  // a cheap webcam's mild barrel distortion (k2 = p1 = p2 = k3 = 0)
   c.ptu_height_m = 0.6F;
   c.lever_m = 0.21F;               // L
   c.support_angle_rad = 0.0F;      // Ω

@@ -24,7 +24,12 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::number("camera", "focal_px", c.focal_px, 50.0, 5000.0)) &&
          s.add(ConfigKey::number("camera", "principal_x_px", c.principal_x_px, 0.0, kMaxWidth)) &&
          s.add(ConfigKey::number("camera", "principal_y_px", c.principal_y_px, 0.0, kMaxHeight)) &&
-         s.add(ConfigKey::number("camera", "radial_k1", c.radial_k1, -1.0, 1.0)) &&
+         // OpenCV's distortion coefficients; wider than any webcam's calibration needs.
+         s.add(ConfigKey::number("camera", "k1", c.k1, -1.0, 1.0)) &&
+         s.add(ConfigKey::number("camera", "k2", c.k2, -1.0, 1.0)) &&
+         s.add(ConfigKey::number("camera", "p1", c.p1, -0.1, 0.1)) &&
+         s.add(ConfigKey::number("camera", "p2", c.p2, -0.1, 0.1)) &&
+         s.add(ConfigKey::number("camera", "k3", c.k3, -1.0, 1.0)) &&
          s.add(ConfigKey::number("ptu", "height_m", c.ptu_height_m, 0.1, 2.0)) &&
          s.add(ConfigKey::number("ptu", "lever_m", c.lever_m, 0.01, 1.0)) &&
          s.add(ConfigKey::number("ptu", "support_angle_rad", c.support_angle_rad, -1.0, 1.0)) &&

@@ -37,7 +37,7 @@ CameraIntrinsics small_camera(float k1 = 0.0F) {
   c.focal_px = 150.0F;
   c.principal_x_px = 79.5F;
   c.principal_y_px = 59.5F;
-  c.radial_k1 = k1;
+  c.k1 = k1;
   return c;
 }
 

@@ -61,7 +61,7 @@ TEST(SimBoard, TheHalBagDrivesOneWorldInLockstep) {
   hal::Hal& h = board->hal();
   // The renderer uses exactly the config's camera.
   UNSIGNED_LONGS_EQUAL(board->config().camera_width_px, board->renderer().width_px());
-  DOUBLES_EQUAL(board->config().radial_k1, board->rig().camera().radial_k1, 0.0);
+  DOUBLES_EQUAL(board->config().k1, board->rig().camera().k1, 0.0);
   CHECK(h.camera.init());
   CHECK(h.pan_tilt.init());
   CHECK(h.base.init());

@@ -227,7 +227,7 @@ void SceneRenderer::render_yuyv(const stereo::RigModel& rig, const stereo::Camer
   const float bg[3] = {background.x(), background.y(), background.z()};
   const auto colour_at = [&](float pu, float pv, float ycc[3]) {
     float d[3];
-    if (cam.radial_k1 == 0.0F) {
+    if (cam.k1 == 0.0F && cam.radial_k1_only()) {
       const float xn = (pu - cam.principal_x_px) / cam.focal_px;
       const float yn = (pv - cam.principal_y_px) / cam.focal_px;
       for (int r = 0; r < 3; ++r) d[r] = rot[r * 3] * xn + rot[r * 3 + 1] * yn + rot[r * 3 + 2];

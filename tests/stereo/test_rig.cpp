@@ -68,7 +68,7 @@ TEST(Rig, LowResolutionCameraHasTheThesisFocalLength) {
 
 TEST(Rig, ProjectionAndBackProjectionInvertEachOtherWithDistortion) {
   CameraIntrinsics camera;
-  camera.radial_k1 = -0.12F;
+  camera.k1 = -0.12F;
   const Eigen::Vector2f pixels[] = {
       {10.0F, 20.0F}, {319.5F, 239.5F}, {600.0F, 400.0F}, {100.0F, 470.0F}};
   for (const Eigen::Vector2f& pixel : pixels) {

@@ -39,7 +39,7 @@ int bench_world(const char* name, int rounds) {
     return 1;
   }
   boticelli::stereo::RigParams params;  // the thesis's rig: 640x480, F = 600 px, L = 21 cm
-  params.camera.radial_k1 = -0.02F;
+  params.camera.k1 = -0.02F;
   const boticelli::stereo::RigModel rig(params);
   if (!sim.init(world, rig, SimParams{}, error, sizeof error)) {
     std::fprintf(stderr, "render: %s\n", error);

@@ -1,8 +1,10 @@
-// Benchmark suite "stereo": time and depth accuracy per frame pair, ours against OpenCV.
+// Benchmark suite "stereo": time and depth accuracy per frame pair, ours against OpenCV; the Aloe
+// pair.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <ctime>
+#include <string>
 #include <vector>
 
 #include "algo/core/fixed_vector.h"
@@ -11,6 +13,9 @@
 #include "algo/stereo/stereo_processor.h"
 #include "bench.h"
 #include "stereo_scenes.h"
+#ifdef BOTICELLI_OPENCV_SAMPLES_DIR
+#include "aloe_pair.h"
+#endif
 
 #ifdef BOTICELLI_BENCH_HAVE_OPENCV
 #include <opencv2/core.hpp>
@@ -91,6 +96,58 @@ double median_ms(std::vector<double>& ns) {
 
 boticelli::stereo::PairPose pair_pose(const RigModel& rig, const boticelli::test::WallPair& pair) {
   return {pair.pan_rad, pair.first_tilt_rad, pair.first_tilt_rad - rig.params().tilt_step_rad};
+}
+
+// The Middlebury "Aloe" pair (a real photograph pair with ground truth, OpenCV's sample
+// data) at 160x138, transposed: the tracker with its defaults, with the thesis's test alone
+// (E_thresh on whole rows), and OpenCV GFTT + PyrLK on the same frames.
+void aloe_cases() {
+  namespace bench = boticelli::bench;
+#ifdef BOTICELLI_OPENCV_SAMPLES_DIR
+  static boticelli::test::AloePair pair;
+  std::string why;
+  if (!boticelli::test::load_aloe_pair(BOTICELLI_OPENCV_SAMPLES_DIR, pair, why)) {
+    bench::JsonLine("stereo", "aloe").text("skipped", why.c_str()).emit();
+    return;
+  }
+  constexpr int kAloeRepeats = 50;
+  const auto emit = [](const char* name, const boticelli::test::StereoYield& y) {
+    bench::JsonLine line("stereo", name);
+    line.integer("features", static_cast<std::int64_t>(y.features))
+        .integer("matched", static_cast<std::int64_t>(y.matched))
+        .num("yield", y.yield())
+        .num("within_1px", y.share_within_1px())
+        .num("beyond_3px", y.share_beyond_3px())
+        .num("within_1px_of_block_mean",
+             y.with_truth == 0
+                 ? 0.0
+                 : static_cast<double>(y.within_1px_of_mean) / static_cast<double>(y.with_truth))
+        .num("beyond_3px_of_block_mean",
+             y.with_truth == 0
+                 ? 0.0
+                 : static_cast<double>(y.beyond_3px_of_mean) / static_cast<double>(y.with_truth))
+        .num("cpu_ms_median", y.cpu_ms);
+    line.emit();
+  };
+  emit("aloe_ours",
+       boticelli::test::track_aloe(pair, boticelli::image::TrackParams{}, kAloeRepeats));
+  boticelli::image::TrackParams whole_rows;
+  whole_rows.half_pixel_search = false;
+  whole_rows.normalized_error_thresh = 0.0F;
+  emit("aloe_ours_thesis_test", boticelli::test::track_aloe(pair, whole_rows, kAloeRepeats));
+  boticelli::image::TrackParams half_only = boticelli::image::TrackParams{};
+  half_only.normalized_error_thresh = 0.0F;
+  emit("aloe_ours_half_rows_only", boticelli::test::track_aloe(pair, half_only, kAloeRepeats));
+  boticelli::image::TrackParams normalized_only = whole_rows;
+  normalized_only.normalized_error_thresh = boticelli::image::TrackParams{}.normalized_error_thresh;
+  emit("aloe_ours_normalized_only",
+       boticelli::test::track_aloe(pair, normalized_only, kAloeRepeats));
+  emit("aloe_opencv_gftt_pyrlk", boticelli::test::track_aloe_opencv(pair, kAloeRepeats));
+#else
+  bench::JsonLine("stereo", "aloe")
+      .text("skipped", "OpenCV or its sample data (opencv-doc) not found at configure time")
+      .emit();
+#endif
 }
 
 }  // namespace
@@ -245,5 +302,6 @@ BOTICELLI_BENCH_SUITE(stereo,
       .text("skipped", "OpenCV not found at configure time")
       .emit();
 #endif
+  aloe_cases();
   return 0;
 }

@@ -95,6 +95,7 @@ std::size_t StereoProcessor::process(const image::LowResFrame& first,
     point.first_px = first_px;
     point.second_px = Eigen::Vector2f(track.u_px, track.v_px);
     point.match_error = track.match_error;
+    point.normalized_error = track.normalized_error;
     if (!triangulate(pose1, pose2, point.first_px, point.second_px, point.point_ptu_m)) {
       continue;
     }

@@ -16,7 +16,11 @@ stereo::RigParams make_rig_params(const BoardConfig& c) {
   p.camera.focal_px = c.focal_px;
   p.camera.principal_x_px = c.principal_x_px;
   p.camera.principal_y_px = c.principal_y_px;
-  p.camera.radial_k1 = c.radial_k1;
+  p.camera.k1 = c.k1;
+  p.camera.k2 = c.k2;
+  p.camera.p1 = c.p1;
+  p.camera.p2 = c.p2;
+  p.camera.k3 = c.k3;
   p.lever_m = c.lever_m;
   p.support_angle_rad = c.support_angle_rad;
   p.ptu_height_m = c.ptu_height_m;

@@ -98,6 +98,25 @@ TEST(ConfigFile, AGoodFileSetsEveryKeyItNamesAndLeavesTheRest) {
   STRCMP_EQUAL("/dev/ttyUSB0", k.devices.ptu_device.data());
 }
 
+// OpenCV's five distortion coefficients as calibrateCamera prints them, pasted into [camera].
+TEST(ConfigFile, TheFiveDistortionCoefficientsAreReadAsCalibrationReportsThem) {
+  Rpi4Keys k;
+  char error[320] = "";
+  const std::string text =
+      "[camera]\n"
+      "k1 = -0.121\n"
+      "k2 = 0.084\n"
+      "p1 = 0.0012\n"
+      "p2 = -0.0007\n"
+      "k3 = -0.013\n";
+  CHECK_TEXT(apply_config_text(text, "lens.conf", k.schema, error, sizeof error), error);
+  DOUBLES_EQUAL(-0.121, static_cast<double>(k.config.k1), 1e-7);
+  DOUBLES_EQUAL(0.084, static_cast<double>(k.config.k2), 1e-7);
+  DOUBLES_EQUAL(0.0012, static_cast<double>(k.config.p1), 1e-7);
+  DOUBLES_EQUAL(-0.0007, static_cast<double>(k.config.p2), 1e-7);
+  DOUBLES_EQUAL(-0.013, static_cast<double>(k.config.k3), 1e-7);
+}
+
 // Every bad file gives "FILE:LINE: why" with the line of the offending value, and changes
 // nothing (the good key on line 2 is not applied either).
 TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
@@ -112,6 +131,11 @@ TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
       {"width_px = -8", "camera.width_px = -8 is out of range (160 to 1280)"},
       {"width_px = 642", "camera.width_px = 642 must be a multiple of 8"},
       {"focal_px = 10", "camera.focal_px = 10 is out of range (50 to 5000)"},
+      {"k1 = -1.5", "camera.k1 = -1.5 is out of range (-1 to 1)"},
+      {"k3 = 2", "camera.k3 = 2 is out of range (-1 to 1)"},
+      {"p1 = 0.2", "camera.p1 = 0.2 is out of range (-0.1 to 0.1)"},
+      {"p2 = -0.25", "camera.p2 = -0.25 is out of range (-0.1 to 0.1)"},
+      {"radial_k1 = -0.1", "unknown key 'camera.radial_k1'"},  // the one-term model's key
       {"focal_px = inf", "camera.focal_px must be a finite number"},
       {"focal_px = nan", "camera.focal_px must be a finite number"},
       {"focal_px = true", "camera.focal_px must be a number"},

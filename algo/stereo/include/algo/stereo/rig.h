@@ -33,23 +33,40 @@ namespace boticelli::stereo {
 // L = 21 cm, Φ = 7.7°).
 // ---------------------------------------------------------------------------------------
 
-// Pinhole camera with one radial distortion term, at one image resolution. Distortion:
-// distorted normalised = undistorted normalised · (1 + k1·ρ²), ρ² = x² + y² (undistorted).
+// Pinhole camera with OpenCV's radial-tangential distortion (Brown-Conrady; the five
+// coefficients calibrateCamera and ROS camera_calibration report, in their order k1, k2, p1,
+// p2, k3), at one image resolution. With (x, y) undistorted normalised coordinates and
+// ρ² = x² + y², the distorted ones are
+//   x_d = x·(1 + k1·ρ² + k2·ρ⁴ + k3·ρ⁶) + 2·p1·x·y + p2·(ρ² + 2·x²)
+//   y_d = y·(1 + k1·ρ² + k2·ρ⁴ + k3·ρ⁶) + p1·(ρ² + 2·y²) + 2·p2·x·y
+// The coefficients are the same at every resolution (normalised coordinates).
 struct CameraIntrinsics {
   float focal_px = 600.0F;        // F [px]
   float principal_x_px = 319.5F;  // principal point [px]
   float principal_y_px = 239.5F;
-  float radial_k1 = 0.0F;  // k1 (normalised coordinates; same at every resolution)
+  float k1 = 0.0F;  // radial, ρ²
+  float k2 = 0.0F;  // radial, ρ⁴
+  float p1 = 0.0F;  // tangential
+  float p2 = 0.0F;
+  float k3 = 0.0F;  // radial, ρ⁶
   std::uint32_t width_px = 640;
   std::uint32_t height_px = 480;
+
+  // Only k1 is set (or none): the one-term model, computed as it always was.
+  [[nodiscard]] bool radial_k1_only() const {
+    return k2 == 0.0F && p1 == 0.0F && p2 == 0.0F && k3 == 0.0F;
+  }
+  // Distorted normalised coordinates of undistorted ones (the model above).
+  [[nodiscard]] Eigen::Vector2f distort(const Eigen::Vector2f& undistorted) const;
 
   // The camera seen through an image averaged in factor x factor blocks (low-resolution
   // pixel (u, v) covers full-resolution pixels [f·u, f·u + f) x [f·v, f·v + f)).
   [[nodiscard]] CameraIntrinsics downsampled(std::uint32_t factor) const;
 
-  // Undistorted normalised coordinates (x/z, y/z) of a pixel (inverts k1 iteratively).
+  // Undistorted normalised coordinates (x/z, y/z) of a pixel: the model inverted by a fixed
+  // number of fixed-point steps (as OpenCV's undistortPoints), point by point, allocation-free.
   [[nodiscard]] Eigen::Vector2f normalized_from_pixel(const Eigen::Vector2f& pixel) const;
-  // Pixel of undistorted normalised coordinates (applies k1).
+  // Pixel of undistorted normalised coordinates (applies the distortion).
   [[nodiscard]] Eigen::Vector2f pixel_from_normalized(const Eigen::Vector2f& normalized) const;
   // Camera-frame point [m] → pixel; false (pixel untouched) if the point is not in front.
   [[nodiscard]] bool project(const Eigen::Vector3f& point_camera_m, Eigen::Vector2f& pixel) const;

@@ -61,6 +61,7 @@ struct StereoPoint {
   Eigen::Vector2f first_px = Eigen::Vector2f::Zero();     // feature, low-resolution pixels
   Eigen::Vector2f second_px = Eigen::Vector2f::Zero();    // match, sub-pixel
   float match_error = 0.0F;                               // E (Eq 3.1) [grey levels²]
+  float normalized_error = -1.0F;                         // the tracker's (Track), −1 if none
   Eigen::Vector3f point_ptu_m = Eigen::Vector3f::Zero();  // PTU frame [m]
   float range_camera_m = 0.0F;                            // from the first optical centre [m]
   float range_error_m = 0.0F;                             // δr of Eq 3.7 at that range [m]

@@ -19,7 +19,13 @@ struct BoardConfig {
   float focal_px = 600.0F;        // focal length at full resolution [px]
   float principal_x_px = 320.0F;  // principal point [px]
   float principal_y_px = 240.0F;
-  float radial_k1 = 0.0F;  // radial distortion, normalised coordinates
+  // Lens distortion, OpenCV's radial-tangential model in normalised coordinates (rig.h;
+  // docs/configuration.md "Calibrating the camera"): calibrateCamera's k1, k2, p1, p2, k3.
+  float k1 = 0.0F;
+  float k2 = 0.0F;
+  float p1 = 0.0F;
+  float p2 = 0.0F;
+  float k3 = 0.0F;
   // Pan-tilt unit and the L-shaped camera support (App. A).
   float ptu_height_m = 0.6F;       // PTU centre (pan and tilt axes) above the floor [m]
   float lever_m = 0.21F;           // tilt axis to camera optical centre, L [m]
