@@ -1,4 +1,4 @@
-// Ray caster: per-pixel rays (with radial distortion) against boxes, cylinders and planes,
+// Ray caster: per-pixel rays (with the lens distortion) against boxes, cylinders and planes,
 // culled per 16x16 tile by each surface's projected bounds; Lambert + ambient shading,
 // procedural patterns, vignetting, sensor noise; BT.601 (limited range) YUYV output.
 #include "hal/sim/renderer.h"

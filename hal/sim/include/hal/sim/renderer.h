@@ -28,7 +28,7 @@ bool cast_ray(const World& world, const Eigen::Vector3f& origin_m, const Eigen::
 
 class Renderer {
  public:
-  // Precomputes the per-pixel rays (with the radial distortion) and the vignetting; allocates,
+  // Precomputes the per-pixel rays (with the lens distortion, rig.h) and the vignetting; allocates,
   // so call at init. `world` and `textures` must outlive the renderer.
   bool init(const World& world, const TextureBank& textures, const stereo::CameraIntrinsics& camera,
             const RenderSettings& settings, char* error, std::size_t error_size);
