@@ -1,4 +1,5 @@
-// boticelli-box-devices: the robot's base and PTU for the robot computer in a box (tests/box/run.sh).
+// boticelli-box-devices: the robot's base and PTU for the robot computer in a box
+// (tests/box/run.sh).
 //
 //   boticelli-box-devices odrive IFACE   in the box: two ODrive axes on the SocketCAN IFACE
 //   boticelli-box-devices ptu LINK       on the host: a PTU-D46 on a pty, LINK a symlink to
@@ -21,7 +22,9 @@
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int /*signal*/) { g_stop = 1; }
+void on_signal(int /*signal*/) {
+  g_stop = 1;
+}
 
 std::uint64_t now_us() {
   timespec t{};
