@@ -21,8 +21,9 @@ std::string worlds_dir(const char* dir_env, const char* fallback);
 
 // The worlds in `dir` (file names without ".sdf", sorted), restricted by the environment
 // variable `filter_env` = name[,name...] (with or without ".sdf") when it is set; a listed
-// name that is not in `dir` is reported on stderr with the `suite` prefix and skipped.
+// name that is not in `dir` is reported on stderr with the `suite` prefix (unless
+// !report_missing: the caller looks in several folders) and skipped.
 std::vector<std::string> world_names(const std::string& dir, const char* filter_env,
-                                     const char* suite);
+                                     const char* suite, bool report_missing = true);
 
 }  // namespace boticelli::bench

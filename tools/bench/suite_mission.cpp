@@ -378,8 +378,11 @@ int run() {
     sets.push_back({"tests", BOTICELLI_TEST_WORLDS_DIR, "tests/worlds"});
   }
   std::vector<Run> runs;
+  std::vector<std::string> listed_anywhere;  // what the filter found in some set
   for (const Set& set : sets) {
-    for (const std::string& name : world_names(set.dir, "BOTICELLI_MISSION_WORLDS", kSuite)) {
+    for (const std::string& name :
+         world_names(set.dir, "BOTICELLI_MISSION_WORLDS", kSuite, false)) {
+      listed_anywhere.push_back(name);
       const std::string path = set.dir + "/" + name + ".sdf";
       char error[256] = "";
       if (!hal::sim::load_world(path.c_str(), g_world, error, sizeof error)) {
@@ -411,6 +414,24 @@ int run() {
           runs.push_back(r);
         }
       }
+    }
+  }
+
+  // A listed world in no set is a typing error worth a word (one set lacking it is not).
+  if (const char* only = std::getenv("BOTICELLI_MISSION_WORLDS");
+      only != nullptr && *only != '\0') {
+    std::string list = only;
+    std::size_t at = 0;
+    while (at <= list.size()) {
+      const std::size_t comma = std::min(list.find(',', at), list.size());
+      std::string item = list.substr(at, comma - at);
+      if (item.size() > 4 && item.compare(item.size() - 4, 4, ".sdf") == 0)
+        item.resize(item.size() - 4);
+      if (!item.empty() && std::find(listed_anywhere.begin(), listed_anywhere.end(), item) ==
+                               listed_anywhere.end()) {
+        std::fprintf(stderr, "mission: no world '%s' in any set\n", item.c_str());
+      }
+      at = comma + 1;
     }
   }
 
