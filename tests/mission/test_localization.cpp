@@ -17,6 +17,7 @@
 #include "algo/core/angles.h"
 #include "algo/core/geometry.h"
 #include "firmware/app/firmware_main.h"
+#include "mission_runner.h"
 #include "sim_board.h"
 
 #include "CppUTest/TestHarness.h"
@@ -25,16 +26,11 @@
 
 using boticelli::core::Pose2;
 
+using boticelli::test::slurp;
+
 namespace {
 
 boticelli::boards::sim::SimBoard g_board;
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 struct Row {
   double t_s = 0.0;
@@ -65,22 +61,7 @@ Run run_mission(const char* world, const char* seed, const char* sim_table, cons
   std::vector<const char*> argv = {"boticelli",  "--world",      path.c_str(), "--seed", seed,
                                    "--trace",    trace.c_str(),  "--console",  "stdio",  "--config",
                                    conf.c_str(), "--max-cycles", cycles};
-  std::fflush(stdout);
-  const int saved = dup(1);
-  const int saved_in = dup(0);
-  FILE* f = std::fopen(out.c_str(), "w");
-  FILE* null_in = std::fopen("/dev/null", "r");
-  dup2(fileno(f), 1);
-  dup2(fileno(null_in), 0);
-  (void)boticelli::firmware::firmware_main(static_cast<int>(argv.size()), argv.data(), g_board,
-                                           nullptr);
-  std::fflush(stdout);
-  dup2(saved, 1);
-  dup2(saved_in, 0);
-  close(saved);
-  close(saved_in);
-  std::fclose(f);
-  std::fclose(null_in);
+  (void)boticelli::test::run_captured(g_board, argv, out);
   Run run;
   run.output = slurp(out);
   std::stringstream lines(slurp(trace));

@@ -22,6 +22,7 @@
 #include "firmware/app/firmware_main.h"
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
+#include "mission_runner.h"
 #include "sim_board.h"
 
 #include "alloc_guard.h"
@@ -29,6 +30,8 @@
 #include "CppUTest/MemoryLeakWarningPlugin.h"
 
 namespace sim = boticelli::hal::sim;
+
+using boticelli::test::slurp;
 
 namespace {
 
@@ -46,13 +49,6 @@ struct MissionRun {
   boticelli::core::Pose2 final_pose{};  // the robot's true pose when the firmware returned
   boticelli::core::Point2 target{};     // the true target (its foot on the floor)
 };
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // Runs firmware_main on the sim board with stdout captured; checks the trace against the
 // world's colliders with the robot's disc (not the simulator's own contact counter). The
@@ -78,24 +74,9 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
                                    "stdio",     "--max-cycles"};
   argv.push_back("45");
   for (const char* arg : extra) argv.push_back(arg);
-  std::fflush(stdout);
-  const int saved = dup(1);
-  const int saved_in = dup(0);
-  FILE* f = std::fopen(out.c_str(), "w");
-  FILE* null_in = std::fopen("/dev/null", "r");
-  dup2(fileno(f), 1);
-  dup2(console_in >= 0 ? console_in : fileno(null_in), 0);
-  run.exit_code = boticelli::firmware::firmware_main(static_cast<int>(argv.size()), argv.data(),
-                                                     g_board, hooks);
+  run.exit_code = boticelli::test::run_captured(g_board, argv, out, hooks, console_in);
   run.final_pose = g_board.robot_pose();
   run.target = {g_board.target_m().x(), g_board.target_m().y()};
-  std::fflush(stdout);
-  dup2(saved, 1);
-  dup2(saved_in, 0);
-  close(saved);
-  close(saved_in);
-  std::fclose(f);
-  std::fclose(null_in);
   const std::string text = slurp(out);
   run.telemetry_confirmed = text.find("target=confirmed\r\n") != std::string::npos;
   const std::size_t at = text.rfind("MISSION ");

@@ -203,7 +203,7 @@ void ScanMatcher::transform_line(std::size_t first, std::size_t stride, int n) {
       --k;
     }
     if (s <= line_z_[static_cast<std::size_t>(k)]) {
-      // Only possible at k == 0: the new parabola is lower everywhere.
+      // Only possible at k == 0: this parabola is lower everywhere.
       line_v_[0] = q;
       line_z_[0] = -kFar;
       line_z_[1] = kFar;
