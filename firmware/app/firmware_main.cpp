@@ -28,6 +28,7 @@
 #include "firmware/telemetry/snapshot.h"
 #include "firmware/state/state_saver.h"
 #include "firmware/executive/task_table.h"
+#include "firmware/app/last_gasp.h"
 #include "firmware/common/text_buffer.h"
 
 namespace boticelli::firmware {
@@ -235,6 +236,10 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   // Devices.
   if (!hal.console.open()) return fail("console", hal.console.error());
   if (!hal.base.init()) return fail("base", hal.base.error());
+  // From here a crash still brakes the wheels (a kill -9 cannot be caught: the ODrives'
+  // watchdog stops them then).
+  LastGasp last_gasp;
+  if (!last_gasp.arm(hal.base)) slog.log(LogLevel::kWarn, "no last-gasp stop on a crash");
   if (!hal.pan_tilt.init()) return fail("pan-tilt unit", hal.pan_tilt.error());
   if (!hal.camera.init()) return fail("camera", hal.camera.error());
   bool watchdog_armed = false;

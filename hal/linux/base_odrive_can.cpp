@@ -61,6 +61,8 @@ BaseOdriveCan::BaseOdriveCan(const BaseOdriveCanConfig& config, hal::Clock& cloc
     : config_(config), clock_(clock), integrator_(config.geometry) {
   axes_[0].node_id = config.left_node_id;
   axes_[1].node_id = config.right_node_id;
+  for (int k = 0; k < 2; ++k)
+    last_gasp_frames_[k] = odrive::encode_set_input_vel(axes_[k].node_id, 0.0F);
 }
 
 BaseOdriveCan::~BaseOdriveCan() {
@@ -442,6 +444,17 @@ bool BaseOdriveCan::resume() {
   integrator_.reset_reference();
   begin_startup(clock_.now_us());
   return true;
+}
+
+void BaseOdriveCan::last_gasp_stop() noexcept {
+  const int fd = fd_;
+  if (fd < 0) return;
+  for (const odrive::CanFrame& f : last_gasp_frames_) {
+    const can_frame frame = to_os(f);  // plain stores: async-signal-safe
+    for (int tries = 0; tries < 3; ++tries) {
+      if (::write(fd, &frame, sizeof frame) >= 0 || errno != EINTR) break;
+    }
+  }
 }
 
 }  // namespace boticelli::hal_linux

@@ -2,6 +2,8 @@
 // only, no I/O).
 #pragma once
 
+#include <unistd.h>
+
 #include <cstdint>
 
 #include "firmware/executive/host_clock.h"
@@ -64,8 +66,13 @@ class FakeBase final : public hal::Base {
   }
   hal::BaseHealth health() const override { return health_; }
   hal::Odometry odometry() const override { return odometry_value; }
+  // Writes one byte 'G' to `gasp_fd` (a pipe a forked test watches): the crash's last act.
+  void last_gasp_stop() noexcept override {
+    if (gasp_fd >= 0) (void)!::write(gasp_fd, "G", 1);
+  }
 
   hal::Odometry odometry_value;
+  int gasp_fd = -1;
   float v_m_s = 0.0F;
   float omega_rad_s = 0.0F;
   int updates = 0;

@@ -324,3 +324,25 @@ TEST(BaseOdriveCan, AWheelWhoseEncoderStreamStopsStopsTheBaseInsteadOfTurningThe
   // turned the odometry by 0.5/0.5 = 1 rad/s.
   DOUBLES_EQUAL(yaw_before, rig.base->odometry().yaw_rad, 0.005);
 }
+
+// The last gasp of a crashing firmware: a zero velocity to both axes, which their velocity
+// controllers brake to (not Estop: that would idle them and let the robot coast), and
+// nothing else: no state of the driver changes (it runs inside a signal handler).
+TEST(BaseOdriveCan, TheLastGaspSendsAZeroVelocityToBothAxesAndNoEstop) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.3F, 0.2F);
+  rig.cycle();
+  rig.cycle();
+  CHECK(std::fabs(rig.emu.vel_setpoint(kLeft)) > 0.1F);
+  const std::uint32_t sent = rig.base->sent_frames();
+  rig.base->last_gasp_stop();
+  rig.emu.service(rig.clock.peek_us());
+  for (int axis : {kLeft, kRight}) {
+    DOUBLES_EQUAL(0.0, rig.emu.vel_setpoint(axis), 0.0);
+    CHECK_EQUAL(8, rig.emu.axis_state(axis));  // still in closed loop: braking
+    CHECK_EQUAL(0U, rig.emu.estops(axis));
+  }
+  CHECK(rig.base->health() == BaseHealth::kReady);
+  CHECK_EQUAL(sent, rig.base->sent_frames());  // no counter touched
+}

@@ -39,6 +39,11 @@ class Base : private NonCopyable {
   virtual BaseHealth health() const = 0;
   virtual Odometry odometry() const = 0;
   virtual const char* error() const { return ""; }
+  // The last gasp of a dying process, from a fatal signal's handler (SIGSEGV, SIGABRT, ...):
+  // commands the wheels to brake to a stop. Async-signal-safe: no lock, no allocation, no
+  // state change, nothing but write(2) of what init() prepared. The default does nothing (a
+  // base the process's death stops by itself).
+  virtual void last_gasp_stop() noexcept {}
 };
 
 }  // namespace boticelli::hal

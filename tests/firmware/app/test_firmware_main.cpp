@@ -680,6 +680,92 @@ TEST(FirmwareMain, OutputToAClosedPipeDoesNotKillItAndTheMissionEndsWithItsSave)
   CHECK_EQUAL(4U, state.seed);
   CHECK_EQUAL(2U, state.log.size());
 }
+
+namespace {
+// How a forked firmware dies at its 20th frame.
+enum class Crash { kAbort, kBadAccess };
+struct CrashPlan {
+  Crash how = Crash::kAbort;
+  int frames = 0;
+};
+void crash_at_frame_20(void* context) {
+  auto* plan = static_cast<CrashPlan*>(context);
+  if (++plan->frames < 20) return;
+  if (plan->how == Crash::kAbort) std::abort();
+  volatile std::uintptr_t address = 8;  // a real fault: the kernel raises SIGSEGV
+  *reinterpret_cast<volatile int*>(address) = 1;
+}
+// Runs firmware_main in a forked child that crashes as planned; what its base's last gasp
+// wrote (to a pipe) and the child's wait status (-1: it did not end within 60 s).
+std::string crash_and_read_gasp(Crash how, const std::string& dir, int& status) {
+  int fds[2];
+  CHECK(pipe(fds) == 0);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    const int null_fd = open("/dev/null", O_WRONLY);
+    if (null_fd >= 0) {
+      dup2(null_fd, STDOUT_FILENO);
+      dup2(null_fd, STDERR_FILENO);
+    }
+    static CrashPlan plan;
+    plan.how = how;
+    static MainHooks hooks;
+    hooks.after_frame = crash_at_frame_20;
+    hooks.context = &plan;
+    auto board = std::make_unique<FakeBoard>();
+    board->base.gasp_fd = fds[1];
+    const std::vector<const char*> argv{"boticelli", "--state", dir.c_str()};
+    const int code = firmware_main(static_cast<int>(argv.size()), argv.data(), *board, &hooks);
+    _exit(code == 0 ? 99 : code);
+  }
+  close(fds[1]);
+  status = boticelli::test::wait_for_child(child, 60000);
+  std::string gasp;
+  char c = 0;
+  while (read(fds[0], &c, 1) == 1) gasp.push_back(c);
+  close(fds[0]);
+  return gasp;
+}
+}  // namespace
+
+// A crash brakes the base before the process dies, and it still dies of its signal (core
+// dump, the wait status systemd restarts on), once.
+TEST(FirmwareMain, AnAbortCommandsTheBaseToStopOnceAndStillDiesOfIt) {
+  int status = 0;
+  STRCMP_EQUAL("G", crash_and_read_gasp(Crash::kAbort, dir, status).c_str());
+  CHECK_TEXT(status != -1, "the child did not end");
+  CHECK(WIFSIGNALED(status));
+  CHECK_EQUAL(SIGABRT, WTERMSIG(status));
+}
+
+TEST(FirmwareMain, ABadMemoryAccessCommandsTheBaseToStopOnceAndStillKillsTheProcess) {
+  int status = 0;
+  STRCMP_EQUAL("G", crash_and_read_gasp(Crash::kBadAccess, dir, status).c_str());
+  CHECK_TEXT(status != -1, "the child did not end");
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's handler (the one found when the last gasp was armed) reports it.
+  CHECK(WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) != 0));
+#else
+  CHECK(WIFSIGNALED(status));
+  CHECK_EQUAL(SIGSEGV, WTERMSIG(status));
+#endif
+}
+
+// After firmware_main returns, nothing of its last gasp is left armed.
+TEST(FirmwareMain, AFinishedRunLeavesNoFatalSignalHandlerBehind) {
+  struct sigaction before {};
+  sigaction(SIGSEGV, nullptr, &before);
+  const Run r = run_firmware({"--max-cycles", "1"});
+  CHECK_EQUAL(kExitFailure, r.exit_code);
+  struct sigaction after {};
+  sigaction(SIGSEGV, nullptr, &after);
+  CHECK((before.sa_flags & SA_SIGINFO) == (after.sa_flags & SA_SIGINFO));
+  CHECK(reinterpret_cast<void*>(before.sa_sigaction) ==
+        reinterpret_cast<void*>(after.sa_sigaction));
+}
 #endif  // BOTICELLI_TESTS_UNDER_EMULATOR
 
 namespace {

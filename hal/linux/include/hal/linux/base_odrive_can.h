@@ -51,6 +51,11 @@ class BaseOdriveCan final : public hal::Base {
   hal::BaseHealth health() const override { return health_; }
   hal::Odometry odometry() const override { return odometry_; }
   const char* error() const override { return error_; }
+  // Set_Input_Vel(0) to both axes, written as prepared at construction: in closed loop the
+  // ODrives' velocity controllers brake the wheels to a stop, and once the setpoints stop
+  // coming their watchdog (if enabled) idles the axes. Not Estop: that idles at once and
+  // the robot coasts.
+  void last_gasp_stop() noexcept override;
 
   // Diagnostics.
   std::uint32_t rejected_frames() const { return rejected_frames_; }
@@ -102,6 +107,7 @@ class BaseOdriveCan final : public hal::Base {
   std::uint32_t sent_frames_ = 0;
   std::uint32_t send_failures_ = 0;
   char error_[160] = "not initialised";
+  codec::odrive::CanFrame last_gasp_frames_[2]{};
 };
 
 }  // namespace boticelli::hal_linux
