@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "algo/core/angles.h"
+#include "firmware/common/log.h"
 #include "firmware/state/atomic_file.h"
 
 namespace boticelli::boards::sim {
@@ -101,6 +103,15 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   }
   sim_.faults().set_plan(plan_);
   firmware::set_storage_fault_hook(storage_fault, &sim_);
+  // The world's true state, beside the firmware's (a new mission: the robot at the world's
+  // start, the file started afresh at the first step).
+  truth_file_.close();
+  truth_failed_ = false;
+  truth_path_[0] = '\0';
+  if (options.state_dir != nullptr) {
+    std::snprintf(truth_path_.data(), truth_path_.size(), "%s/sim-world.truth", options.state_dir);
+  }
+  clock_.set_after_advance(record_world, this);
   console_.set_baud(config_.console_baud);
   console_.select(console_mode(options.console), options.console_path);
   clock_.set_speed(options.speed);
@@ -116,13 +127,65 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   return true;
 }
 
+void SimBoard::record_world(void* context) {
+  auto* board = static_cast<SimBoard*>(context);
+  if (!board->truth_file_.is_open()) {
+    if (board->truth_failed_ || board->truth_path_[0] == '\0') return;
+    char why[600] = "";
+    if (!board->truth_file_.open(board->truth_path_.data(),
+                                 WorldTruthFile::world_id(board->world_), why, sizeof why)) {
+      board->truth_failed_ = true;
+      firmware::service_log().log(firmware::LogLevel::kWarn,
+                                  "sim: the world's state is not kept (%s)", why);
+      return;
+    }
+  }
+  board->truth_file_.record(board->sim_.physical_state());
+}
+
 bool SimBoard::place_robot(const core::Pose2& mission_pose, char* error, std::size_t error_size) {
   // The mission's frame is the odometry frame of its first run, which started at the world's
   // start pose.
-  const core::Pose2 world = core::compose(world_.start, mission_pose);
-  if (sim_.teleport(world)) return true;
+  const core::Pose2 saved = core::compose(world_.start, mission_pose);
+  firmware::ServiceLog& slog = firmware::service_log();
+  hal::sim::SimWorld::PhysicalState truth;
+  char why[600] = "";
+  const WorldTruthFile::Load loaded =
+      truth_path_[0] == '\0'
+          ? WorldTruthFile::Load::kMissing
+          : WorldTruthFile::load(truth_path_.data(), WorldTruthFile::world_id(world_), truth, why,
+                                 sizeof why);
+  if (loaded == WorldTruthFile::Load::kLoaded && sim_.restore_physical_state(truth)) {
+    // Nobody commands the wheels while no firmware runs: they roll until the ODrives'
+    // watchdog stops them, and the new firmware starts with them at rest.
+    const std::uint64_t give_up_us = sim_.now_us() + 5000000U;
+    while (sim_.now_us() < give_up_us) {
+      const hal::sim::SimWorld::PhysicalState now = sim_.physical_state();
+      if (now.wheel_left_m_s == 0.0F && now.wheel_right_m_s == 0.0F) break;
+      sim_.advance_to(sim_.now_us() + 10000U);
+    }
+    const core::Pose2 here = sim_.true_pose();
+    slog.log(firmware::LogLevel::kInfo,
+             "sim: the robot stands where the world left it (%.3f, %.3f, %.3f); the saved pose is "
+             "%.3f m and %.1f deg from there",
+             static_cast<double>(here.x_m), static_cast<double>(here.y_m),
+             static_cast<double>(here.yaw_rad),
+             static_cast<double>(core::distance_m({here.x_m, here.y_m}, {saved.x_m, saved.y_m})),
+             static_cast<double>(std::fabs(core::wrap_pi(here.yaw_rad - saved.yaw_rad))) *
+                 180.0 / 3.14159265358979323846);
+    record_world(this);
+    return true;
+  }
+  if (loaded == WorldTruthFile::Load::kLoaded) {
+    std::snprintf(why, sizeof why, "%s: its pose collides", truth_path_.data());
+  }
+  // No true state to go by (a state directory from before it was kept, another world's): the
+  // robot is put where the firmware believed it was.
+  slog.log(firmware::LogLevel::kWarn,
+           "sim: no state of the simulated world (%s): the robot is put at the saved pose", why);
+  if (sim_.teleport(saved)) return true;
   std::snprintf(error, error_size, "saved pose (%.2f, %.2f) m in the world collides",
-                static_cast<double>(world.x_m), static_cast<double>(world.y_m));
+                static_cast<double>(saved.x_m), static_cast<double>(saved.y_m));
   return false;
 }
 

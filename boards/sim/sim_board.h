@@ -9,6 +9,7 @@
 
 #include "board_config.h"
 #include "sim_config.h"
+#include "world_truth_file.h"
 #include "firmware/app/board.h"
 #include "hal/hal.h"
 #include "hal/linux/console_port.h"
@@ -53,7 +54,14 @@ class SimBoard final : public firmware::Board,
   bool inject(std::string_view device, std::string_view type, double seconds,
               firmware::TextBufferBase& reply) override;
   void describe_active(firmware::TextBufferBase& out) const override;
+  // A resumed mission: the robot stands where the simulated world's own state file
+  // (`sim-world.truth` in --state DIR, written as the world moves) says the last run left it,
+  // rolling on as the ODrives' watchdog lets it; `mission_pose` is only compared with that. A
+  // state directory without that file (or one of another world) puts the robot at
+  // `mission_pose`, with a warning.
   bool place_robot(const core::Pose2& mission_pose, char* error, std::size_t error_size) override;
+  // The file the world's true state goes to ("" without --state).
+  const char* truth_path() const { return truth_path_.data(); }
   // TruthSource: the simulator's own pose and target (trace, target error).
   core::Pose2 robot_pose() const override { return sim_.true_pose(); }
   core::Pose2 odometry_origin() const override { return sim_.odometry_origin(); }
@@ -116,6 +124,10 @@ class SimBoard final : public firmware::Board,
   hal::sim::WatchdogSim watchdog_;
   hal_linux::ConsolePort console_;
   hal::Hal hal_;
+  static void record_world(void* board);
+  WorldTruthFile truth_file_;
+  std::array<char, 512> truth_path_{};
+  bool truth_failed_ = false;  // the file could not be opened: said once, not tried again
   hal::sim::FaultPlan plan_;
   hal::sim::FaultPlan default_faults_;
   std::array<std::span<const core::Point2>, hal::sim::kMaxColliders> outlines_{};

@@ -125,6 +125,8 @@ Mission::Mission(const MissionContext& c)
 void Mission::start(std::uint64_t now_us) {
   now_us_ = now_us;
   next_trace_us_ = now_us;
+  wheels_wait_since_us_ = 0;
+  last_drive_status_ = DriveStatus::kIdle;
   phase_ = Phase::kStart;
   result_ = Result::kRunning;
   end_reason_.clear();
@@ -299,6 +301,7 @@ void Mission::control(std::uint64_t now_us) {
       const hal::PanTiltState ptu = hal_.pan_tilt.state();
       if (ptu.fault) return hold_for_device("pan-tilt unit fault", hal_.pan_tilt.error(), now_us);
       if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) {
+        if (!resume_from_wheels(now_us)) return;  // the wheel counters are not in yet
         pose_.anchor(state_.pose);  // the odometry as the base reports it once ready
         begin_look(now_us);
       }
@@ -459,10 +462,18 @@ void Mission::control_drive(std::uint64_t now_us) {
     return hold_for_device("base stopped by itself", hal_.base.error(), now_us);
   }
   if (driver_.busy()) {
-    // At least every second while driving: a firmware killed mid-step resumes near here.
-    if (now_us >= next_pose_save_us_) save_pose(now_us);
+    // At least every second while driving, and where the turn ends and the straight begins:
+    // a firmware killed mid-step resumes near here, and from here the wheel counters'
+    // single arc describes what the robot does until it stops.
+    const DriveStatus status = driver_.status();
+    if (now_us >= next_pose_save_us_ ||
+        (status != last_drive_status_ && last_drive_status_ == DriveStatus::kTurning)) {
+      save_pose(now_us);
+    }
+    last_drive_status_ = status;
     return;
   }
+  last_drive_status_ = DriveStatus::kIdle;
   const bool ok = driver_.status() == DriveStatus::kDone;
   const core::Pose2 here = pose_.pose();
   planner_.visited({here.x_m, here.y_m});
@@ -512,6 +523,46 @@ void Mission::control_drive(std::uint64_t now_us) {
 void Mission::take_pose() {
   state_.pose = pose_.pose();
   state_.pose_time_ms = hal_.clock.wall_time_ms();
+  // The wheel counters of the same moment (PoseKeeper reads the same odometry).
+  const hal::Odometry o = hal_.base.odometry();
+  state_.wheels_known = o.wheels_known;
+  state_.wheel_left_m = o.wheel_left_m;
+  state_.wheel_right_m = o.wheel_right_m;
+}
+
+bool Mission::resume_from_wheels(std::uint64_t now_us) {
+  if (!state_.wheels_known) return true;  // a new mission, or a state without the counters
+  const hal::Odometry o = hal_.base.odometry();
+  if (!o.wheels_known) {
+    // The motor controllers report their counters within a few frames of being ready.
+    if (wheels_wait_since_us_ == 0) wheels_wait_since_us_ = now_us != 0 ? now_us : 1;
+    if (now_us - wheels_wait_since_us_ < params_.resume_wheels_wait_us) return false;
+    state_.add_log(state_.cycle, "resumed at the saved pose: the base reports no wheel counters");
+    state_.wheels_known = false;
+    return true;
+  }
+  const double left_m = o.wheel_left_m - state_.wheel_left_m;
+  const double right_m = o.wheel_right_m - state_.wheel_right_m;
+  TextBuffer<MissionLogEntry::kMaxTextBytes + 1> line;
+  if (std::fabs(left_m) > static_cast<double>(params_.resume_max_roll_m) ||
+      std::fabs(right_m) > static_cast<double>(params_.resume_max_roll_m)) {
+    // More than a robot rolls by itself: the controllers restarted (their counters begin
+    // again) or someone pushed it far. The saved pose is all there is.
+    line.appendf("resumed at the saved pose: the wheel counters moved %.2f m and %.2f m since",
+                 left_m, right_m);
+  } else {
+    // What the robot did while no firmware ran (the last step's end, the ODrives' watchdog
+    // stopping it), from the counters the controllers kept.
+    const core::Pose2 moved =
+        core::arc_motion(left_m, right_m, static_cast<double>(config_.track_width_m));
+    state_.pose = core::compose(state_.pose, moved);
+    line.appendf("resumed pose moved on by the wheels: %.3f m, %.1f deg",
+                 static_cast<double>(std::hypot(moved.x_m, moved.y_m)),
+                 static_cast<double>(moved.yaw_rad) * 180.0 / 3.14159265358979323846);
+  }
+  state_.add_log(state_.cycle, line.view());
+  state_.wheels_known = false;  // used: a later anchor (after a hold) keeps the pose
+  return true;
 }
 
 void Mission::save_pose(std::uint64_t now_us) {

@@ -63,6 +63,8 @@ void MissionState::clear() {
   end_reason[0] = '\0';
   pose = {};
   pose_time_ms = 0;
+  wheels_known = false;
+  wheel_left_m = wheel_right_m = 0.0;
   has_goal = false;
   goal = {};
   goal_height_m = 0.0F;
@@ -88,7 +90,11 @@ bool operator==(const MissionState& a, const MissionState& b) {
   if (a.end != b.end || a.end_reason_text() != b.end_reason_text()) return false;
   if (a.cycle != b.cycle || a.seed != b.seed || a.pose.x_m != b.pose.x_m ||
       a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad ||
-      a.pose_time_ms != b.pose_time_ms || a.has_goal != b.has_goal) {
+      a.pose_time_ms != b.pose_time_ms || a.has_goal != b.has_goal ||
+      a.wheels_known != b.wheels_known) {
+    return false;
+  }
+  if (a.wheels_known && (a.wheel_left_m != b.wheel_left_m || a.wheel_right_m != b.wheel_right_m)) {
     return false;
   }
   if (a.has_goal && (a.goal.x_m != b.goal.x_m || a.goal.y_m != b.goal.y_m ||

@@ -137,6 +137,25 @@ bool parse_float(std::string_view text, float& out) {
 }
 
 // Exactly `n` floats separated by single spaces, nothing else.
+// A double as written by "%.17g" (the wheel counters: metres over a card's lifetime).
+bool parse_double(std::string_view text, double& out) {
+  constexpr std::size_t kMax = 40;
+  if (text.empty() || text.size() > kMax) return false;
+  for (const char c : text) {
+    if (!((c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E')) {
+      return false;
+    }
+  }
+  char copy[kMax + 1];
+  std::memcpy(copy, text.data(), text.size());
+  copy[text.size()] = '\0';
+  char* end = nullptr;
+  const double v = std::strtod(copy, &end);
+  if (end != copy + text.size() || !std::isfinite(v)) return false;
+  out = v;
+  return true;
+}
+
 bool parse_floats(std::string_view text, float* out, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     if (!parse_float(next_word(text), out[i])) return false;
@@ -215,6 +234,18 @@ bool decode_body(Reader& r, MissionState& s, std::uint64_t& sequence) {
     }
     s.pose_time_ms = static_cast<std::int64_t>(ms);
   }
+  if (version >= 5) {
+    if (!r.keyed("wheels", v)) return r.fail("bad wheels");
+    if (v == "none") {
+      s.wheels_known = false;
+    } else {
+      s.wheels_known = true;
+      if (!parse_double(next_word(v), s.wheel_left_m) ||
+          !parse_double(next_word(v), s.wheel_right_m) || !v.empty()) {
+        return r.fail("bad wheels");
+      }
+    }
+  }
   if (!r.keyed("goal", v)) return false;
   if (v == "none") {
     s.has_goal = false;
@@ -280,6 +311,11 @@ std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity,
   w.printf("pose %.9g %.9g %.9g\npose_time_ms %lld\n", static_cast<double>(s.pose.x_m),
            static_cast<double>(s.pose.y_m), static_cast<double>(s.pose.yaw_rad),
            static_cast<long long>(s.pose_time_ms < 0 ? 0 : s.pose_time_ms));
+  if (s.wheels_known) {
+    w.printf("wheels %.17g %.17g\n", s.wheel_left_m, s.wheel_right_m);
+  } else {
+    w.printf("wheels none\n");
+  }
   if (s.has_goal) {
     w.printf("goal %.9g %.9g %.9g\n", static_cast<double>(s.goal.x_m),
              static_cast<double>(s.goal.y_m), static_cast<double>(s.goal_height_m));

@@ -323,6 +323,15 @@ void BaseOdriveCan::update_odometry(std::uint64_t now_us) {
   codec::wheels_to_body({axes_[0].encoder.vel_turns_s, axes_[1].encoder.vel_turns_s},
                         config_.geometry, odometry_.v_m_s, odometry_.omega_rad_s);
   odometry_.timestamp_us = now_us;
+  // The ODrives' own position estimates as wheel travel: they keep counting while no
+  // firmware runs (a resumed mission dead-reckons from them).
+  const double per_turn_m =
+      2.0 * 3.14159265358979323846 * static_cast<double>(config_.geometry.wheel_radius_m);
+  odometry_.wheels_known = true;
+  odometry_.wheel_left_m = static_cast<double>(axes_[0].encoder.pos_turns) *
+                           static_cast<double>(config_.geometry.left_direction) * per_turn_m;
+  odometry_.wheel_right_m = static_cast<double>(axes_[1].encoder.pos_turns) *
+                            static_cast<double>(config_.geometry.right_direction) * per_turn_m;
 }
 
 void BaseOdriveCan::update() {

@@ -1,10 +1,12 @@
 // The mission end to end on the sim board: Look-Think-Drive finds the target without touching
 // anything, checked against the world's geometry from the trace, and is deterministic.
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <numbers>
 #include <cstdio>
@@ -20,6 +22,8 @@
 #include "firmware/common/board_config.h"
 #include "firmware/executive/executive.h"
 #include "firmware/app/firmware_main.h"
+#include "firmware/state/persistence.h"
+#include "child_process.h"
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
 #include "mission_runner.h"
@@ -572,3 +576,136 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   std::remove((dir + "/mission.state.b").c_str());
   rmdir(dir.c_str());
 }
+
+// qemu-user cannot be trusted to fork a process it emulates: native only.
+#ifndef BOTICELLI_TESTS_UNDER_EMULATOR
+namespace {
+// A firmware killed (SIGKILL: no handler, no last save) at the first frame after 6 s, with a
+// state saved, in which the robot drives straight at speed, or turns on the spot at speed.
+enum class KillWhile { kDriving, kTurning };
+struct KillPlan {
+  KillWhile when = KillWhile::kDriving;
+  int frames = 0;
+  std::string state_a, state_b;  // nothing to resume before a state was saved
+};
+void kill_in_motion(void* context) {
+  auto* plan = static_cast<KillPlan*>(context);
+  if (++plan->frames < 600) return;
+  if (access(plan->state_a.c_str(), F_OK) != 0 && access(plan->state_b.c_str(), F_OK) != 0) return;
+  const auto s = g_board.sim().physical_state();
+  const float v = 0.5F * (s.wheel_left_m_s + s.wheel_right_m_s);
+  const float spin = 0.5F * (s.wheel_right_m_s - s.wheel_left_m_s);
+  const bool driving = v > 0.25F && std::fabs(spin) < 0.02F;
+  const bool turning = std::fabs(spin) > 0.1F && std::fabs(v) < 0.02F;
+  if ((plan->when == KillWhile::kDriving && driving) ||
+      (plan->when == KillWhile::kTurning && turning)) {
+    ::raise(SIGKILL);
+  }
+}
+
+// Kills a mission in `dir` as planned (in a forked child), then resumes it here for one
+// cycle. The resumed firmware's pose once its base is ready (the trace's estimate, mission
+// frame) against the truth then, and the saved pose against the truth [m, rad].
+struct KilledAndResumed {
+  int child_status = 0;
+  double estimate_off_m = -1.0, estimate_off_rad = -1.0;
+  double saved_off_m = -1.0, saved_off_rad = -1.0;
+  std::string log;
+};
+KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir) {
+  KilledAndResumed out;
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t child = fork();
+  if (child == 0) {
+    static KillPlan plan;
+    plan.when = when;
+    plan.state_a = dir + "/mission.state.a";
+    plan.state_b = dir + "/mission.state.b";
+    static boticelli::firmware::MainHooks hooks;
+    hooks.after_frame = kill_in_motion;
+    hooks.context = &plan;
+    (void)run_mission("thesis_room", "1", 0.0F, &hooks, {"--state", dir.c_str()});
+    _exit(3);  // the mission ended before the kill
+  }
+  out.child_status = boticelli::test::wait_for_child(child, 600000);
+  // The pose the killed firmware last saved (mission frame).
+  static boticelli::firmware::MissionState saved;
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  if (!store.open(dir.c_str(), error, sizeof error) ||
+      store.load(saved, error, sizeof error) != boticelli::firmware::LoadResult::kLoaded) {
+    out.log = error;
+    return out;
+  }
+  const MissionRun resumed = run_mission("thesis_room", "1", 0.0F, nullptr,
+                                         {"--state", dir.c_str(), "--resume", "--max-cycles", "1"});
+  out.log = resumed.trace_text.substr(0, 200) + " | " + resumed.mission_line;
+  // The first row the mission no longer waits for its base in: anchored.
+  std::size_t row = 0;
+  while (row < resumed.trace.size() && std::string(resumed.trace[row].state) == "start") ++row;
+  if (row == resumed.trace.size()) return out;
+  std::istringstream lines(resumed.trace_text);
+  std::string line;
+  for (std::size_t i = 0; i <= row + 1 && std::getline(lines, line);) ++i;  // header + rows
+  std::vector<double> f;
+  std::stringstream fields(line);
+  std::string field;
+  while (std::getline(fields, field, ',')) f.push_back(std::atof(field.c_str()));
+  const boticelli::core::Pose2 start = g_board.world().start;
+  const sim::TraceRow& t = resumed.trace[row];
+  const boticelli::core::Pose2 truth = boticelli::core::compose(
+      boticelli::core::inverse(start), {static_cast<float>(t.x_m), static_cast<float>(t.y_m),
+                                        static_cast<float>(t.yaw_rad)});
+  const double tx = truth.x_m, ty = truth.y_m, tyaw = truth.yaw_rad;
+  out.estimate_off_m = std::hypot(f[10] - tx, f[11] - ty);
+  out.estimate_off_rad = std::fabs(std::remainder(f[12] - tyaw, 2.0 * std::numbers::pi));
+  out.saved_off_m = std::hypot(static_cast<double>(saved.pose.x_m) - tx,
+                               static_cast<double>(saved.pose.y_m) - ty);
+  out.saved_off_rad = std::fabs(
+      std::remainder(static_cast<double>(saved.pose.yaw_rad) - tyaw, 2.0 * std::numbers::pi));
+  return out;
+}
+
+void remove_state_dir(const std::string& dir) {
+  for (const char* name : {"/mission.state.a", "/mission.state.b", "/sim-world.truth"}) {
+    std::remove((dir + name).c_str());
+  }
+  rmdir(dir.c_str());
+}
+}  // namespace
+
+// Killed mid-drive at full speed: the last pose saved is up to a second old, and the wheels
+// roll on until the ODrives' watchdog stops them. The world keeps where the robot truly
+// stands (its own file); the resumed firmware carries its saved pose on by the wheel counters
+// the motor controllers kept, and is within 5 cm and 1° of the truth.
+TEST(MissionResume, KilledMidDriveItResumesWithinFiveCentimetresOfWhereTheRobotStands) {
+  char dir_template[] = "/tmp/boticelli-kill-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const KilledAndResumed r = kill_and_resume(KillWhile::kDriving, dir);
+  remove_state_dir(dir);
+  CHECK_TEXT(WIFSIGNALED(r.child_status) && WTERMSIG(r.child_status) == SIGKILL, r.log.c_str());
+  CHECK_TEXT(r.saved_off_m > 0.05, ("the saved pose alone was off by " +
+                                    std::to_string(r.saved_off_m) + " m")
+                                       .c_str());
+  CHECK_TEXT(r.estimate_off_m >= 0.0 && r.estimate_off_m <= 0.05,
+             (std::to_string(r.estimate_off_m) + " m off: " + r.log).c_str());
+  CHECK_TEXT(r.estimate_off_rad <= 1.0 * std::numbers::pi / 180.0,
+             std::to_string(r.estimate_off_rad).c_str());
+}
+
+// Killed while turning on the spot: the heading the saved pose misses comes back too.
+TEST(MissionResume, KilledMidTurnItResumesWithinOneDegreeOfTheRobotsHeading) {
+  char dir_template[] = "/tmp/boticelli-kill-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const KilledAndResumed r = kill_and_resume(KillWhile::kTurning, dir);
+  remove_state_dir(dir);
+  CHECK_TEXT(WIFSIGNALED(r.child_status) && WTERMSIG(r.child_status) == SIGKILL, r.log.c_str());
+  CHECK_TEXT(r.saved_off_rad > 2.0 * std::numbers::pi / 180.0,
+             ("the saved heading alone was off by " + std::to_string(r.saved_off_rad)).c_str());
+  CHECK_TEXT(r.estimate_off_m >= 0.0 && r.estimate_off_m <= 0.05,
+             (std::to_string(r.estimate_off_m) + " m off: " + r.log).c_str());
+  CHECK_TEXT(r.estimate_off_rad <= 1.0 * std::numbers::pi / 180.0,
+             std::to_string(r.estimate_off_rad).c_str());
+}
+#endif  // BOTICELLI_TESTS_UNDER_EMULATOR

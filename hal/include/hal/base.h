@@ -15,6 +15,13 @@ struct Odometry {
   float v_m_s = 0.0F;        // forward speed
   float omega_rad_s = 0.0F;  // yaw rate
   std::uint64_t timestamp_us = 0;
+  // Each wheel's travel as its motor controller counts it [m], forward positive: counted
+  // since the controller powered up, so it carries on across a restart of the firmware (a
+  // resumed mission dead-reckons the robot's motion while no firmware ran from it). Unknown
+  // until the controller has reported it.
+  bool wheels_known = false;
+  double wheel_left_m = 0.0;
+  double wheel_right_m = 0.0;
 };
 
 enum class BaseHealth : std::uint8_t {

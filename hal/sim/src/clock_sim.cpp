@@ -39,6 +39,7 @@ void ClockSim::sleep_until_us(std::uint64_t deadline_us) {
       world_.advance_to(world_.now_us() + kSlowUs);
     }
   }
+  if (after_advance_ != nullptr) after_advance_(after_advance_context_);
   if (speed_ <= 0.0) return;
   const std::uint64_t now_ns = monotonic_ns();
   const std::uint64_t sim_us = world_.now_us();

@@ -59,6 +59,7 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   base_error_ = "not started";
   base_started_ = false;
   odometry_ = Odometry{};
+  wheel_count_left_m_ = wheel_count_right_m_ = 0.0;
   in_place_turn_ = false;
   turn_scrub_factor_ = 1.0;
   collisions_ = 0;
@@ -232,6 +233,10 @@ void SimWorld::step_base(float dt_s) {
   // What the encoders count (the commanded rims at the odometry's diameters) [m].
   const double el = static_cast<double>(wheel_left_m_s_) * static_cast<double>(dt_s);
   const double er = static_cast<double>(wheel_right_m_s_) * static_cast<double>(dt_s);
+  const double count_left_before = wheel_count_left_m_;
+  const double count_right_before = wheel_count_right_m_;
+  wheel_count_left_m_ += el;
+  wheel_count_right_m_ += er;
   // Each in-place turn slips by its own random share (scrub on the floor).
   const bool turning = el * er < 0.0;
   if (turning && !in_place_turn_) {
@@ -260,6 +265,8 @@ void SimWorld::step_base(float dt_s) {
       last_collision_model_ = model;
       std::snprintf(collision_error_, sizeof collision_error_, "collision with '%s'", model);
       wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
+      wheel_count_left_m_ = count_left_before;  // the wheels did not turn either
+      wheel_count_right_m_ = count_right_before;
       base_stop(collision_error_);
       if (!contact_) ++contacts_;
       contact_ = true;
@@ -291,6 +298,52 @@ void SimWorld::step_base(float dt_s) {
   odometry_.v_m_s = 0.5F * (wheel_left_m_s_ + wheel_right_m_s_);
   odometry_.omega_rad_s = (wheel_right_m_s_ - wheel_left_m_s_) / b.track_width_m;
   odometry_.timestamp_us = now_us_;
+  odometry_.wheels_known = true;
+  odometry_.wheel_left_m = wheel_count_left_m_;
+  odometry_.wheel_right_m = wheel_count_right_m_;
+}
+
+SimWorld::PhysicalState SimWorld::physical_state() const {
+  PhysicalState s;
+  s.x_m = x_m_;
+  s.y_m = y_m_;
+  s.yaw_rad = yaw_rad_;
+  s.wheel_left_m = wheel_count_left_m_;
+  s.wheel_right_m = wheel_count_right_m_;
+  s.wheel_left_m_s = wheel_left_m_s_;
+  s.wheel_right_m_s = wheel_right_m_s_;
+  return s;
+}
+
+bool SimWorld::restore_physical_state(const PhysicalState& state) {
+  if (!std::isfinite(state.x_m) || !std::isfinite(state.y_m) || !std::isfinite(state.yaw_rad) ||
+      !std::isfinite(state.wheel_left_m) || !std::isfinite(state.wheel_right_m) ||
+      !std::isfinite(state.wheel_left_m_s) || !std::isfinite(state.wheel_right_m_s)) {
+    return false;
+  }
+  if (!teleport({static_cast<float>(state.x_m), static_cast<float>(state.y_m),
+                 static_cast<float>(state.yaw_rad)})) {
+    return false;
+  }
+  x_m_ = state.x_m;  // teleport() kept floats: the double pose exactly
+  y_m_ = state.y_m;
+  yaw_rad_ = state.yaw_rad;
+  wheel_count_left_m_ = state.wheel_left_m;
+  wheel_count_right_m_ = state.wheel_right_m;
+  const float limit = params_.base.max_speed_m_s + 0.5F * params_.base.max_turn_rate_rad_s *
+                                                       params_.base.track_width_m;
+  wheel_left_m_s_ = target_left_m_s_ = std::clamp(state.wheel_left_m_s, -limit, limit);
+  wheel_right_m_s_ = target_right_m_s_ = std::clamp(state.wheel_right_m_s, -limit, limit);
+  if (wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F) {
+    // The axes are still in closed loop on the last setpoint; their watchdog ends that.
+    base_health_ = BaseHealth::kReady;
+    base_error_ = "";
+    base_last_update_us_ = now_us_;
+  }
+  odometry_.wheels_known = true;
+  odometry_.wheel_left_m = wheel_count_left_m_;
+  odometry_.wheel_right_m = wheel_count_right_m_;
+  return true;
 }
 
 void SimWorld::base_start() {
@@ -302,6 +355,10 @@ void SimWorld::base_start() {
   odometry_origin_ = true_pose();
   odometry_ = Odometry{};
   odometry_.timestamp_us = now_us_;
+  // The controllers' counters are theirs: a new firmware's base start does not reset them.
+  odometry_.wheels_known = true;
+  odometry_.wheel_left_m = wheel_count_left_m_;
+  odometry_.wheel_right_m = wheel_count_right_m_;
 }
 
 const char* SimWorld::base_fault() const {

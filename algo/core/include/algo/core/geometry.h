@@ -61,4 +61,17 @@ inline Pose2 inverse(const Pose2& a) {
   return {p.x_m, p.y_m, -a.yaw_rad};
 }
 
+// A differential drive's motion when its wheels travelled `left_m` and `right_m` on a track
+// `track_m` wide, as one arc of constant curvature (exact for a straight line, a turn on the
+// spot and any one arc), in the frame of the pose it started from. Heading wrapped to (−π, π].
+inline Pose2 arc_motion(double left_m, double right_m, double track_m) {
+  const double ds = 0.5 * (left_m + right_m);
+  const double dyaw = (right_m - left_m) / track_m;
+  const double half = 0.5 * dyaw;
+  const double chord = std::fabs(half) > 1e-9 ? ds * std::sin(half) / half : ds;
+  const double yaw = std::remainder(dyaw, 2.0 * kPi<double>);
+  return {static_cast<float>(chord * std::cos(half)), static_cast<float>(chord * std::sin(half)),
+          static_cast<float>(yaw <= -kPi<double> ? yaw + 2.0 * kPi<double> : yaw)};
+}
+
 }  // namespace boticelli::core

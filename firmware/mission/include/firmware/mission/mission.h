@@ -197,6 +197,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // (save_pose: a copy into its hand-over buffer, no I/O here with a writer thread).
   void take_pose();
   void save_pose(std::uint64_t now_us);
+  // A resumed mission's pose carried on by the wheel counters the motor controllers kept
+  // while no firmware ran (saved with the pose); false while it waits for them.
+  bool resume_from_wheels(std::uint64_t now_us);
   // A part of the grabbed view's processing (a unit); true when the view is done.
   bool process_view(ViewPart part);
   // The pair aimed at the target's estimate (or its unconfirmed candidate) after the scan.
@@ -246,6 +249,8 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   TextBuffer<160> device_reason_;
   bool gave_up_on_device_ = false;
   std::uint64_t next_pose_save_us_ = 0;  // while driving
+  DriveStatus last_drive_status_ = DriveStatus::kIdle;
+  std::uint64_t wheels_wait_since_us_ = 0;  // waiting for the wheel counters at the start
   TextBuffer<160> end_reason_;           // a copy: a device's reason may change after the end
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;

@@ -46,6 +46,12 @@ struct MissionState {
   // When `pose` was taken, by the board's wall clock [ms since the Unix epoch]; 0: unknown
   // (a board without one, or a state from before version 4). A resumed run says how old it is.
   std::int64_t pose_time_ms = 0;
+  // The motor controllers' wheel counters when `pose` was taken (hal::Odometry, [m]): a
+  // resumed run dead-reckons from them what the robot did while no firmware ran. Unknown in
+  // a state from before version 5, or from a base that does not report them.
+  bool wheels_known = false;
+  double wheel_left_m = 0.0;
+  double wheel_right_m = 0.0;
   bool has_goal = false;
   core::Point2 goal;           // target position once confirmed, mission frame [m]
   float goal_height_m = 0.0F;  // the target's height above the floor [m]

@@ -21,7 +21,7 @@ std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
 //   / crc32 XXXXXXXX (over everything before that line).
 // Versions 1 (a goal without its height), 2 (no sequence, no result) and 3 (no pose time) are
 // still read: their sequence is 0 (before 3), their mission running, their pose's time unknown.
-inline constexpr std::uint32_t kStateFormatVersion = 4;  // 4: the pose's wall-clock time
+inline constexpr std::uint32_t kStateFormatVersion = 5;  // 5: the wheel counters at the pose
 inline constexpr std::size_t kMaxStateFileBytes =
     256 + 40 * (MissionState::kMaxObstaclePoints + MissionState::kMaxExplorationPoints) +
     MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64 + 224;

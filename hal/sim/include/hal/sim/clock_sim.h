@@ -25,6 +25,12 @@ class ClockSim final : public Clock {
   // Simulated seconds per wall second: 1 = real time, 0 = as fast as possible (the default).
   void set_speed(double speed);
   double speed() const { return speed_; }
+  // Called after each sleep has stepped the world (the sim board records the world's state
+  // there); nullptr for none.
+  void set_after_advance(void (*callback)(void* context), void* context) {
+    after_advance_ = callback;
+    after_advance_context_ = context;
+  }
 
  private:
   SimWorld& world_;
@@ -35,6 +41,8 @@ class ClockSim final : public Clock {
   std::uint64_t anchor_sim_us_ = 0;   // simulated time at the anchor
   std::uint64_t anchor_wall_ns_ = 0;  // CLOCK_MONOTONIC at the anchor
   std::int64_t last_wake_latency_ns_ = -1;
+  void (*after_advance_)(void* context) = nullptr;
+  void* after_advance_context_ = nullptr;
 };
 
 }  // namespace boticelli::hal::sim

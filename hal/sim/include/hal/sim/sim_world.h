@@ -113,6 +113,20 @@ class SimWorld {
   // The true pose at which the odometry frame was fixed (the last base start).
   core::Pose2 odometry_origin() const { return odometry_origin_; }
 
+  // ---- the world outliving the firmware (the sim board keeps it in a file of its own) ----
+  // What of the simulated robot a dead firmware leaves behind: where it stands, how fast its
+  // wheels turn, and what the motor controllers' wheel counters read.
+  struct PhysicalState {
+    double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;     // true pose in the world
+    double wheel_left_m = 0.0, wheel_right_m = 0.0;  // the controllers' wheel counters
+    float wheel_left_m_s = 0.0F, wheel_right_m_s = 0.0F;
+  };
+  PhysicalState physical_state() const;
+  // Puts the robot back as a dead firmware left it (before the next one starts its base):
+  // wheels still turning roll on with nobody commanding them, until the ODrives' watchdog
+  // (BaseParams::command_timeout_us) stops them. False, unchanged, when the pose collides.
+  bool restore_physical_state(const PhysicalState& state);
+
   // ---- PTU (driven through PanTiltSim) ----
   PtuAxis& pan() { return pan_; }
   PtuAxis& tilt() { return tilt_; }
@@ -158,6 +172,8 @@ class SimWorld {
   double x_m_ = 0.0, y_m_ = 0.0, yaw_rad_ = 0.0;
   float wheel_left_m_s_ = 0.0F, wheel_right_m_s_ = 0.0F;
   // The in-place turn under way (wheels in opposite directions) and its scrub factor.
+  // The motor controllers' wheel counters (the encoders at the odometry's diameters) [m].
+  double wheel_count_left_m_ = 0.0, wheel_count_right_m_ = 0.0;
   bool in_place_turn_ = false;
   double turn_scrub_factor_ = 1.0;
   float target_left_m_s_ = 0.0F, target_right_m_s_ = 0.0F;

@@ -56,6 +56,11 @@ struct MissionParams {
   // While driving the pose goes to the state writer at least this often, and at the end of
   // every step, so a firmware killed mid-step resumes near where the robot stands [µs].
   std::uint32_t pose_save_period_us = 1000000;
+  // A resumed mission waits this long after the base is ready for its wheel counters [µs],
+  // and believes them up to this much travel of either wheel since the save [m] (beyond: the
+  // motor controllers restarted, or the robot was carried).
+  std::uint32_t resume_wheels_wait_us = 1000000;
+  float resume_max_roll_m = 1.0F;
   std::uint32_t trace_period_us = 100000;  // one trace row per this much time [µs]
   std::uint32_t vi_work_per_unit = 256;    // value-iteration work per background unit
   std::size_t max_failed_cycles = 4;       // cycles in a row with no safe step → not_found
