@@ -150,6 +150,7 @@ bool SimBoard::place_robot(const core::Pose2& mission_pose, char* error, std::si
   firmware::ServiceLog& slog = firmware::service_log();
   hal::sim::SimWorld::PhysicalState truth;
   char why[600] = "";
+  if (truth_path_[0] == '\0') std::snprintf(why, sizeof why, "no --state directory");
   const WorldTruthFile::Load loaded =
       truth_path_[0] == '\0'
           ? WorldTruthFile::Load::kMissing

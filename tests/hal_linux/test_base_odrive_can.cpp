@@ -346,3 +346,30 @@ TEST(BaseOdriveCan, TheLastGaspSendsAZeroVelocityToBothAxesAndNoEstop) {
   CHECK(rig.base->health() == BaseHealth::kReady);
   CHECK_EQUAL(sent, rig.base->sent_frames());  // no counter touched
 }
+
+// The wheel counters are the ODrives' own position estimates as forward wheel travel (the
+// right motor mirrored): they do not restart with the driver, which is what lets a resumed
+// mission dead-reckon across a restart of the firmware.
+TEST(BaseOdriveCan, TheWheelCountersAreTheOdrivesPositionsAsForwardTravelAndOutliveTheDriver) {
+  Rig rig(Rig::emu_config());
+  CHECK_FALSE(rig.base->odometry().wheels_known);
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 100; ++i) rig.cycle();  // 1 s at 0.5 m/s
+  const double per_turn = 2.0 * std::numbers::pi * 0.1;
+  const auto odo = rig.base->odometry();
+  CHECK(odo.wheels_known);
+  DOUBLES_EQUAL(0.5, odo.wheel_left_m, 0.02);
+  DOUBLES_EQUAL(0.5, odo.wheel_right_m, 0.02);
+  DOUBLES_EQUAL(rig.emu.pos_turns(kLeft) * per_turn, odo.wheel_left_m, 0.006);
+  DOUBLES_EQUAL(-rig.emu.pos_turns(kRight) * per_turn, odo.wheel_right_m, 0.006);
+  // Stopped and started again: the counters are still the ODrives' positions.
+  rig.base->stop();
+  rig.cycle();
+  const double left_before = rig.base->odometry().wheel_left_m;
+  CHECK_TRUE(rig.base->resume());
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kReady; }));
+  rig.cycle();
+  DOUBLES_EQUAL(left_before, rig.base->odometry().wheel_left_m, 0.006);
+  DOUBLES_EQUAL(rig.emu.pos_turns(kLeft) * per_turn, rig.base->odometry().wheel_left_m, 1e-6);
+}

@@ -503,6 +503,7 @@ TEST(MissionResume, WhileDrivingThePoseIsSavedAtLeastEverySecond) {
              std::to_string(watch.worst_gap_moving_us).c_str());
   std::remove((watch.dir + "/mission.state.a").c_str());
   std::remove((watch.dir + "/mission.state.b").c_str());
+  std::remove((watch.dir + "/sim-world.truth").c_str());
   rmdir(watch.dir.c_str());
 }
 
@@ -544,11 +545,10 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   const MissionRun second =
       run_mission("thesis_room", "1", 0.0F, nullptr, {"--state", dir.c_str(), "--resume"});
   check_found_safely(second);
-  // Put back where the base came to rest: the true pose when the first run's firmware
-  // returned (the trace keeps 4 decimals). Its last trace row may be a frame older: the last
-  // cycle can end mid-drive, and the base rolls on a few mm while it stops. The board places
-  // the robot at the saved pose, the firmware's estimate (its looks registered): that is
-  // within the estimate's error of the truth, a few cm and tenths of a degree here.
+  // Where the base came to rest: the true pose when the first run's firmware returned (the
+  // trace keeps 4 decimals). Its last trace row may be a frame older: the last cycle can end
+  // mid-drive, and the base rolls on a few mm while it stops. The world's own file keeps
+  // where the robot stands; the firmware's saved pose is not where the board puts it.
   const sim::TraceRow& resumed = second.trace.front();
   const double rest_x = first.final_pose.x_m;
   const double rest_y = first.final_pose.y_m;
@@ -574,6 +574,7 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   CHECK_TEXT(std::atoi(second.mission_line.c_str() + c + 7) > 3, second.mission_line.c_str());
   std::remove((dir + "/mission.state.a").c_str());
   std::remove((dir + "/mission.state.b").c_str());
+  std::remove((dir + "/sim-world.truth").c_str());
   rmdir(dir.c_str());
 }
 

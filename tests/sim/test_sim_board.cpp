@@ -1,5 +1,10 @@
 // Tests of the sim board's wiring: config, world loading, the HAL bag driving one SimWorld.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <cstddef>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -7,6 +12,8 @@
 
 #include "sim_board.h"
 #include "sim_test_worlds.h"
+#include "test_files.h"
+#include "world_truth_file.h"
 
 #include "alloc_guard.h"
 #include "CppUTest/TestHarness.h"
@@ -130,4 +137,120 @@ TEST(SimBoard, APlacedRobotStandsAtTheSavedPoseFromTheWorldsStartAndACollidingOn
   CHECK_FALSE(board->place_robot({-1.2F, 0.0F, 0.0F}, g_error, sizeof g_error));
   CHECK(std::strstr(g_error, "collides") != nullptr);
   DOUBLES_EQUAL(expected.x_m, board->sim().true_pose().x_m, 1e-5);
+}
+
+namespace {
+void remove_truth_dir(const std::string& dir) {
+  std::remove((dir + "/sim-world.truth").c_str());
+  rmdir(dir.c_str());
+}
+}  // namespace
+
+// The world outlives the firmware: a run killed while the robot drives leaves the world's
+// state in its own file; the next run's board puts the robot there (not at the pose the
+// firmware saved), lets it roll until the ODrives' watchdog stops it, and the motor
+// controllers' wheel counters carry on from where they were.
+TEST(SimBoard, ARestartedBoardPutsTheRobotWhereTheWorldLeftItRollingUntilTheWatchdogStopsIt) {
+  const std::string dir = boticelli::test::temp_dir("truth");
+  const std::string path = world_path("thesis_room");
+  boticelli::firmware::Options options;
+  options.world_file = path.c_str();
+  options.state_dir = dir.c_str();
+  board->settings().camera_fps = 1.0F;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  STRCMP_EQUAL((dir + "/sim-world.truth").c_str(), board->truth_path());
+  hal::Hal& h = board->hal();
+  CHECK(h.base.init());
+  const std::uint32_t frame_us = board->config().minor_frame_us;
+  for (int i = 0; i < 300; ++i) {  // 3 s: ready after 50 ms, then 0.2 m/s straight ahead
+    h.base.update();
+    h.base.set_velocity(0.2F, 0.0F);
+    h.clock.sleep_until_us(h.clock.now_us() + frame_us);
+  }
+  const auto left = board->sim().physical_state();  // what the file holds now: "kill -9"
+  CHECK(left.wheel_left_m_s > 0.19F);
+  CHECK(left.wheel_left_m > 0.5);
+  board = std::make_unique<boticelli::boards::sim::SimBoard>();  // the next run
+  board->settings().camera_fps = 1.0F;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  CHECK_EQUAL(0.0, board->sim().physical_state().wheel_left_m);  // before the restore
+  // The firmware believed itself at its start: the board goes by the world's file instead.
+  CHECK_TEXT(board->place_robot({0.0F, 0.0F, 0.0F}, g_error, sizeof g_error), g_error);
+  const auto now = board->sim().physical_state();
+  // Rolled on for the watchdog's 0.2 s at 0.2 m/s, then stopped: 4 cm further, straight on.
+  const double rolled = std::hypot(now.x_m - left.x_m, now.y_m - left.y_m);
+  DOUBLES_EQUAL(0.04, rolled, 0.005);
+  DOUBLES_EQUAL(left.yaw_rad, now.yaw_rad, 1e-6);
+  CHECK_EQUAL(0.0F, now.wheel_left_m_s);
+  CHECK_EQUAL(0.0F, now.wheel_right_m_s);
+  DOUBLES_EQUAL(left.wheel_left_m + rolled, now.wheel_left_m, 1e-4);
+  // A new firmware's base start does not reset the controllers' counters.
+  CHECK(board->hal().base.init());
+  const hal::Odometry o = board->hal().base.odometry();
+  CHECK(o.wheels_known);
+  DOUBLES_EQUAL(now.wheel_right_m, o.wheel_right_m, 0.0);
+  board.reset();
+  remove_truth_dir(dir);
+}
+
+// Without the world's own file (a state directory from before it was kept), or with the file
+// of another world, the robot is put at the saved pose.
+TEST(SimBoard, WithoutTheWorldsFileOrWithAnotherWorldsTheRobotGoesToTheSavedPose) {
+  const std::string dir = boticelli::test::temp_dir("truth");
+  boticelli::firmware::Options options;
+  const std::string other = world_path("corridor");
+  options.world_file = other.c_str();
+  options.state_dir = dir.c_str();
+  board->settings().camera_fps = 1.0F;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  board->hal().clock.sleep_until_us(10000);  // the corridor's state written
+  const std::string path = world_path("thesis_room");
+  options.world_file = path.c_str();
+  for (int run = 0; run < 2; ++run) {
+    board = std::make_unique<boticelli::boards::sim::SimBoard>();
+    board->settings().camera_fps = 1.0F;
+    CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+    if (run == 1) std::remove((dir + "/sim-world.truth").c_str());
+    CHECK_TEXT(board->place_robot({0.5F, 0.2F, 0.3F}, g_error, sizeof g_error), g_error);
+    const boticelli::core::Point2 expected =
+        boticelli::core::to_world(board->world().start, {0.5F, 0.2F});
+    DOUBLES_EQUAL(expected.x_m, board->sim().true_pose().x_m, 1e-5);
+  }
+  board.reset();
+  remove_truth_dir(dir);
+}
+
+// Two slots written in turn: a record torn by the kill (its checksum wrong) leaves the one
+// before it.
+TEST(SimBoard, ATornNewestRecordOfTheWorldsFileFallsBackToTheOneBefore) {
+  using boticelli::boards::sim::WorldTruthFile;
+  const std::string dir = boticelli::test::temp_dir("truth");
+  const std::string file = dir + "/sim-world.truth";
+  WorldTruthFile truth;
+  CHECK_TEXT(truth.open(file.c_str(), 77, g_error, sizeof g_error), g_error);
+  boticelli::hal::sim::SimWorld::PhysicalState a, b, out;
+  a.x_m = 1.25;
+  b.x_m = 2.5;
+  truth.record(a);
+  truth.record(b);
+  CHECK(WorldTruthFile::load(file.c_str(), 77, out, g_error, sizeof g_error) ==
+        WorldTruthFile::Load::kLoaded);
+  DOUBLES_EQUAL(2.5, out.x_m, 0.0);
+  CHECK(WorldTruthFile::load(file.c_str(), 78, out, g_error, sizeof g_error) ==
+        WorldTruthFile::Load::kOtherWorld);
+  truth.close();
+  // b went to slot 0 (sequence 2): flip a byte of its x.
+  const int fd = ::open(file.c_str(), O_RDWR);
+  CHECK(fd >= 0);
+  const off_t at = static_cast<off_t>(offsetof(WorldTruthFile::Layout, slots) +
+                                      offsetof(WorldTruthFile::Slot, values) + 7);
+  unsigned char byte = 0;
+  CHECK(::pread(fd, &byte, 1, at) == 1);
+  byte ^= 0x01U;
+  CHECK(::pwrite(fd, &byte, 1, at) == 1);
+  ::close(fd);
+  CHECK(WorldTruthFile::load(file.c_str(), 77, out, g_error, sizeof g_error) ==
+        WorldTruthFile::Load::kLoaded);
+  DOUBLES_EQUAL(1.25, out.x_m, 0.0);
+  remove_truth_dir(dir);
 }

@@ -117,7 +117,8 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
     }
   }
   for (const char* name :
-       {"plan.txt", "out.txt", "err.txt", "mission.state.a", "mission.state.b"}) {
+       {"plan.txt", "out.txt", "err.txt", "mission.state.a", "mission.state.b",
+        "sim-world.truth"}) {
     ::unlink((std::string(dir) + "/" + name).c_str());
   }
   ::rmdir(dir);

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -48,6 +49,9 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   s.seed = 42;
   s.pose = {0.1F * static_cast<float>(cycle), -0.37F, 0.001F * static_cast<float>(cycle)};
   s.pose_time_ms = cycle % 4 == 0 ? 0 : 1700000000000LL + static_cast<std::int64_t>(cycle);
+  s.wheels_known = cycle % 2 == 1;
+  s.wheel_left_m = 1234.5678901234567 + 0.1 * static_cast<double>(cycle);
+  s.wheel_right_m = -0.1 / 3.0 * static_cast<double>(cycle);
   s.has_goal = cycle % 3 == 0;
   s.goal = {1.0F / 3.0F, 2.5e-7F * static_cast<float>(cycle)};
   s.goal_height_m = 0.01F * static_cast<float>(cycle % 40);
@@ -249,6 +253,39 @@ TEST(Persistence, ReadsAVersionOneFileWhoseGoalHasNoHeight) {
   DOUBLES_EQUAL(1.5, g_b.goal.x_m, 0.0);
   DOUBLES_EQUAL(-2.0, g_b.goal.y_m, 0.0);
   DOUBLES_EQUAL(0.0, g_b.goal_height_m, 0.0);
+}
+
+// The wheel counters at the pose, to the last bit of a double (metres over a base's life),
+// or none; a version 4 file has none and still loads.
+TEST(Persistence, TheWheelCountersRoundTripExactlyAndAVersionFourFileHasNone) {
+  make_state(7, g_a);
+  CHECK(g_a.wheels_known);
+  std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  const char* why = "";
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
+  CHECK(g_b.wheels_known);
+  CHECK(g_a.wheel_left_m == g_b.wheel_left_m);
+  CHECK(g_a.wheel_right_m == g_b.wheel_right_m);
+  g_b.wheel_right_m = std::nextafter(g_b.wheel_right_m, 0.0);
+  CHECK_FALSE(g_a == g_b);  // compared too
+  g_a.wheels_known = false;
+  n = encode_state(g_a, g_file, sizeof g_file);
+  CHECK(std::string(g_file, n).find("\nwheels none\n") != std::string::npos);
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
+  CHECK_FALSE(g_b.wheels_known);
+  const std::string body =
+      "BOTICELLI-STATE 4\nsequence 2\ncycle 3\nseed 1\nresult running\npose 0 0 0\n"
+      "pose_time_ms 0\ngoal none\nobstacles 0\nexploration 0\nmodel 0\n\nlog 0\nend\n";
+  g_b.wheels_known = true;
+  CHECK_TRUE_TEXT(decode_state(with_crc(body), g_b, &why), why);
+  CHECK_FALSE(g_b.wheels_known);
+  // A version 5 file must say; a bad counter is refused.
+  std::string v5 = body;
+  v5.replace(v5.find(" 4\n"), 3, " 5\n");
+  CHECK_FALSE(decode_state(with_crc(v5), g_b, &why));
+  v5.insert(v5.find("goal none"), "wheels 1.5 nan\n");
+  CHECK_FALSE(decode_state(with_crc(v5), g_b, &why));
+  STRCMP_EQUAL("bad wheels", why);
 }
 
 TEST(Persistence, KeepsTheMissionsResultAndTheSequenceNumber) {
