@@ -132,8 +132,8 @@ void SimBoard::record_world(void* context) {
   if (!board->truth_file_.is_open()) {
     if (board->truth_failed_ || board->truth_path_[0] == '\0') return;
     char why[600] = "";
-    if (!board->truth_file_.open(board->truth_path_.data(),
-                                 WorldTruthFile::world_id(board->world_), why, sizeof why)) {
+    if (!board->truth_file_.open(board->truth_path_.data(), WorldTruthFile::world_id(board->world_),
+                                 why, sizeof why)) {
       board->truth_failed_ = true;
       firmware::service_log().log(firmware::LogLevel::kWarn,
                                   "sim: the world's state is not kept (%s)", why);
@@ -172,8 +172,8 @@ bool SimBoard::place_robot(const core::Pose2& mission_pose, char* error, std::si
              static_cast<double>(here.x_m), static_cast<double>(here.y_m),
              static_cast<double>(here.yaw_rad),
              static_cast<double>(core::distance_m({here.x_m, here.y_m}, {saved.x_m, saved.y_m})),
-             static_cast<double>(std::fabs(core::wrap_pi(here.yaw_rad - saved.yaw_rad))) *
-                 180.0 / 3.14159265358979323846);
+             static_cast<double>(std::fabs(core::wrap_pi(here.yaw_rad - saved.yaw_rad))) * 180.0 /
+                 3.14159265358979323846);
     record_world(this);
     return true;
   }

@@ -46,7 +46,8 @@ std::uint64_t WorldTruthFile::world_id(const hal::sim::World& world) {
   std::uint64_t h = fnv(kFnvBasis, &world.start, sizeof world.start);
   for (std::size_t i = 0; i < world.collider_count; ++i) {
     const hal::sim::Collider& c = world.colliders[i];
-    const float shape[4] = {c.centre_x_m, c.centre_y_m, c.radius_m, static_cast<float>(c.hull_size)};
+    const float shape[4] = {c.centre_x_m, c.centre_y_m, c.radius_m,
+                            static_cast<float>(c.hull_size)};
     h = fnv(h, shape, sizeof shape);
     for (std::size_t k = 0; k < c.hull_size; ++k) h = fnv(h, &c.hull[k], sizeof c.hull[k]);
   }

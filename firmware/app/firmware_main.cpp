@@ -2,6 +2,9 @@
 // line.
 #include "firmware/app/firmware_main.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <csignal>
 #include <cstdint>
 #include <optional>
@@ -344,6 +347,19 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   const std::uint64_t start_us = hal.clock.now_us();
   mission.start(start_us);
   console.log(LogLevel::kInfo, "boticelli %s on %s: ready", BOTICELLI_VERSION, info.name);
+  if (options.state_dir != nullptr) {
+    // A package upgrade restarted the firmware (postinst leaves DIR/start-held): held, as by
+    // `pause`, until the operator's `resume`, once. A file that cannot be removed still holds.
+    char held_path[520];
+    std::snprintf(held_path, sizeof held_path, "%s/start-held", options.state_dir);
+    if (::unlink(held_path) == 0 || errno != ENOENT) {
+      executive.set_background_paused(true);
+      slog.log(LogLevel::kWarn, "started held (%s, left by a package upgrade): type resume",
+               held_path);
+      console.log(LogLevel::kWarn, "started held (%s, left by a package upgrade): type resume",
+                  held_path);
+    }
+  }
   // A mission that ended before this start is not carried on: the firmware stays up with the
   // robot stopped (console, status, LED) until it is stopped; with --max-cycles there is
   // nothing to run, so it ends at once.

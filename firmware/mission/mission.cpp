@@ -302,7 +302,7 @@ void Mission::control(std::uint64_t now_us) {
       if (ptu.fault) return hold_for_device("pan-tilt unit fault", hal_.pan_tilt.error(), now_us);
       if (hal_.base.health() == hal::BaseHealth::kReady && !ptu.moving) {
         if (!resume_from_wheels(now_us)) return;  // the wheel counters are not in yet
-        pose_.anchor(state_.pose);  // the odometry as the base reports it once ready
+        pose_.anchor(state_.pose);                // the odometry as the base reports it once ready
         begin_look(now_us);
       }
       return;

@@ -656,8 +656,8 @@ KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir) {
   const boticelli::core::Pose2 start = g_board.world().start;
   const sim::TraceRow& t = resumed.trace[row];
   const boticelli::core::Pose2 truth = boticelli::core::compose(
-      boticelli::core::inverse(start), {static_cast<float>(t.x_m), static_cast<float>(t.y_m),
-                                        static_cast<float>(t.yaw_rad)});
+      boticelli::core::inverse(start),
+      {static_cast<float>(t.x_m), static_cast<float>(t.y_m), static_cast<float>(t.yaw_rad)});
   const double tx = truth.x_m, ty = truth.y_m, tyaw = truth.yaw_rad;
   out.estimate_off_m = std::hypot(f[10] - tx, f[11] - ty);
   out.estimate_off_rad = std::fabs(std::remainder(f[12] - tyaw, 2.0 * std::numbers::pi));
@@ -686,9 +686,8 @@ TEST(MissionResume, KilledMidDriveItResumesWithinFiveCentimetresOfWhereTheRobotS
   const KilledAndResumed r = kill_and_resume(KillWhile::kDriving, dir);
   remove_state_dir(dir);
   CHECK_TEXT(WIFSIGNALED(r.child_status) && WTERMSIG(r.child_status) == SIGKILL, r.log.c_str());
-  CHECK_TEXT(r.saved_off_m > 0.05, ("the saved pose alone was off by " +
-                                    std::to_string(r.saved_off_m) + " m")
-                                       .c_str());
+  CHECK_TEXT(r.saved_off_m > 0.05,
+             ("the saved pose alone was off by " + std::to_string(r.saved_off_m) + " m").c_str());
   CHECK_TEXT(r.estimate_off_m >= 0.0 && r.estimate_off_m <= 0.05,
              (std::to_string(r.estimate_off_m) + " m off: " + r.log).c_str());
   CHECK_TEXT(r.estimate_off_rad <= 1.0 * std::numbers::pi / 180.0,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Checks the .deb's maintainer scripts. postinst never starts or restarts a unit (installing
-# or upgrading must not set the robot driving). Then runs them against a scratch root
+# or upgrading must not set the robot driving) but the firmware held after an upgrade. Then runs them against a scratch root
 # (DPKG_ROOT, with deb-systemd-helper's real bookkeeping): the first installation enables the
 # units, an upgrade keeps an administrator's disable, remove and purge leave nothing enabled.
 #   maintainer_scripts.sh PACKAGING_DIR
@@ -11,9 +11,15 @@ pkg=$1
 # a running systemd its systemd calls are skipped, so running it cannot show one. Comments
 # and quoted text (messages to the operator) are left out; any tool that starts a unit
 # counts, and so does `enable --now`.
+# One start is allowed: the firmware's, after an upgrade, within five lines after a file was
+# written (`: >"$held"`, quotes stripped; the run below checks it is the start-held file that
+# makes the firmware wait for the operator's `resume`).
 starts=$(sed -e 's/#.*//' -e 's/"[^"]*"//g' -e "s/'[^']*'//g" "$pkg/postinst" |
-  grep -nE '(deb-systemd-invoke|systemctl|invoke-rc\.d|service)\b.*(\b(start|restart|try-restart|reload-or-restart|try-reload-or-restart|condrestart)\b|--now)' ||
-  true)
+  awk '/^ *: *> *$/ { held = NR }
+       /(deb-systemd-invoke|systemctl|invoke-rc\.d|service)( |.* )(start|restart|try-restart|reload-or-restart|try-reload-or-restart|condrestart)( |$)|--now/ {
+         if (!($0 ~ /deb-systemd-invoke start boticelli\.service/ && held && NR - held <= 5))
+           print NR ": " $0
+       }' || true)
 if [ -n "$starts" ]; then
   printf '%s\n' "$starts"
   echo "FAIL: postinst starts or restarts a unit: installing or upgrading would set the robot off"
@@ -51,10 +57,18 @@ sh "$pkg/prerm" upgrade 0.1.0
 sh "$pkg/postinst" configure 0.1.0
 enabled boticelli.service && fail "an upgrade re-enabled the service the administrator disabled"
 enabled boticelli-can0.service || fail "an upgrade disabled boticelli-can0.service"
+[ -e "$root/var/lib/boticelli/start-held" ] && fail "an upgrade of a stopped firmware held it"
+
+# An upgrade of a running firmware (prerm left its marker): started again held.
+mkdir -p "$root/run"
+: >"$root/run/boticelli.upgrade-restart"
+sh "$pkg/postinst" configure 0.1.0 2>/dev/null
+[ -e "$root/var/lib/boticelli/start-held" ] || fail "an upgrade of a running firmware did not hold it"
+[ -e "$root/run/boticelli.upgrade-restart" ] && fail "postinst left the upgrade marker"
 
 sh "$pkg/prerm" remove
 sh "$pkg/postrm" remove
 sh "$pkg/postrm" purge
 enabled boticelli-can0.service && fail "purge left boticelli-can0.service enabled"
-echo "maintainer scripts: nothing started, enable on first install, admin's disable kept on" \
-  "upgrade, purge clean"
+echo "maintainer scripts: nothing started but a held firmware after an upgrade, enable on" \
+  "first install, admin's disable kept on upgrade, purge clean"

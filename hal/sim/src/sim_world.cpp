@@ -330,8 +330,8 @@ bool SimWorld::restore_physical_state(const PhysicalState& state) {
   yaw_rad_ = state.yaw_rad;
   wheel_count_left_m_ = state.wheel_left_m;
   wheel_count_right_m_ = state.wheel_right_m;
-  const float limit = params_.base.max_speed_m_s + 0.5F * params_.base.max_turn_rate_rad_s *
-                                                       params_.base.track_width_m;
+  const float limit = params_.base.max_speed_m_s +
+                      0.5F * params_.base.max_turn_rate_rad_s * params_.base.track_width_m;
   wheel_left_m_s_ = target_left_m_s_ = std::clamp(state.wheel_left_m_s, -limit, limit);
   wheel_right_m_s_ = target_right_m_s_ = std::clamp(state.wheel_right_m_s, -limit, limit);
   if (wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F) {

@@ -298,6 +298,31 @@ TEST(FirmwareMain, PrintsTheBoardsReasonWhenItsInitFails) {
   STRCMP_CONTAINS("boticelli: camera: no such device", cam.err.c_str());
 }
 
+// After a package upgrade (postinst leaves DIR/start-held) the firmware starts held, as by
+// `pause`, until the operator's `resume`; the file is used up, the next start is not held.
+TEST(FirmwareMain, AStartHeldFileHoldsTheStartUntilResumeAndIsUsedUp) {
+  const std::string held = dir + "/start-held";
+  FILE* f = std::fopen(held.c_str(), "w");
+  CHECK(f != nullptr);
+  std::fclose(f);
+  std::string console_output;
+  Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.console.feed("status\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  STRCMP_CONTAINS(("started held (" + held + ", left by a package upgrade)").c_str(),
+                  r.err.c_str());
+  STRCMP_CONTAINS("started held", console_output.c_str());
+  STRCMP_CONTAINS("paused=1 waits_for=resume", console_output.c_str());
+  CHECK(access(held.c_str(), F_OK) != 0);
+  r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.console.feed("status\rquit\r");
+    b.after_run = [&](FakeBoard& done) { console_output = done.console.written(); };
+  });
+  CHECK(r.err.find("started held") == std::string::npos);
+  STRCMP_CONTAINS("paused=0", console_output.c_str());
+}
+
 TEST(FirmwareMain, StopsOnTheConsolesQuitCommandAfterAnsweringOnTheConsole) {
   std::string console_output;
   const Run r = run_firmware({}, [&](FakeBoard& b) {

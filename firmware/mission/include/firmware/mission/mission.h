@@ -251,7 +251,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   std::uint64_t next_pose_save_us_ = 0;  // while driving
   DriveStatus last_drive_status_ = DriveStatus::kIdle;
   std::uint64_t wheels_wait_since_us_ = 0;  // waiting for the wheel counters at the start
-  TextBuffer<160> end_reason_;           // a copy: a device's reason may change after the end
+  TextBuffer<160> end_reason_;              // a copy: a device's reason may change after the end
   std::uint64_t now_us_ = 0;
   std::uint64_t cycles_this_run_ = 0;
   std::uint64_t next_trace_us_ = 0;

@@ -117,7 +117,7 @@ class SimWorld {
   // What of the simulated robot a dead firmware leaves behind: where it stands, how fast its
   // wheels turn, and what the motor controllers' wheel counters read.
   struct PhysicalState {
-    double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;     // true pose in the world
+    double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;      // true pose in the world
     double wheel_left_m = 0.0, wheel_right_m = 0.0;  // the controllers' wheel counters
     float wheel_left_m_s = 0.0F, wheel_right_m_s = 0.0F;
   };
