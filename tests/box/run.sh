@@ -430,8 +430,18 @@ frames=$(motion_frames 3)
 version=$(bx dpkg-query -W -f='\${Version}' boticelli)
 if [ "$up_ok" != 1 ]; then
   fail upgrade_does_not_start_motion "the upgrade failed: $(tail -n 3 "$up_log" | tr '\n' ' ')"
-elif { [ "$state" != inactive ] && [ "$state" != failed ]; } || [ "$frames" != 0 ]; then
+elif [ "$frames" != 0 ]; then
   fail upgrade_does_not_start_motion "after the upgrade (was $before): unit $state, $frames motion frames in 3 s"
+elif [ "$before" = active ]; then
+  # A running firmware is started again held (DIR/start-held) until the operator's resume.
+  paused=$(status_field paused || true)
+  if [ "$state" = active ] && [ "$paused" = 1 ]; then
+    pass upgrade_does_not_start_motion "was active, now $version, active and held (paused=1), 0 motion frames in 3 s"
+  else
+    fail upgrade_does_not_start_motion "after the upgrade (was active): unit $state, paused=$paused (expected active and held)"
+  fi
+elif [ "$state" != inactive ] && [ "$state" != failed ]; then
+  fail upgrade_does_not_start_motion "after the upgrade (was $before): unit $state (expected stopped)"
 else
   pass upgrade_does_not_start_motion "was $before, now $version and $state (stopped by prerm), 0 motion frames in 3 s"
 fi

@@ -72,6 +72,19 @@ TEST(ServiceUnit, DoesNotRestartOnTheExitCodesARestartCannotMendButDoesOnAFailur
   STRCMP_EQUAL("on-failure", keys.at("Restart").c_str());
 }
 
+// A stop (systemd's SIGTERM, the console's shutdown) or a mission that ended without the target
+// exits kExitNotFound: a clean end, so the unit is inactive afterwards, not "failed"; a usage
+// or configuration error (kExitUsage) and a failure stay failures.
+TEST(ServiceUnit, AStopOrAnEndedMissionLeavesTheUnitInactiveNotFailed) {
+  const auto keys = service_keys();
+  CHECK_TEXT(keys.count("SuccessExitStatus") == 1, "no SuccessExitStatus");
+  if (keys.count("SuccessExitStatus") == 0) return;
+  const std::string& success = keys.at("SuccessExitStatus");
+  CHECK(has_word(success, boticelli::firmware::kExitNotFound));
+  CHECK_FALSE(has_word(success, boticelli::firmware::kExitUsage));
+  CHECK_FALSE(has_word(success, boticelli::firmware::kExitFailure));
+}
+
 // The fault policy's end (docs/reliability.md): a device given up on after its retry time
 // exits kExitFailure, which the unit restarts; a fault that persists through restarts must end
 // the service, so the start limit must be reachable by such restarts: StartLimitBurst of them
