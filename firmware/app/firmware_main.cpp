@@ -17,6 +17,7 @@
 #include "firmware/app/runtime.h"
 #include "firmware/executive/executive.h"
 #include "firmware/executive/host_timing_text.h"
+#include "firmware/common/journal_forwarder.h"
 #include "firmware/common/log.h"
 #include "firmware/mission/mission.h"
 #include "firmware/telemetry/map_export.h"
@@ -71,6 +72,11 @@ ConfigSchema g_config_keys;
 mission::TraceWriter g_trace;
 SnapshotWriter g_snapshots;
 LogRing g_log_ring;
+JournalForwarder g_journal;
+// Stops the journal's thread on every way out of firmware_main (it writes what is queued).
+struct JournalStop {
+  ~JournalStop() { g_journal.stop(); }
+};
 
 // Everything that is bound to the board's devices, rebuilt in place for each run (static
 // storage, no heap; firmware_main may be called again, e.g. by tests): the runtime, then the
@@ -288,6 +294,9 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   Safety& safety = rt.safety;
   Console& console = *rt.console;
   console.set_log_ring(&g_log_ring, &hal.clock);
+  // With stderr the journal, the console's log lines go there too (a thread writes them).
+  JournalStop journal_stop;
+  if (slog.to_journal() && g_journal.start(STDERR_FILENO)) console.set_journal(&g_journal);
   console.set_board_name(info.name);
   console.set_watchdog_state(watchdog_armed             ? Console::WatchdogState::kArmed
                              : !config.watchdog_enabled ? Console::WatchdogState::kDisabled

@@ -135,6 +135,10 @@ void Console::log(LogLevel level, const char* format, ...) {
   if (keep) {
     ring_->add(clock_ != nullptr ? clock_->now_us() : now_us_, level, text.view().substr(prefix));
   }
+  // Faults at run time reach the journal too, under their level (not only the console).
+  if (journal_ != nullptr && level <= LogLevel::kInfo) {
+    (void)journal_->push(level, text.view().substr(prefix));
+  }
   if (level > log_level_) return;
   if (text.size() > 256 - 3) return;  // never cut a line in the middle of the protocol
   text.append(kEol);

@@ -1,5 +1,6 @@
 // Tests of the serial console: line assembly, parsing with hostile input, every command, telemetry,
 // no allocation.
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 
 #include "fake_clock.h"
 #include "fake_serial_port.h"
+#include "firmware/common/journal_forwarder.h"
 #include "firmware/console/console.h"
 #include "firmware/console/console_line.h"
 #include "firmware/console/console_parser.h"
@@ -242,6 +244,61 @@ TEST(ConsoleParser, ReadsOnlyPlainDecimalNumbers) {
                           "1.5-", "1.2.3", "2e", "3e+", "123456789012345678901234567890123"}) {
     CHECK_FALSE_TEXT(parse_number(bad, v), bad);
   }
+}
+
+namespace {
+// Everything a pipe's read end holds now (non-blocking).
+std::string read_pipe(int fd) {
+  std::string s;
+  char buf[512];
+  ssize_t n = 0;
+  while ((n = ::read(fd, buf, sizeof buf)) > 0) s.append(buf, static_cast<std::size_t>(n));
+  return s;
+}
+}  // namespace
+
+TEST_GROUP(JournalForwarder) {
+  int fds[2] = {-1, -1};
+  void setup() override {
+    CHECK(::pipe(fds) == 0);
+    CHECK(::fcntl(fds[0], F_SETFL, O_NONBLOCK) == 0);
+  }
+  void teardown() override {
+    ::close(fds[0]);
+    ::close(fds[1]);
+  }
+};
+
+// Each line once, with its sd-daemon priority (warn 4, error 3, info 6), one line per entry.
+TEST(JournalForwarder, WritesEachLineOnceWithItsPriorityAndNoNewlineInside) {
+  JournalForwarder journal;
+  CHECK(journal.push(LogLevel::kWarn, "camera: device gone (ENODEV), re-opening"));
+  CHECK(journal.push(LogLevel::kError, "two\nlines"));
+  CHECK(journal.push(LogLevel::kInfo, "back"));
+  CHECK(journal.start(fds[1]));
+  journal.stop();
+  STRCMP_EQUAL("<4>camera: device gone (ENODEV), re-opening\n<3>two lines\n<6>back\n",
+               read_pipe(fds[0]).c_str());
+  CHECK_EQUAL(3U, journal.written());
+  CHECK_FALSE(journal.running());
+}
+
+// The executive's side never waits: a full queue drops the line and counts it, and pushing
+// allocates nothing; what was queued is written in order.
+TEST(JournalForwarder, AFullQueueDropsAndCountsWithoutBlockingOrAllocating) {
+  static JournalForwarder journal;
+  CHECK_NO_ALLOCATION(for (std::size_t i = 0; i < JournalForwarder::kSlots + 3; ++i) {
+    (void)journal.push(LogLevel::kWarn, i < JournalForwarder::kSlots ? "queued" : "dropped");
+  });
+  CHECK_EQUAL(3U, journal.dropped());
+  CHECK_FALSE(journal.push(LogLevel::kWarn, "still full"));
+  CHECK(journal.start(fds[1]));
+  journal.stop();
+  const std::string out = read_pipe(fds[0]);
+  CHECK_EQUAL(JournalForwarder::kSlots,
+              static_cast<std::size_t>(std::count(out.begin(), out.end(), '\n')));
+  CHECK(out.find("dropped") == std::string::npos);
+  CHECK(journal.push(LogLevel::kWarn, "room again"));
 }
 
 TEST_GROUP(Console) {
@@ -635,6 +692,25 @@ TEST(Console, RedrawsAHalfTypedLineAfterTelemetryWhenEchoIsOn) {
   port.feed("tus\r");
   service(1);
   STRCMP_CONTAINS("tus\r\nstatus state=look", port.written().c_str());
+}
+
+// The console's log lines of info and above reach the journal under their level (faults at
+// run time are not only on the console); debug lines do not.
+TEST(Console, LogLinesOfInfoAndAboveGoToTheJournalUnderTheirLevel) {
+  static JournalForwarder journal;
+  int fds[2];
+  CHECK(::pipe(fds) == 0);
+  CHECK(::fcntl(fds[0], F_SETFL, O_NONBLOCK) == 0);
+  console.set_journal(&journal);
+  console.log(LogLevel::kWarn, "PTU: no reply for %.1f s", 0.5);
+  console.log(LogLevel::kInfo, "devices back");
+  console.log(LogLevel::kDebug, "not for the journal");
+  CHECK(journal.start(fds[1]));
+  journal.stop();
+  STRCMP_EQUAL("<4>PTU: no reply for 0.5 s\n<6>devices back\n", read_pipe(fds[0]).c_str());
+  ::close(fds[0]);
+  ::close(fds[1]);
+  console.set_journal(nullptr);
 }
 
 TEST(Console, ShowsTheLastLogLinesFromItsRing) {

@@ -11,6 +11,7 @@
 #include "firmware/console/console_parser.h"
 #include "firmware/executive/executive.h"
 #include "firmware/console/fault_injection.h"
+#include "firmware/common/journal_forwarder.h"
 #include "firmware/common/log.h"
 #include "firmware/telemetry/mission_view.h"
 #include "firmware/common/parameters.h"
@@ -43,6 +44,9 @@ class Console {
     ring_ = ring;
     clock_ = clock;
   }
+  // Where the log lines of info and above go besides the ring: the journal (the firmware
+  // sets one when stderr is the journal), or nullptr. At init.
+  void set_journal(JournalForwarder* journal) { journal_ = journal; }
   void set_board_name(const char* name) { board_name_ = name; }
   // The hardware watchdog's state, which `status` shows (`watchdog=`). At init.
   enum class WatchdogState : std::uint8_t {
@@ -145,6 +149,7 @@ class Console {
 
   std::string_view model_pending_;  // rest of a `model` reply still to be queued
   LogRing* ring_ = nullptr;
+  JournalForwarder* journal_ = nullptr;
   hal::Clock* clock_ = nullptr;
   const char* board_name_ = "?";
   WatchdogState watchdog_state_ = WatchdogState::kUnavailable;
