@@ -70,6 +70,8 @@ void MissionState::clear() {
   goal_height_m = 0.0F;
   obstacles.clear();
   exploration.clear();
+  grid_cell_m = 0.0F;
+  grid.clear();
   model_bytes = 0;
   log.clear();
   log_dropped = 0;
@@ -103,6 +105,13 @@ bool operator==(const MissionState& a, const MissionState& b) {
   }
   if (!same_points(a.obstacles, b.obstacles) || !same_points(a.exploration, b.exploration)) {
     return false;
+  }
+  if (a.grid_cell_m != b.grid_cell_m || a.grid.size() != b.grid.size()) return false;
+  for (std::size_t i = 0; i < a.grid.size(); ++i) {
+    if (a.grid[i].tx != b.grid[i].tx || a.grid[i].ty != b.grid[i].ty ||
+        a.grid[i].cells != b.grid[i].cells) {
+      return false;
+    }
   }
   if (a.model_text() != b.model_text() || a.log.size() != b.log.size()) return false;
   for (std::size_t i = 0; i < a.log.size(); ++i) {

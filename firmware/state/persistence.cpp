@@ -180,6 +180,54 @@ bool read_points(Reader& r, const char* name, std::size_t capacity,
   return true;
 }
 
+int hex_digit(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  return -1;
+}
+
+// "grid CELL_M N" and N tiles "TX TY HEX" (version 5).
+bool read_grid(Reader& r, MissionState& s) {
+  std::string_view v;
+  if (!r.keyed("grid", v)) return r.fail("bad grid");
+  float cell_m = 0.0F;
+  std::uint64_t n = 0;
+  if (!parse_float(next_word(v), cell_m) || !(cell_m >= 0.0F) || !parse_u64(next_word(v), n) ||
+      !v.empty()) {
+    return r.fail("bad grid");
+  }
+  if (n > worldmap::kMaxTiles) return r.fail("more grid tiles than the capacity");
+  s.grid_cell_m = cell_m;
+  s.grid.clear();
+  constexpr std::size_t kCells = worldmap::kTileCells * worldmap::kTileCells;
+  for (std::uint64_t i = 0; i < n; ++i) {
+    std::string_view l;
+    if (!r.line(l)) return false;
+    std::uint64_t tx = 0;
+    std::uint64_t ty = 0;
+    if (!parse_u64(next_word(l), tx) || !parse_u64(next_word(l), ty) ||
+        tx >= worldmap::kDirectoryTiles || ty >= worldmap::kDirectoryTiles ||
+        l.size() != 2 * kCells) {
+      return r.fail("bad grid tile");
+    }
+    worldmap::SavedTile t;
+    t.tx = static_cast<std::int16_t>(tx);
+    t.ty = static_cast<std::int16_t>(ty);
+    for (std::size_t k = 0; k < kCells; ++k) {
+      const int hi = hex_digit(l[2 * k]);
+      const int lo = hex_digit(l[2 * k + 1]);
+      if (hi < 0 || lo < 0) return r.fail("bad grid tile");
+      const auto byte = static_cast<std::uint8_t>(hi * 16 + lo);
+      t.cells[k] = static_cast<std::int8_t>(byte);
+      if (t.cells[k] > worldmap::kMaxLogOdds || t.cells[k] < -worldmap::kMaxLogOdds) {
+        return r.fail("bad grid tile");
+      }
+    }
+    (void)s.grid.push_back(t);
+  }
+  return true;
+}
+
 // The first line (and from version 3 the second): version and sequence number.
 bool decode_header(Reader& r, std::uint64_t& version, std::uint64_t& sequence) {
   std::string_view l;
@@ -260,6 +308,7 @@ bool decode_body(Reader& r, MissionState& s, std::uint64_t& sequence) {
   if (!read_points(r, "exploration", MissionState::kMaxExplorationPoints, s.exploration)) {
     return false;
   }
+  if (version >= 5 && !read_grid(r, s)) return false;
   std::uint64_t model_bytes = 0;
   if (!r.keyed("model", v) || !parse_u64(v, model_bytes)) return r.fail("bad model size");
   if (model_bytes > MissionState::kMaxModelBytes) return r.fail("model larger than the capacity");
@@ -324,6 +373,19 @@ std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity,
   }
   write_points(w, "obstacles", s.obstacles);
   write_points(w, "exploration", s.exploration);
+  w.printf("grid %.9g %zu\n", static_cast<double>(s.grid_cell_m), s.grid.size());
+  for (const worldmap::SavedTile& t : s.grid) {
+    char line[16 + 2 * worldmap::kTileCells * worldmap::kTileCells + 2];
+    int n = std::snprintf(line, sizeof line, "%d %d ", t.tx, t.ty);
+    static constexpr char kHex[] = "0123456789abcdef";
+    for (const std::int8_t c : t.cells) {
+      const auto byte = static_cast<std::uint8_t>(c);
+      line[n++] = kHex[byte >> 4U];
+      line[n++] = kHex[byte & 0x0FU];
+    }
+    line[n++] = '\n';
+    w.bytes({line, static_cast<std::size_t>(n)});
+  }
   w.printf("model %zu\n", s.model_bytes);
   w.bytes(s.model_text());
   w.bytes("\n");

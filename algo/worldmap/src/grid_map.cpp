@@ -64,6 +64,40 @@ bool GridMap::add(Cell c, int delta) {
   return true;
 }
 
+std::size_t GridMap::save_tiles(SavedTile* out, std::size_t capacity) const {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < directory_.size(); ++i) {
+    const std::int16_t t = directory_[i];
+    if (t == kNoTile) continue;
+    if (n < capacity) {
+      SavedTile& s = out[n];
+      s.tx = static_cast<std::int16_t>(i % kDirectoryTiles);
+      s.ty = static_cast<std::int16_t>(i / kDirectoryTiles);
+      s.cells = tiles_[static_cast<std::size_t>(t)];
+    }
+    ++n;
+  }
+  return n;
+}
+
+bool GridMap::restore_tile(const SavedTile& tile) {
+  if (tile.tx < 0 || tile.tx >= kDirectoryTiles || tile.ty < 0 || tile.ty >= kDirectoryTiles) {
+    return false;
+  }
+  std::int16_t& t = directory_[static_cast<std::size_t>(tile.ty) * kDirectoryTiles +
+                               static_cast<std::size_t>(tile.tx)];
+  if (t != kNoTile || tiles_used_ >= params_.max_tiles) return false;
+  t = static_cast<std::int16_t>(tiles_used_++);
+  Tile& cells = tiles_[static_cast<std::size_t>(t)];
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    cells[i] = static_cast<std::int8_t>(std::clamp<int>(tile.cells[i], -kMaxLogOdds, kMaxLogOdds));
+    const CellState state = state_of(cells[i]);
+    free_cells_ += state == CellState::kFree ? 1U : 0U;
+    occupied_cells_ += state == CellState::kOccupied ? 1U : 0U;
+  }
+  return true;
+}
+
 bool GridMap::segment_blocked(core::Point2 a, core::Point2 b) const {
   const float length = core::distance_m(a, b);
   const int samples = static_cast<int>(std::ceil(length / (0.5F * params_.cell_m)));

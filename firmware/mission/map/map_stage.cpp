@@ -12,6 +12,10 @@ void MapStage::start(const MissionState& state, const worldmap::GridMapParams& g
   has_prior_look_ = false;  // a resumed mission's first look has none
   for (const core::Point2& p : state.obstacles) (void)map_.obstacles().push_back(p);
   for (const core::Point2& p : state.exploration) (void)map_.exploration().push_back(p);
+  // A resumed mission's world memory, when it was kept at this cell side.
+  if (state.grid_cell_m == grid.cell_m) {
+    for (const worldmap::SavedTile& t : state.grid) (void)grid_.restore_tile(t);
+  }
 }
 
 void MapStage::begin(const mapping::LocalModelParams& params, const LookReadings& readings,
@@ -85,6 +89,10 @@ void MapStage::save(MissionState& state) const {
   for (const core::Point2& p : map_.exploration()) {
     if (!state.exploration.push_back(p)) break;
   }
+  // The grid's tiles in use, into the state's fixed storage.
+  state.grid_cell_m = grid_.cell_m();
+  const std::size_t n = state.grid.resize(grid_.tiles_used());
+  (void)grid_.save_tiles(state.grid.data(), n);
 }
 
 }  // namespace boticelli::firmware::mission

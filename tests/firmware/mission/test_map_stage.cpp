@@ -72,13 +72,42 @@ TEST(MapStage, StartTakesTheGlobalListsFromTheStateAndSaveGivesThemBack) {
   CHECK_EQUAL(1U, stage->global().exploration().size());
   DOUBLES_EQUAL(1.5, stage->global().obstacles()[1].x_m, 0.0);
   DOUBLES_EQUAL(-3.0, stage->global().exploration()[0].x_m, 0.0);
-  MissionState saved;
+  static MissionState saved;
+  saved.clear();
   (void)saved.obstacles.push_back({9.0F, 9.0F});  // whatever it held before goes
   stage->save(saved);
   CHECK_EQUAL(2U, saved.obstacles.size());
   CHECK_EQUAL(1U, saved.exploration.size());
   DOUBLES_EQUAL(1.0, saved.obstacles[0].x_m, 0.0);
   DOUBLES_EQUAL(0.5, saved.exploration[0].y_m, 0.0);
+}
+
+// The world memory survives a restart: the grid's tiles go into the state and a resumed
+// mission's grid holds them again, cell for cell; a grid kept at another cell side is not
+// restored (its cells would mean other places).
+TEST(MapStage, TheGridGoesIntoTheStateAndAResumedMissionHasItBack) {
+  stage->start(*state, {});
+  CHECK(stage->swept({0.0F, 0.0F}, {1.0F, 0.0F}, 0.2F));  // a move: free cells along it
+  look_at({5.0F, 5.0F, 0.0F}, nullptr);
+  stage->begin_grid({5.0F, 5.0F, 0.0F}, {});
+  while (!stage->grid_done()) stage->grid_unit();
+  CHECK(stage->grid().tiles_used() > 0);
+  const auto cell = stage->grid().cell_of({0.1F, -0.05F});
+  const int before = stage->grid().log_odds(cell);
+  CHECK(before < 0);
+  stage->save(*state);
+  CHECK_EQUAL(stage->grid().tiles_used(), state->grid.size());
+  DOUBLES_EQUAL(stage->grid().cell_m(), state->grid_cell_m, 0.0);
+  auto resumed = std::make_unique<MapStage>();
+  resumed->start(*state, {});
+  CHECK_EQUAL(stage->grid().tiles_used(), resumed->grid().tiles_used());
+  CHECK_EQUAL(stage->grid().free_cells(), resumed->grid().free_cells());
+  CHECK_EQUAL(stage->grid().occupied_cells(), resumed->grid().occupied_cells());
+  CHECK_EQUAL(before, resumed->grid().log_odds(cell));
+  boticelli::worldmap::GridMapParams coarser;
+  coarser.cell_m = 0.1F;
+  resumed->start(*state, coarser);
+  CHECK_EQUAL(0U, resumed->grid().tiles_used());
 }
 
 TEST(MapStage, ARestartedMissionHoldsOnlyTheListsOfItsState) {

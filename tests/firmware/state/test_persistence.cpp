@@ -17,6 +17,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <tuple>
 
 #include "firmware/state/mission_state.h"
 #include "firmware/state/persistence.h"
@@ -49,6 +50,16 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   s.seed = 42;
   s.pose = {0.1F * static_cast<float>(cycle), -0.37F, 0.001F * static_cast<float>(cycle)};
   s.pose_time_ms = cycle % 4 == 0 ? 0 : 1700000000000LL + static_cast<std::int64_t>(cycle);
+  s.grid_cell_m = 0.05F;
+  for (std::size_t i = 0; i < cycle % 9; ++i) {
+    boticelli::worldmap::SavedTile t;
+    t.tx = static_cast<std::int16_t>(i * 7 % 64);
+    t.ty = static_cast<std::int16_t>(63 - i);
+    for (std::size_t k = 0; k < t.cells.size(); ++k) {
+      t.cells[k] = static_cast<std::int8_t>(static_cast<int>((k * 13 + cycle) % 121) - 60);
+    }
+    (void)s.grid.push_back(t);
+  }
   s.wheels_known = cycle % 2 == 1;
   s.wheel_left_m = 1234.5678901234567 + 0.1 * static_cast<double>(cycle);
   s.wheel_right_m = -0.1 / 3.0 * static_cast<double>(cycle);
@@ -135,6 +146,17 @@ TEST(Persistence, HoldsAStateFilledToEveryCapacity) {
   CHECK_FALSE(g_a.set_model(std::string_view("ab\0cd", 5)));
   CHECK_EQUAL(MissionState::kMaxModelBytes, g_a.model_text().size());
   CHECK_EQUAL('M', g_a.model_text().front());
+  g_a.grid_cell_m = 0.05F;
+  while (g_a.grid.size() < g_a.grid.capacity()) {
+    boticelli::worldmap::SavedTile t;
+    t.tx = static_cast<std::int16_t>(g_a.grid.size() % 64);
+    t.ty = static_cast<std::int16_t>(g_a.grid.size() / 64);
+    t.cells.fill(-60);  // the longest hex: every byte "c4"
+    (void)g_a.grid.push_back(t);
+  }
+  g_a.wheels_known = true;
+  g_a.wheel_left_m = -1.2345678901234567e300;
+  g_a.wheel_right_m = 2.2250738585072014e-308;
   for (int i = 0; i < 500; ++i) g_a.add_log(static_cast<std::uint64_t>(i), std::string(200, '~'));
   CHECK_EQUAL(MissionState::kMaxLogEntries, g_a.log.size());
   CHECK_EQUAL(499U, g_a.log.back().cycle);
@@ -286,6 +308,37 @@ TEST(Persistence, TheWheelCountersRoundTripExactlyAndAVersionFourFileHasNone) {
   v5.insert(v5.find("goal none"), "wheels 1.5 nan\n");
   CHECK_FALSE(decode_state(with_crc(v5), g_b, &why));
   STRCMP_EQUAL("bad wheels", why);
+}
+
+// The grid's tiles round trip exactly; a tile with a bad place, a short or non-hex line, or a
+// log-odds beyond the grid's clamp is refused.
+TEST(Persistence, TheGridsTilesRoundTripAndABadTileIsRefused) {
+  make_state(8, g_a);
+  CHECK_EQUAL(8U, g_a.grid.size());
+  std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  const char* why = "";
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
+  CHECK_EQUAL(8U, g_b.grid.size());
+  CHECK(g_a.grid[7].cells == g_b.grid[7].cells);
+  CHECK_EQUAL(g_a.grid[7].ty, g_b.grid[7].ty);
+  g_b.grid[3].cells[100] = static_cast<std::int8_t>(g_b.grid[3].cells[100] + 1);
+  CHECK_FALSE(g_a == g_b);                 // compared cell by cell
+  const std::string good(g_file, n - 15);  // without its crc line
+  const std::size_t at = good.find("\ngrid ");
+  CHECK(at != std::string::npos);
+  const std::size_t tile = good.find('\n', at + 1) + 1;  // the first tile's line
+  const std::size_t hex = good.find(' ', good.find(' ', tile) + 1) + 1;
+  for (const auto& [from, len, to] :
+       std::initializer_list<std::tuple<std::size_t, std::size_t, std::string>>{
+           {tile, hex - tile, "64 0 "},  // outside the directory
+           {hex, 2, "7f"},               // a log-odds of 127
+           {hex, 2, "zz"},               // not hex
+           {hex, 2, ""}}) {              // a cell short
+    std::string bad = good;
+    bad.replace(from, len, to);
+    CHECK_FALSE_TEXT(decode_state(with_crc(bad), g_b, &why), to.c_str());
+    STRCMP_EQUAL("bad grid tile", why);
+  }
 }
 
 TEST(Persistence, KeepsTheMissionsResultAndTheSequenceNumber) {

@@ -25,6 +25,14 @@ inline bool operator==(Cell a, Cell b) {
   return a.ix == b.ix && a.iy == b.iy;
 }
 
+// One tile in use as a saved state holds it: its place in the directory (tiles from the grid's
+// south-west corner) and its cells' log-odds, rows south to north.
+struct SavedTile {
+  std::int16_t tx = 0;
+  std::int16_t ty = 0;
+  std::array<std::int8_t, kTileCells * kTileCells> cells{};
+};
+
 // What a cell is, from its log-odds (GridMapParams' thresholds).
 enum class CellState : std::uint8_t { kUnknown, kFree, kOccupied };
 
@@ -78,6 +86,13 @@ class GridMap {
   // The smallest cell box holding every tile in use (false when no tile is): what a picture
   // or an export of the map needs to cover. `lo` inclusive, `hi` exclusive.
   bool tile_bounds(Cell& lo, Cell& hi) const;
+  // Every tile in use, in directory order (south-west first), into `out` while it has room;
+  // returns how many there are (more than were written when `out` is too small).
+  std::size_t save_tiles(SavedTile* out, std::size_t capacity) const;
+  // Puts a saved tile back (a resumed mission's grid): false, nothing changed, when its place
+  // is outside the directory, already has a tile, or the pool is full; a log-odds beyond
+  // ±kMaxLogOdds is clamped.
+  bool restore_tile(const SavedTile& tile);
   // The map's memory: the tiles in use and the directory [bytes].
   [[nodiscard]] std::size_t bytes() const {
     return tiles_used_ * sizeof(Tile) + sizeof(directory_);

@@ -10,6 +10,7 @@
 #include "algo/core/fixed_vector.h"
 #include "algo/core/geometry.h"
 #include "algo/mapping/map_points.h"
+#include "algo/worldmap/grid_map.h"
 
 namespace boticelli::firmware {
 
@@ -57,7 +58,11 @@ struct MissionState {
   float goal_height_m = 0.0F;  // the target's height above the floor [m]
   core::FixedVector<core::Point2, kMaxObstaclePoints> obstacles;  // global obstacle list [m]
   core::FixedVector<core::Point2, kMaxExplorationPoints>
-      exploration;                           // global exploration list [m]
+      exploration;  // global exploration list [m]
+  // The world memory (worldmap::GridMap): its cell side [m] and every tile in use, so a
+  // resumed mission knows what it has seen (a grid of another cell side is not restored).
+  float grid_cell_m = 0.0F;
+  core::FixedVector<worldmap::SavedTile, worldmap::kMaxTiles> grid;
   std::array<char, kMaxModelBytes> model{};  // the last occupancy ALN, text format (opaque here)
   std::size_t model_bytes = 0;
   core::FixedVector<MissionLogEntry, kMaxLogEntries> log;  // oldest first

@@ -15,16 +15,19 @@ namespace boticelli::firmware {
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
 
 // Format (docs/console.md "State directory"):
-//   BOTICELLI-STATE 4 / sequence N / cycle N / seed N / result running|found|not_found|aborted
-//   [REASON] / pose X Y YAW / pose_time_ms MS / goal none|goal X Y H / obstacles N + N lines "X Y"
-//   / exploration N + N lines / model BYTES + the bytes + "\n" / log N + N lines "CYCLE TEXT" / end
-//   / crc32 XXXXXXXX (over everything before that line).
-// Versions 1 (a goal without its height), 2 (no sequence, no result) and 3 (no pose time) are
-// still read: their sequence is 0 (before 3), their mission running, their pose's time unknown.
-inline constexpr std::uint32_t kStateFormatVersion = 5;  // 5: the wheel counters at the pose
+//   BOTICELLI-STATE 5 / sequence N / cycle N / seed N / result running|found|not_found|aborted
+//   [REASON] / pose X Y YAW / pose_time_ms MS / wheels none|wheels L R / goal none|goal X Y H
+//   / obstacles N + N lines "X Y" / exploration N + N lines / grid CELL_M N + N lines "TX TY HEX"
+//   (a tile's 256 log-odds, two hex digits each, rows south to north) / model BYTES + the bytes
+//   + "\n" / log N + N lines "CYCLE TEXT" / end / crc32 XXXXXXXX (over everything before it).
+// Versions 1 (a goal without its height), 2 (no sequence, no result), 3 (no pose time) and 4
+// (no wheels, no grid) are still read: their sequence is 0 (before 3), their mission running,
+// their pose's time unknown, no wheel counters, no grid.
+inline constexpr std::uint32_t kStateFormatVersion = 5;  // 5: the wheel counters, the grid
 inline constexpr std::size_t kMaxStateFileBytes =
     256 + 40 * (MissionState::kMaxObstaclePoints + MissionState::kMaxExplorationPoints) +
-    MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64 + 224;
+    MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64 + 224 + 32 +
+    worldmap::kMaxTiles * (16 + 2 * worldmap::kTileCells * worldmap::kTileCells);
 
 // Writes the file's bytes into `out`; returns their count, 0 when `capacity` is too small.
 // `sequence` numbers the saves of a state directory (StateStore: the newest copy wins).
