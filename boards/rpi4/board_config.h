@@ -21,6 +21,8 @@ struct Rpi4Devices {
   std::uint8_t odrive_left_node_id = 0;
   std::uint8_t odrive_right_node_id = 1;
   float odrive_max_wheel_turns_s = 8.0F;
+  // A requested stop brakes in closed loop and idles the axes at rest, or after this [ms].
+  std::uint32_t odrive_brake_timeout_ms = 500;
   // GPIO on the 40-pin header (gpiochip0 = the BCM2711's lines, numbered as BCM GPIOs).
   firmware::DeviceName gpio_chip = {"gpiochip0"};
   std::uint32_t estop_line = 17;   // pin 11: e-stop switch to GND, normally closed
@@ -48,6 +50,7 @@ inline bool add_device_config_keys(firmware::ConfigSchema& s, Rpi4Devices& d) {
          s.add(ConfigKey::whole("base", "right_node_id", d.odrive_right_node_id, 0, 63)) &&
          s.add(ConfigKey::number("base", "max_wheel_turns_s", d.odrive_max_wheel_turns_s, 0.1,
                                  50.0)) &&
+         s.add(ConfigKey::whole("base", "brake_timeout_ms", d.odrive_brake_timeout_ms, 50, 5000)) &&
          s.add(ConfigKey::interface_name("gpio", "chip", d.gpio_chip)) &&
          s.add(ConfigKey::whole("gpio", "estop_line", d.estop_line, 0, 57)) &&
          s.add(ConfigKey::flag_key("gpio", "estop_active_low", d.estop_active_low)) &&

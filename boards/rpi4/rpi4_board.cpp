@@ -17,6 +17,7 @@ hal_linux::BaseOdriveCanConfig base_config(const firmware::BoardConfig& c, const
   b.geometry.wheel_radius_m = c.wheel_radius_m;
   b.geometry.track_width_m = c.track_width_m;
   b.max_wheel_turns_s = d.odrive_max_wheel_turns_s;
+  b.brake_timeout_ms = d.odrive_brake_timeout_ms;
   return b;
 }
 

@@ -171,6 +171,8 @@ bool BaseOdriveCan::interface_usable() {
 void BaseOdriveCan::begin_startup(std::uint64_t now_us) {
   health_ = hal::BaseHealth::kStarting;
   error_[0] = '\0';
+  braking_ = false;
+  idled_by_request_ = false;
   setpoint_turns_s_ = {};
   for (Axis& a : axes_) {
     a.heartbeat_seen = false;
@@ -209,24 +211,75 @@ void BaseOdriveCan::send(const odrive::CanFrame& f) {
   }
 }
 
-void BaseOdriveCan::fault(const char* what, const char* side, std::uint32_t value) {
+void BaseOdriveCan::fault(const char* what, const char* side, std::uint32_t value, StopKind kind) {
   if (side != nullptr) {
     std::snprintf(error_, sizeof error_, "base: %s axis: %s (0x%08x)", side, what,
                   static_cast<unsigned>(value));
   } else {
     std::snprintf(error_, sizeof error_, "base: %s", what);
   }
-  if (health_ != hal::BaseHealth::kStopped) {
+  const std::uint64_t now = clock_.now_us();
+  if (health_ == hal::BaseHealth::kReady && kind == StopKind::kBrake) {
+    // Stop category 1: setpoint 0 in closed loop, the velocity controllers brake; the axes
+    // are idled once the wheels are at rest (update_braking()).
+    braking_ = true;
+    idled_by_request_ = false;
+    brake_deadline_us_ = now + std::uint64_t{config_.brake_timeout_ms} * 1000U;
+    for (const Axis& a : axes_) send(odrive::encode_set_input_vel(a.node_id, 0.0F));
+  } else if (health_ != hal::BaseHealth::kStopped || braking_) {
+    // Braking cannot work (an axis out of closed loop or out of reach): idle both at once,
+    // also a brake under way.
+    braking_ = false;
+    idled_by_request_ = false;
     for (const Axis& a : axes_) {
       send(odrive::encode_set_input_vel(a.node_id, 0.0F));
       send(odrive::encode_estop(a.node_id));
     }
   }
   health_ = hal::BaseHealth::kStopped;
-  next_stop_send_us_ = clock_.now_us() + std::uint64_t{config_.stop_resend_ms} * 1000U;
+  next_stop_send_us_ = now + std::uint64_t{config_.stop_resend_ms} * 1000U;
   setpoint_turns_s_ = {};
   odometry_.v_m_s = 0.0F;
   odometry_.omega_rad_s = 0.0F;
+}
+
+void BaseOdriveCan::send_stop_frames() {
+  for (const Axis& a : axes_) {
+    send(odrive::encode_set_input_vel(a.node_id, 0.0F));
+    send(idled_by_request_ ? odrive::encode_set_axis_state(a.node_id, odrive::AxisState::kIdle)
+                           : odrive::encode_estop(a.node_id));
+  }
+}
+
+// A controlled stop under way: setpoint 0 on every call (it also feeds the ODrives' own
+// watchdog), IDLE once both measured wheel speeds are at rest or the brake time is over. An
+// axis that stops answering or reports an error while braking is idled at once (Estop).
+void BaseOdriveCan::update_braking(std::uint64_t now_us) {
+  for (int k = 0; k < 2; ++k) {
+    const Axis& a = axes_[k];
+    if (now_us - a.last_heartbeat_us > std::uint64_t{config_.heartbeat_timeout_ms} * 1000U) {
+      fault("heartbeat lost while braking", kSide[k], 0);
+      return;
+    }
+    if (a.heartbeat.axis_error != 0) {
+      fault("ODrive reports an axis error while braking", kSide[k], a.heartbeat.axis_error);
+      return;
+    }
+  }
+  bool at_rest = encoders_current(now_us);
+  for (const Axis& a : axes_) {
+    at_rest = at_rest && std::fabs(a.encoder.vel_turns_s) < config_.standstill_turns_s;
+  }
+  if (at_rest || now_us >= brake_deadline_us_) {
+    braking_ = false;
+    idled_by_request_ = true;
+    for (const Axis& a : axes_) {
+      send(odrive::encode_set_axis_state(a.node_id, odrive::AxisState::kIdle));
+    }
+    next_stop_send_us_ = now_us + std::uint64_t{config_.stop_resend_ms} * 1000U;
+    return;
+  }
+  for (const Axis& a : axes_) send(odrive::encode_set_input_vel(a.node_id, 0.0F));
 }
 
 void BaseOdriveCan::handle_error_frame(std::uint32_t can_id, const std::uint8_t* data) {
@@ -374,13 +427,14 @@ void BaseOdriveCan::update() {
     }
   }
   if (health_ == hal::BaseHealth::kStopped) {
+    if (braking_) {
+      update_braking(now);
+      return;
+    }
     // Keep commanding the stop: one that was refused (link down, full TX queue) or lost
     // gets through later, and an ODrive that came back on its own is stopped again.
     if (now >= next_stop_send_us_) {
-      for (const Axis& a : axes_) {
-        send(odrive::encode_set_input_vel(a.node_id, 0.0F));
-        send(odrive::encode_estop(a.node_id));
-      }
+      send_stop_frames();
       next_stop_send_us_ = now + std::uint64_t{config_.stop_resend_ms} * 1000U;
     }
     return;
@@ -391,7 +445,10 @@ void BaseOdriveCan::update() {
     const Axis& a = axes_[k];
     const std::uint64_t encoder_since = a.encoder_seen ? a.last_encoder_us : ready_since_us_;
     if (now - encoder_since > encoder_limit_us) {
-      fault("encoder estimates stopped", kSide[k], 0);
+      // The ODrive's own loop runs on its own encoder, which the CAN stream's silence does not
+      // say is gone (a failed encoder is an axis error): brake, for the brake time (no
+      // measurement to see the rest by).
+      fault("encoder estimates stopped", kSide[k], 0, StopKind::kBrake);
       return;
     }
     if (now - a.last_heartbeat_us > std::uint64_t{config_.heartbeat_timeout_ms} * 1000U) {
@@ -433,11 +490,12 @@ void BaseOdriveCan::set_velocity(float v_m_s, float omega_rad_s) {
 
 void BaseOdriveCan::stop() {
   if (health_ == hal::BaseHealth::kStopped) {
-    // Already stopped (maybe by a fault): still tell the axes, the link may be back.
-    for (const Axis& a : axes_) send(odrive::encode_estop(a.node_id));
+    // Already stopped (maybe by a fault): still tell the axes, the link may be back. A brake
+    // under way goes on.
+    if (!braking_) send_stop_frames();
     return;
   }
-  fault("stopped by request");
+  fault("stopped by request", nullptr, 0, StopKind::kBrake);
 }
 
 bool BaseOdriveCan::resume() {

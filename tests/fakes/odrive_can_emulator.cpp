@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 
@@ -94,7 +95,8 @@ void OdriveCanEmulator::send_heartbeat(AxisSim& a) {
 void OdriveCanEmulator::send_encoder(AxisSim& a) {
   odrive::EncoderEstimates e;
   e.pos_turns = static_cast<float>(a.pos);
-  e.vel_turns_s = a.state == 8 ? a.vel_setpoint : 0.0F;
+  const bool perfect = (a.state == 8 ? config_.accel_turns_s2 : config_.coast_turns_s2) <= 0.0F;
+  e.vel_turns_s = perfect ? (a.state == 8 ? a.vel_setpoint : 0.0F) : a.vel;
   send_frame(odrive::encode_encoder_estimates(a.node, e));
 }
 
@@ -117,6 +119,8 @@ void OdriveCanEmulator::handle(const odrive::CanFrame& f, std::uint64_t now_us) 
     return;
   }
   ++a->counts[static_cast<std::size_t>(m.command)];
+  log_.push_back(
+      {a->node, m.command, m.input_vel_turns_s, m.requested_state, {axes_[0].vel, axes_[1].vel}});
   switch (m.command) {
     case odrive::Command::kEstop:
       a->error |= kErrorEstopRequested;
@@ -163,7 +167,19 @@ void OdriveCanEmulator::service(std::uint64_t now_us) {
   const double dt_s = static_cast<double>(now_us - last_us_) * 1e-6;
   last_us_ = now_us;
   for (AxisSim& a : axes_) {
-    if (a.state == 8) a.pos += static_cast<double>(a.vel_setpoint) * dt_s;
+    const float v0 = a.vel;
+    const bool closed = a.state == 8;
+    const float target = closed ? a.vel_setpoint : 0.0F;
+    const float rate = closed ? config_.accel_turns_s2 : config_.coast_turns_s2;
+    if (rate <= 0.0F) {
+      a.vel = target;
+    } else {
+      const float dv = rate * static_cast<float>(dt_s);
+      a.vel += std::clamp(target - a.vel, -dv, dv);
+    }
+    // Exact for a perfect controller; trapezoidal while the speed changes.
+    a.pos +=
+        (rate <= 0.0F ? static_cast<double>(a.vel) : 0.5 * static_cast<double>(v0 + a.vel)) * dt_s;
   }
   for (;;) {
     can_frame frame{};

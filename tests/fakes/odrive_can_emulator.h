@@ -15,6 +15,10 @@ struct OdriveCanEmulatorConfig {
   std::uint64_t encoder_period_us = 10000;     // cyclic Get_Encoder_Estimates (0 = only on RTR)
   std::uint64_t closed_loop_delay_us = 50000;  // time from Set_Axis_State to closed loop
   std::uint64_t watchdog_timeout_us = 0;       // ODrive axis watchdog (0 = disabled)
+  // The wheel's speed follows the setpoint at this rate in closed loop, and slows at
+  // coast_turns_s2 when idle (0: at once, a perfect velocity controller) [turns/s²].
+  float accel_turns_s2 = 0.0F;
+  float coast_turns_s2 = 0.0F;
 };
 
 // service(now) reads what the driver sent, integrates each axis's position from its velocity
@@ -56,6 +60,17 @@ class OdriveCanEmulator {
   std::uint8_t axis_state(int axis) const { return axes_[axis].state; }
   std::uint32_t axis_error(int axis) const { return axes_[axis].error; }
   float vel_setpoint(int axis) const { return axes_[axis].vel_setpoint; }
+  float velocity(int axis) const { return axes_[axis].vel; }  // the wheel's measured speed
+  // Every frame the driver sent, in order (node, command), since the last clear_log().
+  struct Sent {
+    std::uint8_t node;
+    codec::odrive::Command command;
+    float input_vel;      // Set_Input_Vel's setpoint
+    std::uint32_t state;  // Set_Axis_State's requested state
+    float wheel_vel[2];   // both wheels' speed when it came
+  };
+  const std::vector<Sent>& log() const { return log_; }
+  void clear_log() { log_.clear(); }
   double pos_turns(int axis) const { return axes_[axis].pos; }
   std::uint32_t control_mode(int axis) const { return axes_[axis].control_mode; }
   std::uint32_t input_mode(int axis) const { return axes_[axis].input_mode; }
@@ -71,6 +86,7 @@ class OdriveCanEmulator {
     std::uint32_t control_mode = 0;
     std::uint32_t input_mode = 0;
     float vel_setpoint = 0.0F;
+    float vel = 0.0F;
     double pos = 0.0;
     bool silent = false;
     bool encoder_silent = false;
@@ -92,6 +108,7 @@ class OdriveCanEmulator {
   std::uint64_t last_us_ = 0;
   bool have_time_ = false;
   std::uint32_t undecodable_ = 0;
+  std::vector<Sent> log_;
 };
 
 }  // namespace boticelli::fakes

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "fake_clock.h"
 #include "hal/linux/base_odrive_can.h"
@@ -212,13 +213,142 @@ TEST(BaseOdriveCan, StopIsImmediateAndResumeRunsTheStartUpAgain) {
   rig.base->stop();
   CHECK(rig.base->health() == BaseHealth::kStopped);
   rig.cycle();
-  CHECK_EQUAL(1U, rig.emu.estops(kLeft));
-  CHECK_EQUAL(1U, rig.emu.estops(kRight));
+  rig.cycle();
+  // The perfect emulated controller is at rest at once (its next estimate says so): the
+  // brake ends, the axes idle.
+  CHECK_FALSE(rig.base->braking());
+  CHECK_EQUAL(0U, rig.emu.estops(kLeft));
   CHECK_EQUAL(1, rig.emu.axis_state(kLeft));  // the ODrive disarmed
+  CHECK_EQUAL(1, rig.emu.axis_state(kRight));
   CHECK_TRUE(rig.base->resume());
   CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kReady; }));
-  CHECK_EQUAL(0U, rig.emu.axis_error(kLeft));      // Clear_Errors cleared the estop error
+  CHECK_EQUAL(0U, rig.emu.axis_error(kLeft));
   CHECK_EQUAL(0.0F, rig.emu.vel_setpoint(kLeft));  // the old setpoint was not kept
+}
+
+namespace {
+
+// An ODrive whose velocity controller brakes at 4 turns/s² and whose idle wheel coasts at
+// 0.5 turns/s².
+OdriveCanEmulatorConfig braking_emu(float accel_turns_s2 = 4.0F) {
+  OdriveCanEmulatorConfig ec = Rig::emu_config();
+  ec.accel_turns_s2 = accel_turns_s2;
+  ec.coast_turns_s2 = 0.5F;
+  return ec;
+}
+
+// Index of the first frame of `command` in the log (to `state` for Set_Axis_State), or −1.
+int first(const std::vector<OdriveCanEmulator::Sent>& log, od::Command command,
+          std::uint32_t state = 0) {
+  for (std::size_t i = 0; i < log.size(); ++i) {
+    if (log[i].command == command &&
+        (command != od::Command::kSetAxisState || log[i].state == state)) {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(BaseOdriveCan, ARequestedStopBrakesInClosedLoopAndIdlesTheAxesOnlyAtStandstill) {
+  Rig rig(braking_emu());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);  // 0.80 turns/s each wheel
+  for (int i = 0; i < 50; ++i) rig.cycle();
+  DOUBLES_EQUAL(0.796, rig.emu.velocity(kLeft), 0.01);
+  rig.emu.clear_log();
+  rig.base->stop();
+  CHECK(rig.base->health() == BaseHealth::kStopped);  // no motion commanded from now on
+  CHECK_TRUE(rig.base->braking());
+  const std::uint64_t t0 = rig.clock.peek_us();
+  CHECK_TRUE(rig.run_until([&] { return !rig.base->braking(); }, 100));
+  const std::uint64_t braked_us = rig.clock.peek_us() - t0;
+  rig.cycle();
+  const auto& log = rig.emu.log();
+  // Set_Input_Vel(0) to both axes first, in the stop() call itself.
+  CHECK(log.size() >= 2U);
+  CHECK(log[0].command == od::Command::kSetInputVel && log[0].input_vel == 0.0F);
+  CHECK(log[1].command == od::Command::kSetInputVel && log[1].input_vel == 0.0F);
+  CHECK(log[0].node != log[1].node);
+  // Idle only once both wheels were at rest; until then only zero setpoints (no Estop).
+  const int idle = first(log, od::Command::kSetAxisState, 1);
+  CHECK(idle > 2);
+  CHECK(std::fabs(log[static_cast<std::size_t>(idle)].wheel_vel[0]) < 0.05F);
+  CHECK(std::fabs(log[static_cast<std::size_t>(idle)].wheel_vel[1]) < 0.05F);
+  for (int i = 0; i < idle; ++i) {
+    CHECK(log[static_cast<std::size_t>(i)].command == od::Command::kSetInputVel);
+    CHECK_EQUAL(0.0F, log[static_cast<std::size_t>(i)].input_vel);
+  }
+  CHECK_EQUAL(-1, first(log, od::Command::kEstop));
+  // 0.8 turns/s at 4 turns/s²: 0.2 s of braking, well inside the 0.5 s brake time.
+  CHECK(braked_us >= 190000U && braked_us <= 260000U);
+  CHECK_EQUAL(1, rig.emu.axis_state(kLeft));
+  CHECK_EQUAL(1, rig.emu.axis_state(kRight));
+  CHECK_EQUAL(0U, rig.emu.axis_error(kLeft));  // a requested stop is no error
+  STRCMP_CONTAINS("stopped by request", rig.base->error());
+  // While stopped, the idle state is repeated (not an Estop).
+  for (int i = 0; i < 30; ++i) rig.cycle();
+  CHECK_EQUAL(0U, rig.emu.estops(kLeft));
+  CHECK_TRUE(rig.base->resume());
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kReady; }));
+}
+
+TEST(BaseOdriveCan, ABrakeThatTakesTooLongIdlesTheAxesAtTheBrakeTimeout) {
+  Rig rig(braking_emu(0.5F));  // 0.8 turns/s at 0.5 turns/s²: 1.6 s to rest
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 300; ++i) rig.cycle();
+  rig.emu.clear_log();
+  rig.base->stop();
+  const std::uint64_t t0 = rig.clock.peek_us();
+  CHECK_TRUE(rig.run_until([&] { return !rig.base->braking(); }, 100));
+  const std::uint64_t braked_us = rig.clock.peek_us() - t0;
+  CHECK(braked_us >= 500000U && braked_us <= 520000U);  // brake_timeout_ms
+  rig.cycle();
+  const int idle = first(rig.emu.log(), od::Command::kSetAxisState, 1);
+  CHECK(idle > 0);
+  CHECK(rig.emu.log()[static_cast<std::size_t>(idle)].wheel_vel[0] > 0.3F);  // still turning
+  CHECK_EQUAL(1, rig.emu.axis_state(kLeft));
+}
+
+TEST(BaseOdriveCan, AnAxisErrorCannotBrakeAndIdlesBothAxesAtOnceWithEstop) {
+  Rig rig(braking_emu());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 50; ++i) rig.cycle();
+  rig.emu.clear_log();
+  rig.emu.set_axis_error(kLeft, 0x40);  // the left axis is out of closed loop
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }, 30));
+  CHECK_FALSE(rig.base->braking());
+  rig.cycle();
+  const auto& log = rig.emu.log();
+  const int estop = first(log, od::Command::kEstop);
+  CHECK(estop > 0);
+  // In the same update: Set_Input_Vel(0) then Estop to each axis, the right wheel still
+  // turning (no waiting for rest), and no braked idle.
+  const auto e = static_cast<std::size_t>(estop);
+  CHECK(log[e - 1].command == od::Command::kSetInputVel && log[e - 1].input_vel == 0.0F);
+  CHECK(log[e + 1].command == od::Command::kSetInputVel &&
+        log[e + 2].command == od::Command::kEstop);
+  CHECK(log[e].node != log[e + 2].node);
+  CHECK(std::fabs(log[e].wheel_vel[kRight]) > 0.7F);
+  CHECK_EQUAL(-1, first(log, od::Command::kSetAxisState, 1));
+  CHECK_EQUAL(1, rig.emu.axis_state(kRight));
+}
+
+TEST(BaseOdriveCan, AHeartbeatLostWhileBrakingTurnsTheBrakeIntoAnEstop) {
+  Rig rig(braking_emu(0.5F));
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 300; ++i) rig.cycle();
+  rig.base->stop();
+  rig.emu.silence_heartbeats(kRight, true);
+  CHECK_TRUE(rig.run_until([&] { return !rig.base->braking(); }, 100));
+  STRCMP_CONTAINS("right axis: heartbeat lost while braking", rig.base->error());
+  rig.cycle();
+  CHECK(rig.emu.estops(kLeft) >= 1U);
+  CHECK(rig.emu.estops(kRight) >= 1U);
 }
 
 TEST(BaseOdriveCan, AStartUpWithoutOdrivesTimesOut) {
@@ -309,6 +439,11 @@ TEST(BaseOdriveCan, TheCyclicCallsDoNotAllocate) {
   }
   CHECK(rig.base->health() == BaseHealth::kReady);
   CHECK_NO_ALLOCATION(rig.base->stop());
+  for (int i = 0; i < 10; ++i) {  // the brake's updates
+    CHECK_NO_ALLOCATION(rig.base->update());
+    rig.emu.service(rig.clock.peek_us());
+    rig.clock.advance_us(10000);
+  }
 }
 
 TEST(BaseOdriveCan, AWheelWhoseEncoderStreamStopsStopsTheBaseInsteadOfTurningTheOdometry) {

@@ -230,8 +230,16 @@ TEST(KernelCanLink, AnInterfaceDeletedAndAddedAgainIsOpenedAnewByResume) {
 // "(seconds) vcan0 ID#HEXDATA" or "ID#R" for a remote request), checked against the table
 // of docs/protocols.md: standard ids node<<5|cmd of nodes 0 and 1, the documented commands
 // with their lengths, and start-up's order (Clear_Errors and Set_Controller_Mode velocity /
-// passthrough before the first Set_Axis_State of that node).
+// passthrough before the first Set_Axis_State of that node), and the ODrives' watchdog kept
+// fed: while a node is driven (its heartbeat reports closed loop after a Set_Axis_State(8),
+// until an Estop, a Set_Axis_State(1) or a heartbeat without closed loop), no two
+// Set_Input_Vel frames to it are further apart than kMaxSetpointGapS, half the 0.2 s
+// `watchdog_timeout` docs/flashing.md sets on the ODrives.
 TEST_GROUP(KernelCanRecord){};
+
+namespace {
+constexpr double kMaxSetpointGapS = 0.1;
+}  // namespace
 
 TEST(KernelCanRecord, EveryFrameOnTheBusIsADocumentedCanSimpleFrame) {
   const char* path = std::getenv("CAN_LOG") != nullptr ? std::getenv("CAN_LOG") : "/tmp/can.log";
@@ -244,6 +252,11 @@ TEST(KernelCanRecord, EveryFrameOnTheBusIsADocumentedCanSimpleFrame) {
   bool clear_seen[2] = {false, false};
   bool mode_seen[2] = {false, false};
   bool state_seen[2] = {false, false};
+  bool closed_loop_asked[2] = {false, false};
+  bool driven[2] = {false, false};
+  double last_setpoint_s[2] = {-1.0, -1.0};
+  double worst_gap_s = 0.0;
+  int gaps_checked = 0;
   while (std::fgets(line, sizeof line, f) != nullptr) {
     char ifname[16];
     char frame[64];
@@ -263,18 +276,28 @@ TEST(KernelCanRecord, EveryFrameOnTheBusIsADocumentedCanSimpleFrame) {
     const bool remote = data[0] == 'R';
     const std::size_t dlc = remote ? 0U : std::strlen(data) / 2;
     switch (cmd) {
-      case 0x01:  // Heartbeat
+      case 0x01: {  // Heartbeat: u32 axis error, u8 axis state, ...
         CHECK_EQUAL_TEXT(8U, dlc, line);
         ++heartbeats;
+        const bool closed_loop = std::strncmp(data + 8, "08", 2) == 0;
+        if (!closed_loop) {
+          driven[node] = false;
+        } else if (closed_loop_asked[node]) {
+          driven[node] = true;
+        }
         break;
+      }
       case 0x02:  // Estop
         CHECK_EQUAL_TEXT(0U, dlc, line);
+        driven[node] = closed_loop_asked[node] = false;
         break;
       case 0x07:  // Set_Axis_State: u32 8 (closed loop) or 1 (idle)
         CHECK_EQUAL_TEXT(4U, dlc, line);
         CHECK_TEXT(std::strcmp(data, "08000000") == 0 || std::strcmp(data, "01000000") == 0, line);
         CHECK_TEXT(clear_seen[node] && mode_seen[node], line);
         state_seen[node] = true;
+        closed_loop_asked[node] = std::strcmp(data, "08000000") == 0;
+        if (!closed_loop_asked[node]) driven[node] = false;
         break;
       case 0x09:  // Get_Encoder_Estimates: the ODrive's 8 bytes or the host's request
         CHECK_TEXT(remote || dlc == 8U, line);
@@ -286,6 +309,13 @@ TEST(KernelCanRecord, EveryFrameOnTheBusIsADocumentedCanSimpleFrame) {
       case 0x0D:  // Set_Input_Vel: f32 velocity, f32 torque feed-forward
         CHECK_EQUAL_TEXT(8U, dlc, line);
         ++set_input_vel;
+        if (driven[node] && last_setpoint_s[node] >= 0.0) {
+          const double gap = t - last_setpoint_s[node];
+          ++gaps_checked;
+          if (gap > worst_gap_s) worst_gap_s = gap;
+          CHECK_TEXT(gap <= kMaxSetpointGapS, line);
+        }
+        last_setpoint_s[node] = driven[node] ? t : -1.0;
         break;
       case 0x18:  // Clear_Errors: identify byte 0
         STRCMP_EQUAL_TEXT("00", data, line);
@@ -296,10 +326,13 @@ TEST(KernelCanRecord, EveryFrameOnTheBusIsADocumentedCanSimpleFrame) {
     }
   }
   std::fclose(f);
-  std::printf("\ncandump: %d frames checked (%d heartbeats, %d Set_Input_Vel)\n", frames,
-              heartbeats, set_input_vel);
+  std::printf(
+      "\ncandump: %d frames checked (%d heartbeats, %d Set_Input_Vel; %d setpoint gaps of a "
+      "driven axis, the longest %.1f ms)\n",
+      frames, heartbeats, set_input_vel, gaps_checked, worst_gap_s * 1e3);
   CHECK(frames > 500);
   CHECK(heartbeats > 50);
   CHECK(set_input_vel > 200);
+  CHECK(gaps_checked > 100);
   CHECK_TRUE(state_seen[0] && state_seen[1]);
 }

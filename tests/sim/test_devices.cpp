@@ -153,6 +153,69 @@ TEST(SimDevices, TheBaseDrivesStraightAndTurnsByTheCommandedAmountInSimulatedTim
   CHECK_EQUAL(0U, g_sim.collisions());
 }
 
+TEST(SimDevices, AStopBrakesTheWheelsToRestWithinTheBrakingDistanceAndThenIdlesTheAxes) {
+  start("rectangular_room");
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  make_ready(base, clock);
+  base.set_velocity(0.3F, 0.0F);
+  clock.sleep_until_us(clock.now_us() + 1000000);
+  const double x0 = static_cast<double>(g_sim.true_pose().x_m);
+  base.stop();
+  CHECK(base.health() == BaseHealth::kStopped);  // commands nothing from now on
+  CHECK_TRUE(g_sim.base_braking());
+  const double t = run_until(
+      clock, [&] { return g_sim.wheel_speed_m_s() == 0.0F; }, 2.0, 1000);
+  // 0.3 m/s at the 1 m/s² brake: 0.3 s and v²/2a = 0.045 m.
+  DOUBLES_EQUAL(0.3, t, 0.002);
+  DOUBLES_EQUAL(0.045, static_cast<double>(g_sim.true_pose().x_m) - x0, 0.001);
+  clock.sleep_until_us(clock.now_us() + 1000);
+  CHECK_FALSE(g_sim.base_braking());
+  CHECK_TRUE(g_sim.base_axes_idle());
+  CHECK(base.resume());
+  CHECK_FALSE(g_sim.base_axes_idle());
+}
+
+TEST(SimDevices, AnAxisFaultIdlesTheAxesAndTheWheelsCoastFartherThanABrakedStop) {
+  start("rectangular_room");
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  make_ready(base, clock);
+  base.set_velocity(0.3F, 0.0F);
+  clock.sleep_until_us(clock.now_us() + 1000000);
+  const double x0 = static_cast<double>(g_sim.true_pose().x_m);
+  CHECK(g_sim.faults().inject(FaultDevice::kAxisLeft, FaultType::kOff, clock.now_us(), 0));
+  base.update();
+  CHECK(base.health() == BaseHealth::kStopped);
+  CHECK_FALSE(g_sim.base_braking());
+  CHECK_TRUE(g_sim.base_axes_idle());
+  const double t = run_until(
+      clock, [&] { return g_sim.wheel_speed_m_s() == 0.0F; }, 3.0, 1000);
+  // Coasting on rolling friction (0.2 m/s²): 1.5 s and v²/2a = 0.225 m.
+  DOUBLES_EQUAL(1.5, t, 0.002);
+  DOUBLES_EQUAL(0.225, static_cast<double>(g_sim.true_pose().x_m) - x0, 0.001);
+}
+
+TEST(SimDevices, TheOdrivesWatchdogIdlesTheAxesAndTheWheelsCoast) {
+  SimParams params;
+  params.base.command_timeout_us = 200000;
+  start("rectangular_room", params);
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  make_ready(base, clock);
+  base.set_velocity(0.3F, 0.0F);
+  for (int i = 0; i < 100; ++i) {
+    clock.sleep_until_us(clock.now_us() + 10000);
+    base.update();
+  }
+  const double x0 = static_cast<double>(g_sim.true_pose().x_m);
+  // No setpoint from now on: 0.2 s at 0.3 m/s, then 0.225 m coasting.
+  CHECK(run_until(
+            clock, [&] { return g_sim.wheel_speed_m_s() == 0.0F; }, 3.0, 1000) > 0.0);
+  STRCMP_CONTAINS("0x00000800", base.error());
+  DOUBLES_EQUAL(0.06 + 0.225, static_cast<double>(g_sim.true_pose().x_m) - x0, 0.002);
+}
+
 TEST(SimDevices, DrivingIntoThePartitionStopsTheBaseCountsOneCollisionAndClosesTheBumper) {
   start("thesis_room");
   BaseSim base(g_sim);

@@ -78,11 +78,13 @@ TEST_GROUP(Faults) {
     char summary[512];
     std::snprintf(
         summary, sizeof summary,
-        "%s %s: moving_before=%d stop_latency_ms=%.1f stayed_stopped=%d "
+        "%s %s: moving_before=%d stop_latency_ms=%.1f stop_time_ms=%.0f stop_distance_m=%.4f "
+        "(bound %.4f) stayed_stopped=%d "
         "held_until_reset=%d held_until_resume=%d moving_after=%d says_expected=%d "
         "healthy_after=%d collisions=%u state_loadable=%d\n--- console ---\n",
         boticelli::hal::sim::fault_device_name(device), boticelli::hal::sim::fault_type_name(type),
-        g_result.moving_before ? 1 : 0, g_result.stop_latency_ms, g_result.stayed_stopped ? 1 : 0,
+        g_result.moving_before ? 1 : 0, g_result.stop_latency_ms, g_result.stop_time_ms,
+        g_result.stop_distance_m, g_result.stop_distance_bound_m, g_result.stayed_stopped ? 1 : 0,
         g_result.held_until_reset ? 1 : 0, g_result.held_until_resume ? 1 : 0,
         g_result.moving_after ? 1 : 0, g_result.says_expected ? 1 : 0,
         g_result.healthy_after ? 1 : 0, g_result.collisions, g_result.state_loadable ? 1 : 0);

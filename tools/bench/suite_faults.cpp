@@ -135,8 +135,12 @@ std::string cell(std::string text) {
 }
 
 std::string expected_text(const FaultExpectation& e) {
-  std::string s = e.stops_base ? "base stopped within a frame, stays stopped while it fails; "
-                               : "base keeps moving; ";
+  std::string s = !e.stops_base ? "base keeps moving; "
+                  : e.coasts    ? "base stops commanding within a frame, the axes idled (the "
+                                  "wheels coast), at rest within the coasting distance, stays "
+                                  "stopped while it fails; "
+                                : "base stops commanding within a frame, braked to rest within "
+                                  "the braking distance, stays stopped while it fails; ";
   s += "console: `" + std::string(e.console_says) + "`; ";
   if (e.operator_reset) {
     char buf[200];
@@ -168,7 +172,7 @@ std::string seen_text(const FaultExpectation& e, const FaultScenarioResult& r) {
   char buf[512];
   std::string s;
   if (r.stop_latency_ms >= 0.0) {
-    std::snprintf(buf, sizeof buf, "base stopped after %.0f ms%s; ", r.stop_latency_ms,
+    std::snprintf(buf, sizeof buf, "base stopped commanding after %.0f ms%s; ", r.stop_latency_ms,
                   r.stayed_stopped ? ", stayed stopped" : ", moved again during it");
   } else {
     std::snprintf(buf, sizeof buf, "base %s; ", r.moving_before ? "kept moving" : "was not moving");
@@ -198,6 +202,19 @@ std::string seen_text(const FaultExpectation& e, const FaultScenarioResult& r) {
     s += buf;
   }
   return s;
+}
+
+// The stopping distance (with its bound) and time cells: where the base must stop.
+std::string stopping_cells(const FaultExpectation& e, const FaultScenarioResult& r) {
+  if (!e.stops_base) return "— | —";
+  char buf[160];
+  if (r.stop_time_ms < 0.0) {
+    std::snprintf(buf, sizeof buf, "NOT at rest (bound %.4f) | —", r.stop_distance_bound_m);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.4f (%.4f, %s) | %.0f", r.stop_distance_m,
+                  r.stop_distance_bound_m, e.coasts ? "coasting" : "braked", r.stop_time_ms);
+  }
+  return buf;
 }
 
 // Replaces the text between the markers of `path` with `table`.
@@ -230,8 +247,9 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
   }
   std::string table =
       "| device | fault | expected of the firmware | seen (sim board, fault from 1 s for 3 s) | "
+      "stopping distance [m] (bound) | stopping time [ms] | "
       "mission expected | mission seen (fault from 5 s for 5 s, 1 cycle) | verdict |\n"
-      "|---|---|---|---|---|---|---|\n";
+      "|---|---|---|---|---|---|---|---|---|\n";
   int passed = 0;
   int pairs = 0;
   for (std::size_t d = 0; d < hal::sim::kFaultDeviceCount; ++d) {
@@ -268,6 +286,9 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
           .text("fault", hal::sim::fault_type_name(type))
           .flag("scenario_passed", ran && g_result.passed)
           .num("stop_latency_ms", g_result.stop_latency_ms)
+          .num("stop_distance_m", g_result.stop_distance_m)
+          .num("stop_distance_bound_m", g_result.stop_distance_bound_m)
+          .num("stop_time_ms", g_result.stop_time_ms)
           .flag("stayed_stopped", g_result.stayed_stopped)
           .flag("console_said", g_result.says_expected)
           .flag("healthy_after", g_result.healthy_after)
@@ -289,7 +310,7 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
           "| " + std::string(hal::sim::fault_device_name(device)) + " | " +
           hal::sim::fault_type_name(type) + " | " + cell(expected_text(e)) + " | " +
           cell(ran ? seen_text(e, g_result) : std::string("did not run: ") + g_result.error) +
-          " | " + cell(e.mission) + " | " +
+          " | " + stopping_cells(e, g_result) + " | " + cell(e.mission) + " | " +
           cell("result=" + m.result + " reason=\"" + m.reason + "\"" +
                (m.collisions == 0                ? ""
                 : device == FaultDevice::kBumper ? " (collisions=" + std::to_string(m.collisions) +

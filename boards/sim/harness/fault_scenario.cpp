@@ -94,28 +94,34 @@ constexpr ExpectationRow kExpectations[] = {
      {false, "ptu unhealthy: PTU: garbled reply", true, kPtuHold, false, false, true}},
     {FaultDevice::kAxisLeft,
      FaultType::kOff,
-     {true, "base unhealthy: base: left axis: heartbeat lost", true, kBaseRetry}},
+     {true, "base unhealthy: base: left axis: heartbeat lost", true, kBaseRetry, false, false,
+      false, true}},
     {FaultDevice::kAxisLeft,
      FaultType::kWrong,
-     {true, "base unhealthy: base: left axis: ODrive reports an axis error", true, kBaseRetry}},
+     {true, "base unhealthy: base: left axis: ODrive reports an axis error", true, kBaseRetry,
+      false, false, false, true}},
     {FaultDevice::kAxisLeft,
      FaultType::kIntermittent,
-     {true, "base unhealthy: base: left axis: heartbeat lost", true, kBaseRetry}},
+     {true, "base unhealthy: base: left axis: heartbeat lost", true, kBaseRetry, false, false,
+      false, true}},
     {FaultDevice::kAxisRight,
      FaultType::kOff,
-     {true, "base unhealthy: base: right axis: heartbeat lost", true, kBaseRetry}},
+     {true, "base unhealthy: base: right axis: heartbeat lost", true, kBaseRetry, false, false,
+      false, true}},
     {FaultDevice::kAxisRight,
      FaultType::kWrong,
-     {true, "base unhealthy: base: right axis: ODrive reports an axis error", true, kBaseRetry}},
+     {true, "base unhealthy: base: right axis: ODrive reports an axis error", true, kBaseRetry,
+      false, false, false, true}},
     {FaultDevice::kAxisRight,
      FaultType::kIntermittent,
-     {true, "base unhealthy: base: right axis: heartbeat lost", true, kBaseRetry}},
+     {true, "base unhealthy: base: right axis: heartbeat lost", true, kBaseRetry, false, false,
+      false, true}},
     {FaultDevice::kCan,
      FaultType::kOff,
-     {true, "base unhealthy: base: CAN bus-off", true, kBaseRetry}},
+     {true, "base unhealthy: base: CAN bus-off", true, kBaseRetry, false, false, false, true}},
     {FaultDevice::kCan,
      FaultType::kIntermittent,
-     {true, "base unhealthy: base: CAN bus-off", true, kBaseRetry}},
+     {true, "base unhealthy: base: CAN bus-off", true, kBaseRetry, false, false, false, true}},
     {FaultDevice::kEstop,
      FaultType::kOff,
      {true, "e-stop engaged: button (base stopped)", true, kHoldsUntilReset, false, true}},
@@ -152,7 +158,7 @@ constexpr ExpectationRow kExpectations[] = {
     {FaultDevice::kMainLoop,
      FaultType::kStuck,
      {true, "base unhealthy: base: left axis: ODrive reports an axis error (0x00000800)", true,
-      kBaseRetry}},
+      kBaseRetry, false, false, false, true}},
     {FaultDevice::kMainLoop,
      FaultType::kSlow,
      {false, "LOG warn overruns frame=", true, "carries on; frames overrun"}},
@@ -283,9 +289,9 @@ fw::StateStore g_store;
 std::optional<Rig> g_rig;
 fw::MissionState g_loaded;
 
+// The true wheels (not the odometry, which a frozen encoder fools).
 bool wheels_at_rest(const hal::sim::SimWorld& sim) {
-  const hal::Odometry o = sim.odometry();
-  return std::fabs(o.v_m_s) < 1e-6F && std::fabs(o.omega_rad_s) < 1e-6F;
+  return sim.wheel_speed_m_s() < 1e-6F;
 }
 
 bool contains(std::string_view text, const char* what) {
@@ -382,6 +388,18 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   std::uint64_t failing_since_us = 0;
   std::uint64_t frames_at_end = 0;
   std::uint64_t moves_at_end = 0;
+  // The wheels at the onset (updated each frame before it, then at the start of the failing
+  // spell that stopped the base): the faster wheel's speed and the ground covered so far.
+  double onset_speed = 0.0;
+  double onset_travel = 0.0;
+  std::uint64_t stop_since_us = 0;  // the onset of the spell that stopped the base
+  const hal::sim::BaseParams& bp = sim.params().base;
+  const double decel =
+      static_cast<double>(expected.coasts ? bp.coast_decel_m_s2 : bp.brake_decel_m_s2);
+  // By then the wheels must be at rest (the stop due, then v/a, then a frame for rounding).
+  const auto rest_due_us = [&](std::uint64_t since_us) {
+    return since_us + allowed_us + static_cast<std::uint64_t>(onset_speed / decel * 1e6) + 10000U;
+  };
   if (config.loop_started != nullptr) config.loop_started(config.context);
   while (hal.clock.now_us() < stop_us) {
     rig.runtime.executive.run_frame();
@@ -390,6 +408,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
     const bool at_rest = wheels_at_rest(sim);
     if (now < onset_us) {
       out.moving_before = !at_rest;
+      onset_speed = static_cast<double>(sim.wheel_speed_m_s());
+      onset_travel = sim.rim_travel_m();
       continue;
     }
     if (now < end_us) {
@@ -404,17 +424,33 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
         const std::uint64_t slot =
             (now / hal::sim::FaultInjector::kSlotUs) * hal::sim::FaultInjector::kSlotUs;
         failing_since_us = type == FaultType::kIntermittent && slot > onset_us ? slot : onset_us;
+        if (!stopped_seen && failing_since_us > onset_us) {
+          onset_speed = static_cast<double>(sim.wheel_speed_m_s());
+          onset_travel = sim.rim_travel_m();
+        }
       } else if (!failing) {
         failing_since_us = 0;
       }
-      if (at_rest && !stopped_seen && failing_since_us != 0 &&
-          sim.last_base_stop_us() >= failing_since_us) {
+      // The stop: commanded (the base no longer drives), then the wheels at rest.
+      if (!stopped_seen && failing_since_us != 0 && sim.last_base_stop_us() >= failing_since_us) {
         stopped_seen = true;
+        stop_since_us = failing_since_us;
         out.stop_latency_ms =
             static_cast<double>(sim.last_base_stop_us() - failing_since_us) * 1e-3;
+        out.onset_wheel_speed_m_s = onset_speed;
+        out.stop_distance_bound_m = onset_speed * onset_speed / (2.0 * decel) +
+                                    onset_speed * static_cast<double>(allowed_us) * 1e-6 + 1e-4;
       }
-      // While the device misbehaves (after one frame's grace), the wheels must be at rest.
-      if (failing && failing_since_us != 0 && now - failing_since_us > allowed_us && !at_rest) {
+      if (stopped_seen && out.stop_time_ms < 0.0 && at_rest &&
+          sim.last_base_rest_us() >= sim.last_base_stop_us()) {
+        out.stop_time_ms = static_cast<double>(sim.last_base_rest_us() - stop_since_us) * 1e-3;
+        out.stop_distance_m = sim.rim_travel_at_rest_m() - onset_travel;
+      }
+      // While the device misbehaves (after one frame's grace) the base must not drive, and
+      // the wheels must be at rest once they could be.
+      if (failing && failing_since_us != 0 && now - failing_since_us > allowed_us &&
+          (sim.base_health() == hal::BaseHealth::kReady ||
+           (!at_rest && now > rest_due_us(failing_since_us)))) {
         broke_stop = true;
       }
       if (!asked_mid && now >= mid_us) {
@@ -427,9 +463,16 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
     }
     if (!stopped_seen && sim.last_base_stop_us() >= onset_us && sim.last_base_stop_us() < end_us) {
       // Stopped while no frame of the firmware ran (the main loop's stall): by the ODrives'
-      // own watchdog, and still at rest when the firmware runs again.
+      // own watchdog, and at rest when the firmware runs again.
       stopped_seen = true;
       out.stop_latency_ms = static_cast<double>(sim.last_base_stop_us() - onset_us) * 1e-3;
+      out.onset_wheel_speed_m_s = onset_speed;
+      out.stop_distance_bound_m = onset_speed * onset_speed / (2.0 * decel) +
+                                  onset_speed * static_cast<double>(allowed_us) * 1e-6 + 1e-4;
+      if (at_rest && sim.last_base_rest_us() >= sim.last_base_stop_us()) {
+        out.stop_time_ms = static_cast<double>(sim.last_base_rest_us() - onset_us) * 1e-3;
+        out.stop_distance_m = sim.rim_travel_at_rest_m() - onset_travel;
+      }
       broke_stop = !at_rest;
     }
     if (!after_seen) {
@@ -490,7 +533,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   bool ok = out.collisions == 0 && out.state_loadable && out.says_expected;
   if (expected.stops_base) {
     ok = ok && out.moving_before && out.stayed_stopped && out.stop_latency_ms >= 0.0 &&
-         out.stop_latency_ms * 1e3 <= static_cast<double>(allowed_us);
+         out.stop_latency_ms * 1e3 <= static_cast<double>(allowed_us) && out.stop_time_ms >= 0.0 &&
+         out.stop_distance_m <= out.stop_distance_bound_m;
   } else {
     ok = ok && out.moving_before && !stopped_seen;  // nothing made a stop necessary
   }
@@ -520,6 +564,8 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
   std::uint32_t ended_seen = 0;
   std::uint64_t check_at_us = 0;  // a quiet check is due then (0: none)
   std::uint64_t must_rest_since_us = 0;
+  std::uint64_t rest_due_us = 0;
+  const float brake_decel = sim.params().base.brake_decel_m_s2;
   // The operator: after a stop line was active, the wheels stay at rest until they have typed
   // `clear-estop` and `resume`, which they do kOperatorUs after the line's last fault ended.
   constexpr std::uint64_t kOperatorUs = 500000;
@@ -547,8 +593,18 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
     // The e-stop or bumper line active, or not yet reset and resumed by the operator: the
     // wheels at rest after one frame's grace.
     if (line_active || reset_due) {
-      if (must_rest_since_us == 0) must_rest_since_us = now;
-      if (now - must_rest_since_us > 10000U && !wheels_at_rest(sim)) ++out.stop_violations;
+      if (must_rest_since_us == 0) {
+        must_rest_since_us = now;
+        // Braked from this speed: at rest v/a later (and a frame for the stop, one for rounding).
+        rest_due_us = now + 20000U +
+                      static_cast<std::uint64_t>(static_cast<double>(sim.wheel_speed_m_s()) /
+                                                 static_cast<double>(brake_decel) * 1e6);
+      }
+      // Not driving after a frame's grace, and at rest once braked.
+      if ((now - must_rest_since_us > 10000U && sim.base_health() == hal::BaseHealth::kReady) ||
+          (now > rest_due_us && !wheels_at_rest(sim))) {
+        ++out.stop_violations;
+      }
     } else {
       must_rest_since_us = 0;
     }

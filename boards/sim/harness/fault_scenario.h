@@ -41,6 +41,10 @@ struct FaultExpectation {
   // The whole mission holds for the device and carries on when it is back: its log says
   // `held: ...` and `devices back after ...` (the fault policy).
   bool mission_holds = false;
+  // How the base stops (with stops_base): the axes idled, the wheels coasting at
+  // BaseParams::coast_decel_m_s2 (the fault leaves no closed loop to brake with), else braked
+  // in closed loop at brake_decel_m_s2.
+  bool coasts = false;
 };
 inline constexpr std::uint64_t kResetToResumeUs = 500000;
 // The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the
@@ -72,7 +76,16 @@ struct FaultScenarioResult {
   // The base: moving just before the onset, and how long after it the wheels were at rest
   // (-1: not within the fault), and whether they stayed at rest until it ended.
   bool moving_before = false;
-  double stop_latency_ms = -1.0;
+  double stop_latency_ms = -1.0;  // until the base stopped commanding motion
+  // From the fault's onset until the wheels were at rest: the ground the faster wheel
+  // covered (true, from the simulator) [m] and the time [ms] (-1: not at rest within the
+  // fault), and the bound it is held to: v²/2a at the onset's wheel speed v and the
+  // deceleration a of the stop (braked or coasting), plus the travel until the stop was due
+  // (one frame; the ODrives' 0.2 s watchdog for a stalled main loop) [m].
+  double stop_distance_m = -1.0;
+  double stop_time_ms = -1.0;
+  double stop_distance_bound_m = 0.0;
+  double onset_wheel_speed_m_s = 0.0;
   bool stayed_stopped = false;
   bool moving_after = false;  // turning again by the end of the run
   // With an operator reset: at rest from the fault's end until `clear-estop`, and from

@@ -76,6 +76,9 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   watchdog_expirations_ = 0;
   base_last_update_us_ = 0;
   last_base_stop_us_ = 0;
+  braking_ = axes_idle_ = false;
+  last_rest_us_ = 0;
+  rim_travel_m_ = rim_travel_at_rest_m_ = 0.0;
   faults_.reset(params.seed);
   const char* model = "";
   const float gap = clearance_m(x_m_, y_m_, &model);
@@ -166,7 +169,7 @@ void SimWorld::step(std::uint32_t dt_us) {
   }
   if (base_started_ && base_health_ == BaseHealth::kStarting && now_us_ >= base_ready_at_us_) {
     if (const char* why = base_fault(); why != nullptr) {
-      base_stop(why);  // the start-up fails on an axis that is not there
+      base_stop(why, StopKind::kCoast);  // the start-up fails on an axis that is not there
     } else {
       base_health_ = BaseHealth::kReady;
       base_error_ = "";
@@ -176,7 +179,12 @@ void SimWorld::step(std::uint32_t dt_us) {
       now_us_ - base_last_update_us_ > params_.base.command_timeout_us) {
     // The ODrive's watchdog (WATCHDOG_TIMER_EXPIRED, 0x800): no setpoint came in time, e.g.
     // the executive stalled. The driver then reports the axis error.
-    base_stop("base: left axis: ODrive reports an axis error (0x00000800)");
+    base_stop("base: left axis: ODrive reports an axis error (0x00000800)", StopKind::kCoast);
+  }
+  if (braking_ &&
+      ((wheel_left_m_s_ == 0.0F && wheel_right_m_s_ == 0.0F) || now_us_ >= brake_deadline_us_)) {
+    braking_ = false;  // at rest, or the brake time is over: the driver idles the axes
+    axes_idle_ = true;
   }
   step_base(dt_s);
   if (watchdog_armed_ && now_us_ - last_kick_us_ > watchdog_timeout_us_) {
@@ -227,9 +235,20 @@ float SimWorld::gaussian() {
 
 void SimWorld::step_base(float dt_s) {
   const BaseParams& b = params_.base;
-  const float dv = b.wheel_accel_m_s2 * dt_s;
-  wheel_left_m_s_ += std::clamp(target_left_m_s_ - wheel_left_m_s_, -dv, dv);
-  wheel_right_m_s_ += std::clamp(target_right_m_s_ - wheel_right_m_s_, -dv, dv);
+  const bool was_moving = wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F;
+  // Closed loop: towards the setpoint, speeding up at the ramp, slowing at the brake
+  // deceleration; idle axes: the wheels coast to rest.
+  const auto follow = [&](float& wheel, float target) {
+    if (axes_idle_) target = 0.0F;
+    const bool slowing = std::fabs(target) < std::fabs(wheel) || target * wheel < 0.0F;
+    const float rate = axes_idle_ ? b.coast_decel_m_s2
+                       : slowing  ? b.brake_decel_m_s2
+                                  : b.wheel_accel_m_s2;
+    const float dv = rate * dt_s;
+    wheel += std::clamp(target - wheel, -dv, dv);
+  };
+  follow(wheel_left_m_s_, target_left_m_s_);
+  follow(wheel_right_m_s_, target_right_m_s_);
   // What the encoders count (the commanded rims at the odometry's diameters) [m].
   const double el = static_cast<double>(wheel_left_m_s_) * static_cast<double>(dt_s);
   const double er = static_cast<double>(wheel_right_m_s_) * static_cast<double>(dt_s);
@@ -247,6 +266,11 @@ void SimWorld::step_base(float dt_s) {
   // What the ground does: the true diameters and track.
   const double dl = el * static_cast<double>(b.wheel_scale_left);
   const double dr = er * static_cast<double>(b.wheel_scale_right);
+  rim_travel_m_ += std::max(std::fabs(dl), std::fabs(dr));
+  if (was_moving && wheel_left_m_s_ == 0.0F && wheel_right_m_s_ == 0.0F) {
+    last_rest_us_ = now_us_;
+    rim_travel_at_rest_m_ = rim_travel_m_;
+  }
   if (dl != 0.0 || dr != 0.0) {
     // Exact arc of a differential drive over the step.
     const double track = b.track_width_m;
@@ -264,10 +288,9 @@ void SimWorld::step_base(float dt_s) {
       ++collisions_;
       last_collision_model_ = model;
       std::snprintf(collision_error_, sizeof collision_error_, "collision with '%s'", model);
-      wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
       wheel_count_left_m_ = count_left_before;  // the wheels did not turn either
       wheel_count_right_m_ = count_right_before;
-      base_stop(collision_error_);
+      base_stop(collision_error_, StopKind::kImmediate);
       if (!contact_) ++contacts_;
       contact_ = true;
     } else {
@@ -335,10 +358,12 @@ bool SimWorld::restore_physical_state(const PhysicalState& state) {
   wheel_left_m_s_ = target_left_m_s_ = std::clamp(state.wheel_left_m_s, -limit, limit);
   wheel_right_m_s_ = target_right_m_s_ = std::clamp(state.wheel_right_m_s, -limit, limit);
   if (wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F) {
-    // The axes are still in closed loop on the last setpoint; their watchdog ends that.
+    // The axes are still in closed loop on the last setpoint; their watchdog ends that, and
+    // the wheels coast to rest with the axes idle.
     base_health_ = BaseHealth::kReady;
     base_error_ = "";
     base_last_update_us_ = now_us_;
+    braking_ = axes_idle_ = false;
   }
   odometry_.wheels_known = true;
   odometry_.wheel_left_m = wheel_count_left_m_;
@@ -352,6 +377,7 @@ void SimWorld::base_start() {
   base_error_ = "starting";
   base_ready_at_us_ = now_us_ + params_.base.startup_us;
   base_last_update_us_ = now_us_;
+  braking_ = axes_idle_ = false;
   odometry_origin_ = true_pose();
   odometry_ = Odometry{};
   odometry_.timestamp_us = now_us_;
@@ -382,11 +408,12 @@ const char* SimWorld::base_fault() const {
 
 void SimWorld::base_update() {
   base_last_update_us_ = now_us_;
-  if (base_health_ == BaseHealth::kStopped) return;
+  // A brake under way is turned into an idle by an axis or bus fault, as the driver does.
+  if (base_health_ == BaseHealth::kStopped && !braking_) return;
   const char* why = base_fault();
   if (why == nullptr) return;
   std::snprintf(base_fault_error_, sizeof base_fault_error_, "%s", why);
-  base_stop(base_fault_error_);
+  base_stop(base_fault_error_, StopKind::kCoast);
 }
 
 void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
@@ -400,10 +427,27 @@ void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
   target_right_m_s_ = v + 0.5F * w * b.track_width_m;
 }
 
-void SimWorld::base_stop(const char* reason) {
-  if (base_health_ != BaseHealth::kStopped) last_base_stop_us_ = now_us_;
+void SimWorld::base_stop(const char* reason, StopKind kind) {
+  const bool was_running = base_health_ != BaseHealth::kStopped;
+  if (was_running) last_base_stop_us_ = now_us_;
   target_left_m_s_ = target_right_m_s_ = 0.0F;
-  wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
+  if (kind == StopKind::kImmediate) {
+    if (wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F) {
+      last_rest_us_ = now_us_;
+      rim_travel_at_rest_m_ = rim_travel_m_;
+    }
+    wheel_left_m_s_ = wheel_right_m_s_ = 0.0F;
+    braking_ = false;
+    axes_idle_ = true;
+  } else if (kind == StopKind::kCoast) {
+    braking_ = false;
+    axes_idle_ = true;
+  } else if (was_running && base_health_ == BaseHealth::kReady) {
+    braking_ = true;  // the wheels slow in closed loop (step_base), then the axes idle
+    brake_deadline_us_ = now_us_ + params_.base.brake_timeout_us;
+  } else if (was_running) {
+    axes_idle_ = true;  // stopped while starting: nothing to brake
+  }
   base_health_ = BaseHealth::kStopped;
   base_error_ = reason;
 }
@@ -412,6 +456,7 @@ bool SimWorld::base_resume() {
   if (!base_started_) return false;
   if (base_fault() != nullptr) return false;  // the axis or the bus is still gone
   if (base_health_ == BaseHealth::kStopped) {
+    braking_ = axes_idle_ = false;  // closed loop again (from the wheels' speed now)
     base_health_ = now_us_ >= base_ready_at_us_ ? BaseHealth::kReady : BaseHealth::kStarting;
     base_error_ = base_health_ == BaseHealth::kReady ? "" : "starting";
   }

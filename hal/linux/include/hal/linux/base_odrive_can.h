@@ -22,10 +22,15 @@ struct BaseOdriveCanConfig {
   std::uint32_t heartbeat_timeout_ms = 300;  // no heartbeat from an axis that long: stop
   std::uint32_t startup_timeout_ms = 3000;   // both axes in closed loop by then, or stop
   std::uint32_t state_resend_ms = 250;       // Set_Axis_State repeated while starting
-  std::uint32_t stop_resend_ms = 100;        // Set_Input_Vel 0 + Estop repeated while stopped
-  std::uint32_t encoder_timeout_ms = 100;    // no encoder estimate from an axis that long: stop
-  bool request_encoder = false;              // send an RTR for Get_Encoder_Estimates every update()
-                                             // (when the ODrives do not send it cyclically)
+  std::uint32_t stop_resend_ms = 100;        // the stop's frames repeated while stopped
+  // A controlled stop (stop(), a lost encoder stream) brakes in closed loop with setpoint 0
+  // and idles the axes once both measured wheel speeds are below standstill_turns_s, or after
+  // brake_timeout_ms at the latest (stop category 1).
+  std::uint32_t brake_timeout_ms = 500;
+  float standstill_turns_s = 0.05F;        // [turns/s]
+  std::uint32_t encoder_timeout_ms = 100;  // no encoder estimate from an axis that long: stop
+  bool request_encoder = false;            // send an RTR for Get_Encoder_Estimates every update()
+                                           // (when the ODrives do not send it cyclically)
 };
 
 // Non-blocking: update() drains the socket (bounded), runs the start-up sequence
@@ -34,8 +39,17 @@ struct BaseOdriveCanConfig {
 // velocity setpoint every call (so the ODrive's own watchdog stays fed) and integrates the
 // odometry from Get_Encoder_Estimates. A missing heartbeat or encoder stream, an axis leaving
 // closed loop, an axis error, a bus-off error frame or a socket error stop the base and set
-// error(); while stopped, Set_Input_Vel(0) and Estop go to both axes every stop_resend_ms (a
-// stop that could not be sent, e.g. with the link down, is sent once the link is back).
+// error(). How it stops depends on the cause (docs/protocols.md, "Stopping"):
+// - braked (stop(), encoder estimates stopped): Set_Input_Vel(0) at once and on every
+//   update(), the ODrives' velocity controllers brake; once both wheels are at rest (measured)
+//   or after brake_timeout_ms, Set_Axis_State(IDLE); a heartbeat lost or an axis error while
+//   braking turns it into the next kind;
+// - idled at once (heartbeat lost, axis error, an axis out of closed loop, bus-off, a socket
+//   error, a failed start-up): Set_Input_Vel(0) and Estop; the axes are out of closed loop or
+//   out of reach, so braking cannot work, and both wheels coast.
+// While stopped the final frames (Set_Input_Vel(0) and IDLE or Estop) go to both axes every
+// stop_resend_ms (a stop that could not be sent, e.g. with the link down, is sent once the
+// link is back).
 // resume() refuses while the controller is bus-off or the interface is down or gone, and
 // opens a new socket when the interface was deleted and added again.
 class BaseOdriveCan final : public hal::Base {
@@ -63,6 +77,7 @@ class BaseOdriveCan final : public hal::Base {
   std::uint32_t sent_frames() const { return sent_frames_; }
   std::uint32_t send_failures() const { return send_failures_; }  // frames the socket refused
   bool bus_off() const { return bus_off_; }  // bus-off seen and no restart since
+  bool braking() const { return braking_; }  // a controlled stop is braking the wheels
 
  private:
   struct Axis {
@@ -80,7 +95,11 @@ class BaseOdriveCan final : public hal::Base {
   void handle_error_frame(std::uint32_t can_id, const std::uint8_t* data);
   void begin_startup(std::uint64_t now_us);
   void send_startup_commands();
-  void fault(const char* what, const char* side = nullptr, std::uint32_t value = 0);
+  enum class StopKind : std::uint8_t { kIdle, kBrake };
+  void fault(const char* what, const char* side = nullptr, std::uint32_t value = 0,
+             StopKind kind = StopKind::kIdle);
+  void send_stop_frames();
+  void update_braking(std::uint64_t now_us);
   void update_odometry(std::uint64_t now_us);
   void close_socket();
   bool open_socket();
@@ -96,6 +115,9 @@ class BaseOdriveCan final : public hal::Base {
   std::uint64_t next_state_send_us_ = 0;
   std::uint64_t next_stop_send_us_ = 0;
   std::uint64_t ready_since_us_ = 0;
+  bool braking_ = false;           // a controlled stop under way (closed loop, setpoint 0)
+  bool idled_by_request_ = false;  // the stop ended braked: IDLE, not Estop, is re-sent
+  std::uint64_t brake_deadline_us_ = 0;
   bool owns_interface_ = false;  // opened `interface` itself (not a socket handed in)
   int ifindex_ = 0;              // the interface the socket is bound to
   codec::WheelTurns setpoint_turns_s_{};

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -29,6 +31,14 @@ struct BaseParams {
   float max_speed_m_s = 0.3F;
   float max_turn_rate_rad_s = 0.8F;
   float wheel_accel_m_s2 = 1.0F;  // velocity ramp at the wheel rim (ODrive vel_ramp)
+  // Stopping, as the ODrives do it. In closed loop a wheel slows at brake_decel_m_s2 (the
+  // velocity controller braking at its current limit); with the axes idle (Estop, an axis
+  // error, a lost heartbeat, the ODrives' watchdog) the motors coast and only rolling
+  // friction slows the wheels, at coast_decel_m_s2. A controlled stop (stop()) idles the axes
+  // once the wheels are at rest or after brake_timeout_us (the driver's brake_timeout_ms).
+  float brake_decel_m_s2 = 1.0F;
+  float coast_decel_m_s2 = 0.2F;
+  std::uint32_t brake_timeout_us = 500000;
   // Odometry errors of a real base (Borenstein & Feng 1996, UMBmark): what the wheels do
   // against what the odometry assumes. The encoders count the commanded wheel turns; the
   // ground moves by the true diameters and track. 1, 1, 1, 0, 0 is perfect odometry.
@@ -103,11 +113,25 @@ class SimWorld {
   // injected axis and CAN faults, which stop the base as the ODrive driver does.
   void base_update();
   void base_set_velocity(float v_m_s, float omega_rad_s);
-  void base_stop(const char* reason);
+  // How a stop acts on the wheels: braked in closed loop (a requested stop), the axes idled
+  // so that the wheels coast (faults that leave no closed loop), or at once (a collision).
+  enum class StopKind : std::uint8_t { kBrake, kCoast, kImmediate };
+  void base_stop(const char* reason, StopKind kind);
   bool base_resume();
   BaseHealth base_health() const { return base_health_; }
   // When the base last went from moving or ready to stopped (any cause) [µs]; 0 never.
   std::uint64_t last_base_stop_us() const { return last_base_stop_us_; }
+  // The wheels: a controlled stop braking them, the axes idle (coasting), the faster wheel's
+  // speed [m/s], when they last came to rest [µs] and the ground the faster wheel has covered
+  // in all (true, not the odometry's) [m], also at that rest.
+  bool base_braking() const { return braking_; }
+  bool base_axes_idle() const { return axes_idle_; }
+  float wheel_speed_m_s() const {
+    return std::max(std::fabs(wheel_left_m_s_), std::fabs(wheel_right_m_s_));
+  }
+  std::uint64_t last_base_rest_us() const { return last_rest_us_; }
+  double rim_travel_m() const { return rim_travel_m_; }
+  double rim_travel_at_rest_m() const { return rim_travel_at_rest_m_; }
   const char* base_error() const { return base_error_; }
   Odometry odometry() const { return odometry_; }
   // The true pose at which the odometry frame was fixed (the last base start).
@@ -183,6 +207,12 @@ class SimWorld {
   bool base_started_ = false;
   std::uint64_t base_last_update_us_ = 0;
   std::uint64_t last_base_stop_us_ = 0;
+  bool braking_ = false;
+  bool axes_idle_ = false;
+  std::uint64_t brake_deadline_us_ = 0;
+  std::uint64_t last_rest_us_ = 0;
+  double rim_travel_m_ = 0.0;
+  double rim_travel_at_rest_m_ = 0.0;
   char base_fault_error_[96] = {};
   Odometry odometry_{};
   core::Pose2 odometry_origin_{};
