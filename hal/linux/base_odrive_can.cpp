@@ -178,6 +178,7 @@ void BaseOdriveCan::begin_startup(std::uint64_t now_us) {
     a.heartbeat_seen = false;
     a.encoder_seen = false;
     a.encoder_fresh = false;
+    a.behind_since_us = 0;
   }
   startup_deadline_us_ = now_us + std::uint64_t{config_.startup_timeout_ms} * 1000U;
   send_startup_commands();
@@ -387,6 +388,20 @@ void BaseOdriveCan::update_odometry(std::uint64_t now_us) {
                             static_cast<double>(config_.geometry.right_direction) * per_turn_m;
 }
 
+// True once the wheel has been behind its setpoint for follow_timeout_ms: its measured speed
+// in the setpoint's direction below follow_ratio of it (a setpoint below follow_min_turns_s
+// is not judged; a ramp from rest or a reversal is over well within the time).
+bool BaseOdriveCan::wheel_behind(Axis& a, float setpoint_turns_s, std::uint64_t now_us) {
+  const float want = std::fabs(setpoint_turns_s);
+  const float got = std::copysign(1.0F, setpoint_turns_s) * a.encoder.vel_turns_s;
+  if (want < config_.follow_min_turns_s || got >= config_.follow_ratio * want) {
+    a.behind_since_us = 0;
+    return false;
+  }
+  if (a.behind_since_us == 0) a.behind_since_us = now_us;
+  return now_us - a.behind_since_us > std::uint64_t{config_.follow_timeout_ms} * 1000U;
+}
+
 void BaseOdriveCan::update() {
   if (fd_ < 0) return;
   const std::uint64_t now = clock_.now_us();
@@ -462,6 +477,12 @@ void BaseOdriveCan::update() {
     if (a.heartbeat.axis_state !=
         static_cast<std::uint8_t>(odrive::AxisState::kClosedLoopControl)) {
       fault("left closed-loop control; axis state", kSide[k], a.heartbeat.axis_state);
+      return;
+    }
+    if (wheel_behind(axes_[k], k == 0 ? setpoint_turns_s_.left : setpoint_turns_s_.right, now)) {
+      // Jammed (the motor cannot turn it) or a frozen encoder (the ODrive's own loop is blind
+      // and would wind up): its loop cannot be trusted to brake, so both axes are idled.
+      fault("wheel not following its setpoint", kSide[k], 0);
       return;
     }
   }

@@ -92,11 +92,22 @@ void OdriveCanEmulator::send_heartbeat(AxisSim& a) {
   send_frame(odrive::encode_heartbeat(a.node, hb));
 }
 
+void OdriveCanEmulator::freeze_encoder(int axis, bool frozen) {
+  AxisSim& a = axes_[axis];
+  a.frozen = frozen;
+  a.frozen_at.pos_turns = static_cast<float>(a.pos);
+  a.frozen_at.vel_turns_s = 0.0F;  // the estimate of a position that no longer changes
+}
+
 void OdriveCanEmulator::send_encoder(AxisSim& a) {
+  if (a.frozen) {
+    send_frame(odrive::encode_encoder_estimates(a.node, a.frozen_at));
+    return;
+  }
   odrive::EncoderEstimates e;
   e.pos_turns = static_cast<float>(a.pos);
   const bool perfect = (a.state == 8 ? config_.accel_turns_s2 : config_.coast_turns_s2) <= 0.0F;
-  e.vel_turns_s = perfect ? (a.state == 8 ? a.vel_setpoint : 0.0F) : a.vel;
+  e.vel_turns_s = perfect ? (a.state == 8 && !a.jammed ? a.vel_setpoint : 0.0F) : a.vel;
   send_frame(odrive::encode_encoder_estimates(a.node, e));
 }
 
@@ -169,7 +180,7 @@ void OdriveCanEmulator::service(std::uint64_t now_us) {
   for (AxisSim& a : axes_) {
     const float v0 = a.vel;
     const bool closed = a.state == 8;
-    const float target = closed ? a.vel_setpoint : 0.0F;
+    const float target = closed && !a.jammed ? a.vel_setpoint : 0.0F;
     const float rate = closed ? config_.accel_turns_s2 : config_.coast_turns_s2;
     if (rate <= 0.0F) {
       a.vel = target;

@@ -49,6 +49,10 @@ class OdriveCanEmulator {
   void silence_heartbeats(int axis, bool silent) { axes_[axis].silent = silent; }
   // The axis goes on with its heartbeats but stops sending encoder estimates.
   void silence_encoder(int axis, bool silent) { axes_[axis].encoder_silent = silent; }
+  // The wheel cannot turn (jammed): its speed stays 0 whatever the setpoint.
+  void jam(int axis, bool jammed) { axes_[axis].jammed = jammed; }
+  // The estimates keep coming but stop changing (a frozen encoder): the last ones again.
+  void freeze_encoder(int axis, bool frozen);
   void set_axis_error(int axis, std::uint32_t error);
   void send_bus_off();
   // Any error frame (CAN_ERR_FLAG is added), e.g. CAN_ERR_PROT | CAN_ERR_BUSERROR.
@@ -90,6 +94,9 @@ class OdriveCanEmulator {
     double pos = 0.0;
     bool silent = false;
     bool encoder_silent = false;
+    bool jammed = false;
+    bool frozen = false;
+    codec::odrive::EncoderEstimates frozen_at{};
     bool closed_loop_pending = false;
     std::uint64_t closed_loop_at_us = 0;
     std::uint64_t last_input_us = 0;

@@ -507,4 +507,45 @@ TEST(BaseOdriveCan, TheWheelCountersAreTheOdrivesPositionsAsForwardTravelAndOutl
   rig.cycle();
   DOUBLES_EQUAL(left_before, rig.base->odometry().wheel_left_m, 0.006);
   DOUBLES_EQUAL(rig.emu.pos_turns(kLeft) * per_turn, rig.base->odometry().wheel_left_m, 1e-6);
+
+TEST(BaseOdriveCan, AJammedWheelStopsTheBaseAfterTheFollowTimeAndIdlesBothAxes) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.5F, 0.0F);
+  for (int i = 0; i < 50; ++i) rig.cycle();
+  rig.emu.jam(kLeft, true);
+  const std::uint64_t t0 = rig.clock.peek_us();
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }, 150));
+  const std::uint64_t t = rig.clock.peek_us() - t0;
+  CHECK(t >= 1000000U && t <= 1050000U);  // follow_timeout_ms, and not before
+  STRCMP_CONTAINS("left axis: wheel not following its setpoint", rig.base->error());
+  rig.cycle();
+  CHECK(rig.emu.estops(kLeft) >= 1U);  // its loop cannot be trusted: idled, not braked
+  CHECK(rig.emu.estops(kRight) >= 1U);
+}
+
+TEST(BaseOdriveCan, EncoderEstimatesThatStopChangingStopTheBaseLikeAJammedWheel) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->set_velocity(0.0F, 1.0F);  // turning in place: ∓0.25 m/s, ∓0.40 turns/s
+  for (int i = 0; i < 50; ++i) rig.cycle();
+  rig.emu.freeze_encoder(kRight, true);  // the estimates go on arriving, always the same
+  CHECK_TRUE(rig.run_until([&] { return rig.base->health() == BaseHealth::kStopped; }, 150));
+  STRCMP_CONTAINS("right axis: wheel not following its setpoint", rig.base->error());
+}
+
+TEST(BaseOdriveCan, AWheelRampingUpOrReversingWithinTheFollowTimeIsNotAFault) {
+  OdriveCanEmulatorConfig ec = Rig::emu_config();
+  ec.accel_turns_s2 = 2.0F;  // 0.8 turns/s reversed in 0.8 s
+  Rig rig(ec);
+  CHECK_TRUE(rig.start());
+  for (int k = 0; k < 6; ++k) {
+    rig.base->set_velocity(k % 2 == 0 ? 0.5F : -0.5F, 0.0F);
+    for (int i = 0; i < 150; ++i) rig.cycle();
+    CHECK_TEXT(rig.base->health() == BaseHealth::kReady, rig.base->error());
+  }
+  rig.base->set_velocity(0.03F, 0.0F);  // below follow_min_turns_s: not judged
+  rig.emu.jam(kLeft, true);
+  for (int i = 0; i < 200; ++i) rig.cycle();
+  CHECK_TEXT(rig.base->health() == BaseHealth::kReady, rig.base->error());
 }

@@ -216,6 +216,28 @@ TEST(SimDevices, TheOdrivesWatchdogIdlesTheAxesAndTheWheelsCoast) {
   DOUBLES_EQUAL(0.06 + 0.225, static_cast<double>(g_sim.true_pose().x_m) - x0, 0.002);
 }
 
+TEST(SimDevices, ADelayedCanBusDeliversSetpointsAndEstimatesFiftyMillisecondsLate) {
+  start("rectangular_room");
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  make_ready(base, clock);
+  clock.sleep_until_us(clock.now_us() + 200000);
+  const std::uint64_t before = base.odometry().timestamp_us;
+  CHECK(g_sim.faults().inject(FaultDevice::kCan, FaultType::kDelayed, clock.now_us(), 0));
+  CHECK(base.odometry().timestamp_us >= before);  // a late estimate does not go back in time
+  base.set_velocity(0.2F, 0.0F);
+  clock.sleep_until_us(clock.now_us() + 45000);
+  CHECK_EQUAL(0.0F, g_sim.wheel_speed_m_s());  // the setpoint is still on the bus
+  clock.sleep_until_us(clock.now_us() + 10000);
+  CHECK(g_sim.wheel_speed_m_s() > 0.0F);
+  clock.sleep_until_us(clock.now_us() + 1000000);
+  const std::uint64_t now = clock.now_us();
+  CHECK(base.odometry().timestamp_us <= now - 50000U);
+  CHECK(base.odometry().timestamp_us >= now - 51000U);
+  DOUBLES_EQUAL(0.2, base.odometry().v_m_s, 1e-6);
+  CHECK(base.health() == BaseHealth::kReady);
+}
+
 TEST(SimDevices, DrivingIntoThePartitionStopsTheBaseCountsOneCollisionAndClosesTheBumper) {
   start("thesis_room");
   BaseSim base(g_sim);

@@ -138,7 +138,7 @@ TEST(FaultPlan, ThePairsThatMeanSomethingAreThirtyThree) {
       pairs += fault_applies(static_cast<FaultDevice>(d), static_cast<FaultType>(t)) ? 1 : 0;
     }
   }
-  CHECK_EQUAL(33, pairs);
+  CHECK_EQUAL(38, pairs);
   CHECK(fault_applies(FaultDevice::kCamera, FaultType::kDelayed));
   CHECK_FALSE(fault_applies(FaultDevice::kBumper, FaultType::kSlow));
   CHECK_FALSE(fault_applies(FaultDevice::kCount, FaultType::kOff));

@@ -127,15 +127,21 @@ FAULT_PAIR(TheLeftAxisLosingItsHeartbeatStopsTheBaseWithinAFrameAndTheRetryResta
            kOff)
 FAULT_PAIR_MORE(AnErrorOfTheLeftAxisStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kAxisLeft,
                 kWrong)
+FAULT_PAIR(AFrozenLeftEncoderIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisLeft, kStuck)
+FAULT_PAIR_MORE(AJammedLeftWheelIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisLeft, kSlow)
 FAULT_PAIR_MORE(TheLeftAxisHeartbeatComingAndGoingStopsTheBaseInEveryGap, kAxisLeft, kIntermittent)
 FAULT_PAIR_MORE(TheRightAxisLosingItsHeartbeatStopsTheBaseWithinAFrameAndTheRetryRestartsIt,
                 kAxisRight, kOff)
 FAULT_PAIR_MORE(AnErrorOfTheRightAxisStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kAxisRight,
                 kWrong)
+FAULT_PAIR_MORE(AFrozenRightEncoderIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisRight,
+                kStuck)
+FAULT_PAIR(AJammedRightWheelIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisRight, kSlow)
 FAULT_PAIR_MORE(TheRightAxisHeartbeatComingAndGoingStopsTheBaseInEveryGap, kAxisRight,
                 kIntermittent)
 FAULT_PAIR_MORE(ACanBusOffStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kCan, kOff)
 FAULT_PAIR_MORE(ACanBusGoingOffNowAndThenStopsTheBaseEachTime, kCan, kIntermittent)
+FAULT_PAIR_MORE(ACanBusDelayingEveryFrameBy50MsKeepsTheBaseDrivingAndHealthy, kCan, kDelayed)
 FAULT_PAIR_MORE(ABrokenEstopLineStopsTheBaseUntilClearEstopAndResumeAfterItIsBack, kEstop, kOff)
 FAULT_PAIR_MORE(AStuckEstopStopsTheBaseUntilClearEstopAndResumeAfterTheRelease, kEstop, kStuck)
 FAULT_PAIR_MORE(AChatteringEstopStopsTheBaseUntilClearEstopAndResumeAfterItIsQuiet, kEstop,
@@ -163,7 +169,7 @@ TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
                  boticelli::hal::sim::fault_device_name(device));
     }
   }
-  CHECK_EQUAL(33, pairs);  // the FAULT_PAIR tests above
+  CHECK_EQUAL(38, pairs);  // the FAULT_PAIR tests above
 }
 
 TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {

@@ -136,11 +136,17 @@ std::string cell(std::string text) {
 
 std::string expected_text(const FaultExpectation& e) {
   std::string s = !e.stops_base ? "base keeps moving; "
-                  : e.coasts    ? "base stops commanding within a frame, the axes idled (the "
-                                  "wheels coast), at rest within the coasting distance, stays "
-                                  "stopped while it fails; "
-                                : "base stops commanding within a frame, braked to rest within "
-                                  "the braking distance, stays stopped while it fails; ";
+                  : e.detect_us > 0
+                      ? "base stops commanding within a frame of the driver's 1 s check of the "
+                        "wheels against their setpoints, "
+                      : "base stops commanding within a frame, ";
+  if (e.stops_base) {
+    s += e.coasts ? "the axes idled (the wheels coast), at rest within the coasting distance, "
+                  : "braked to rest within the braking distance, ";
+    s += e.restarts_into_it ? "restarted into the fault by the base task's retry every second "
+                              "and each time stopped again by the check; "
+                            : "stays stopped while it fails; ";
+  }
   s += "console: `" + std::string(e.console_says) + "`; ";
   if (e.operator_reset) {
     char buf[200];

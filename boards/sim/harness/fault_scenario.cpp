@@ -51,6 +51,11 @@ constexpr const char* kCarriesOn = "carries on";
 constexpr const char* kHoldsUntilReset =
     "holds until the operator's clear-estop and resume (typed 2 s after the line is back), "
     "then carries on";
+// The driver's check of a wheel against its setpoint trips after 1 s (BaseParams
+// follow_timeout_us), seen at the next frame; a jammed wheel first slows to a quarter of its
+// setpoint (0.06 s at the brake deceleration).
+constexpr std::uint32_t kFollowDetectUs = 1010000;
+constexpr std::uint32_t kJamDetectUs = 1100000;
 constexpr ExpectationRow kExpectations[] = {
     {FaultDevice::kCamera,
      FaultType::kOff,
@@ -97,9 +102,17 @@ constexpr ExpectationRow kExpectations[] = {
      {true, "base unhealthy: base: left axis: heartbeat lost", true, kBaseRetry, false, false,
       false, true}},
     {FaultDevice::kAxisLeft,
+     FaultType::kStuck,
+     {true, "base unhealthy: base: left axis: wheel not following its setpoint", true, kBaseRetry,
+      false, false, false, true, kFollowDetectUs, true}},
+    {FaultDevice::kAxisLeft,
      FaultType::kWrong,
      {true, "base unhealthy: base: left axis: ODrive reports an axis error", true, kBaseRetry,
       false, false, false, true}},
+    {FaultDevice::kAxisLeft,
+     FaultType::kSlow,
+     {true, "base unhealthy: base: left axis: wheel not following its setpoint", true, kBaseRetry,
+      false, false, false, true, kJamDetectUs, true}},
     {FaultDevice::kAxisLeft,
      FaultType::kIntermittent,
      {true, "base unhealthy: base: left axis: heartbeat lost", true, kBaseRetry, false, false,
@@ -109,9 +122,17 @@ constexpr ExpectationRow kExpectations[] = {
      {true, "base unhealthy: base: right axis: heartbeat lost", true, kBaseRetry, false, false,
       false, true}},
     {FaultDevice::kAxisRight,
+     FaultType::kStuck,
+     {true, "base unhealthy: base: right axis: wheel not following its setpoint", true, kBaseRetry,
+      false, false, false, true, kFollowDetectUs, true}},
+    {FaultDevice::kAxisRight,
      FaultType::kWrong,
      {true, "base unhealthy: base: right axis: ODrive reports an axis error", true, kBaseRetry,
       false, false, false, true}},
+    {FaultDevice::kAxisRight,
+     FaultType::kSlow,
+     {true, "base unhealthy: base: right axis: wheel not following its setpoint", true, kBaseRetry,
+      false, false, false, true, kJamDetectUs, true}},
     {FaultDevice::kAxisRight,
      FaultType::kIntermittent,
      {true, "base unhealthy: base: right axis: heartbeat lost", true, kBaseRetry, false, false,
@@ -119,6 +140,10 @@ constexpr ExpectationRow kExpectations[] = {
     {FaultDevice::kCan,
      FaultType::kOff,
      {true, "base unhealthy: base: CAN bus-off", true, kBaseRetry, false, false, false, true}},
+    {FaultDevice::kCan,
+     FaultType::kDelayed,
+     {false, "unhealthy=none", true,
+      "carries on (setpoints and estimates 50 ms late stay within the driver's timeouts)"}},
     {FaultDevice::kCan,
      FaultType::kIntermittent,
      {true, "base unhealthy: base: CAN bus-off", true, kBaseRetry, false, false, false, true}},
@@ -378,7 +403,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   const std::uint64_t stop_us =
       end_us + static_cast<std::uint64_t>(std::llround(config.after_s * 1e6));
   // The main loop's stall stops the wheels through the ODrives' own watchdog.
-  const std::uint64_t allowed_us = device == FaultDevice::kMainLoop ? 210000U : 10000U;
+  const std::uint64_t allowed_us =
+      (device == FaultDevice::kMainLoop ? 210000U : 10000U) + expected.detect_us;
   const std::uint64_t mid_us = onset_us + fault.duration_us * 3U / 4U;
   bool asked_mid = false;
   bool stopped_seen = false;
@@ -392,7 +418,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   // spell that stopped the base): the faster wheel's speed and the ground covered so far.
   double onset_speed = 0.0;
   double onset_travel = 0.0;
-  std::uint64_t stop_since_us = 0;  // the onset of the spell that stopped the base
+  std::uint64_t stop_since_us = 0;   // the onset of the spell that stopped the base
+  std::uint64_t ready_since_us = 0;  // driving while the fault is failing since (0: not)
   const hal::sim::BaseParams& bp = sim.params().base;
   const double decel =
       static_cast<double>(expected.coasts ? bp.coast_decel_m_s2 : bp.brake_decel_m_s2);
@@ -447,10 +474,19 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
         out.stop_distance_m = sim.rim_travel_at_rest_m() - onset_travel;
       }
       // While the device misbehaves (after one frame's grace) the base must not drive, and
-      // the wheels must be at rest once they could be.
-      if (failing && failing_since_us != 0 && now - failing_since_us > allowed_us &&
-          (sim.base_health() == hal::BaseHealth::kReady ||
-           (!at_rest && now > rest_due_us(failing_since_us)))) {
+      // the wheels must be at rest once they could be; a fault the base is restarted into
+      // must stop it again within the time to see it each time.
+      const bool ready = sim.base_health() == hal::BaseHealth::kReady;
+      if (!failing || !ready) {
+        ready_since_us = 0;
+      } else if (ready_since_us == 0) {
+        ready_since_us = now;
+      }
+      if (expected.restarts_into_it) {
+        // (From the restart: the setpoint comes a frame later, the check starts a frame after.)
+        if (ready_since_us != 0 && now - ready_since_us > allowed_us + 20000U) broke_stop = true;
+      } else if (failing && failing_since_us != 0 && now - failing_since_us > allowed_us &&
+                 (ready || (!at_rest && now > rest_due_us(failing_since_us)))) {
         broke_stop = true;
       }
       if (!asked_mid && now >= mid_us) {

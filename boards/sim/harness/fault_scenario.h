@@ -45,6 +45,13 @@ struct FaultExpectation {
   // BaseParams::coast_decel_m_s2 (the fault leaves no closed loop to brake with), else braked
   // in closed loop at brake_decel_m_s2.
   bool coasts = false;
+  // Time the firmware needs to see the fault at all before it can stop (the driver's 1 s
+  // check of a wheel against its setpoint) [µs]; the stop is due within a frame after it.
+  std::uint32_t detect_us = 0;
+  // The fault cannot be seen while the base stands (a jammed wheel, a frozen encoder): the
+  // base task's retry restarts it into the fault, and each time it must stop again within
+  // detect_us (instead of staying stopped).
+  bool restarts_into_it = false;
 };
 inline constexpr std::uint64_t kResetToResumeUs = 500000;
 // The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the

@@ -20,16 +20,20 @@ constexpr std::uint8_t bit(FaultType t) {
   return static_cast<std::uint8_t>(1U << static_cast<unsigned>(t));
 }
 constexpr std::uint8_t kAll = 0x7F;
+// An ODrive axis: heartbeat lost, frozen encoder estimates, axis error, a jammed wheel.
+constexpr std::uint8_t kAxis = bit(FaultType::kOff) | bit(FaultType::kStuck) |
+                               bit(FaultType::kWrong) | bit(FaultType::kSlow) |
+                               bit(FaultType::kIntermittent);
 constexpr std::array<std::uint8_t, kFaultDeviceCount> kApplies = {
-    kAll,                                                                           // camera
-    kAll,                                                                           // ptu
-    bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),  // left
-    bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),  // right
-    bit(FaultType::kOff) | bit(FaultType::kIntermittent),                           // can
-    bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),  // estop
-    bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),  // bumper
-    bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),  // storage
-    bit(FaultType::kStuck) | bit(FaultType::kSlow),                                 // main loop
+    kAll,                                                                             // camera
+    kAll,                                                                             // ptu
+    kAxis,                                                                            // left
+    kAxis,                                                                            // right
+    bit(FaultType::kOff) | bit(FaultType::kDelayed) | bit(FaultType::kIntermittent),  // can
+    bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),    // estop
+    bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),    // bumper
+    bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),    // storage
+    bit(FaultType::kStuck) | bit(FaultType::kSlow),                                   // main loop
 };
 
 void say(char* error, std::size_t size, const char* name, std::size_t line, const char* why,

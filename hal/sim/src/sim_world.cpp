@@ -78,6 +78,11 @@ bool SimWorld::init(const World& world, const stereo::RigModel& rig, const SimPa
   last_base_stop_us_ = 0;
   braking_ = axes_idle_ = false;
   last_rest_us_ = 0;
+  behind_since_us_[0] = behind_since_us_[1] = 0;
+  pending_head_ = pending_count_ = 0;
+  odometry_history_head_ = 0;
+  for (Odometry& o : odometry_history_) o = Odometry{};
+  odometry_given_us_ = 0;
   rim_travel_m_ = rim_travel_at_rest_m_ = 0.0;
   faults_.reset(params.seed);
   const char* model = "";
@@ -157,6 +162,7 @@ void SimWorld::step(std::uint32_t dt_us) {
     }
   }
   faults_.update(now_us_);
+  apply_due_setpoints();
   // PTU faults that act on the axes: a move that never ends (stuck), or at a tenth of its
   // speed (slow).
   FaultType ptu_fault = FaultType::kOff;
@@ -238,8 +244,12 @@ void SimWorld::step_base(float dt_s) {
   const bool was_moving = wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F;
   // Closed loop: towards the setpoint, speeding up at the ramp, slowing at the brake
   // deceleration; idle axes: the wheels coast to rest.
-  const auto follow = [&](float& wheel, float target) {
+  // A jammed wheel (`axis-* slow`) turns at a tenth of what its motor drives it to.
+  const bool jam_left = axis_failing(FaultDevice::kAxisLeft, FaultType::kSlow);
+  const bool jam_right = axis_failing(FaultDevice::kAxisRight, FaultType::kSlow);
+  const auto follow = [&](float& wheel, float target, bool jammed) {
     if (axes_idle_) target = 0.0F;
+    if (jammed) target *= 0.1F;
     const bool slowing = std::fabs(target) < std::fabs(wheel) || target * wheel < 0.0F;
     const float rate = axes_idle_ ? b.coast_decel_m_s2
                        : slowing  ? b.brake_decel_m_s2
@@ -247,8 +257,11 @@ void SimWorld::step_base(float dt_s) {
     const float dv = rate * dt_s;
     wheel += std::clamp(target - wheel, -dv, dv);
   };
-  follow(wheel_left_m_s_, target_left_m_s_);
-  follow(wheel_right_m_s_, target_right_m_s_);
+  follow(wheel_left_m_s_, target_left_m_s_, jam_left);
+  follow(wheel_right_m_s_, target_right_m_s_, jam_right);
+  // Frozen encoder estimates (`axis-* stuck`): the wheel turns, its encoder counts nothing.
+  const bool frozen_left = axis_failing(FaultDevice::kAxisLeft, FaultType::kStuck);
+  const bool frozen_right = axis_failing(FaultDevice::kAxisRight, FaultType::kStuck);
   // What the encoders count (the commanded rims at the odometry's diameters) [m].
   const double el = static_cast<double>(wheel_left_m_s_) * static_cast<double>(dt_s);
   const double er = static_cast<double>(wheel_right_m_s_) * static_cast<double>(dt_s);
@@ -302,8 +315,8 @@ void SimWorld::step_base(float dt_s) {
       contact_ = contact;
       // Wheel odometry from the encoders at the nominal diameters and track (white noise
       // optional).
-      double ol = el;
-      double orr = er;
+      double ol = frozen_left ? 0.0 : el;
+      double orr = frozen_right ? 0.0 : er;
       if (b.odometry_noise > 0.0F) {
         ol *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
         orr *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
@@ -318,12 +331,16 @@ void SimWorld::step_base(float dt_s) {
       odometry_.yaw_rad = std::remainder(odometry_.yaw_rad + odyaw, 6.283185307179586);
     }
   }
-  odometry_.v_m_s = 0.5F * (wheel_left_m_s_ + wheel_right_m_s_);
-  odometry_.omega_rad_s = (wheel_right_m_s_ - wheel_left_m_s_) / b.track_width_m;
+  const float ml = frozen_left ? 0.0F : wheel_left_m_s_;
+  const float mr = frozen_right ? 0.0F : wheel_right_m_s_;
+  odometry_.v_m_s = 0.5F * (ml + mr);
+  odometry_.omega_rad_s = (mr - ml) / b.track_width_m;
   odometry_.timestamp_us = now_us_;
   odometry_.wheels_known = true;
   odometry_.wheel_left_m = wheel_count_left_m_;
   odometry_.wheel_right_m = wheel_count_right_m_;
+  odometry_history_head_ = (odometry_history_head_ + 1) % kOdometryHistory;
+  odometry_history_[odometry_history_head_] = odometry_;
 }
 
 SimWorld::PhysicalState SimWorld::physical_state() const {
@@ -385,15 +402,23 @@ void SimWorld::base_start() {
   odometry_.wheels_known = true;
   odometry_.wheel_left_m = wheel_count_left_m_;
   odometry_.wheel_right_m = wheel_count_right_m_;
+  for (Odometry& o : odometry_history_) o = odometry_;  // a new frame: no past in it
+  odometry_given_us_ = 0;
+  behind_since_us_[0] = behind_since_us_[1] = 0;
+  pending_count_ = 0;
 }
 
 const char* SimWorld::base_fault() const {
   FaultType type = FaultType::kOff;
-  if (faults_.failing(FaultDevice::kCan, type)) {
+  if (faults_.failing(FaultDevice::kCan, type) && type != FaultType::kDelayed) {
     return "base: CAN bus-off (controller stopped transmitting)";
   }
   for (const FaultDevice d : {FaultDevice::kAxisLeft, FaultDevice::kAxisRight}) {
-    if (!faults_.failing(d, type)) continue;
+    // A frozen encoder or a jammed wheel leaves the axis up: the driver sees them only by
+    // the wheel not following its setpoint (check_wheels_follow()).
+    if (!faults_.failing(d, type) || type == FaultType::kStuck || type == FaultType::kSlow) {
+      continue;
+    }
     const bool left = d == FaultDevice::kAxisLeft;
     if (type == FaultType::kWrong) {
       // MOTOR_FAILED in the heartbeat's axis error.
@@ -411,9 +436,75 @@ void SimWorld::base_update() {
   // A brake under way is turned into an idle by an axis or bus fault, as the driver does.
   if (base_health_ == BaseHealth::kStopped && !braking_) return;
   const char* why = base_fault();
-  if (why == nullptr) return;
+  if (why == nullptr) {
+    if (base_health_ == BaseHealth::kReady) check_wheels_follow();
+    return;
+  }
   std::snprintf(base_fault_error_, sizeof base_fault_error_, "%s", why);
   base_stop(base_fault_error_, StopKind::kCoast);
+}
+
+bool SimWorld::axis_failing(FaultDevice device, FaultType type) const {
+  FaultType active = FaultType::kOff;
+  return faults_.failing(device, active) && active == type;
+}
+
+// As the driver's wheel_behind(): a wheel whose measured speed (what its encoder says) stays
+// below follow_ratio of its setpoint for follow_timeout_us stops the base, the axes idled.
+void SimWorld::check_wheels_follow() {
+  const BaseParams& b = params_.base;
+  const float measured[2] = {
+      axis_failing(FaultDevice::kAxisLeft, FaultType::kStuck) ? 0.0F : wheel_left_m_s_,
+      axis_failing(FaultDevice::kAxisRight, FaultType::kStuck) ? 0.0F : wheel_right_m_s_};
+  const float setpoint[2] = {target_left_m_s_, target_right_m_s_};
+  for (int k = 0; k < 2; ++k) {
+    const float want = std::fabs(setpoint[k]);
+    const float got = std::copysign(1.0F, setpoint[k]) * measured[k];
+    if (want < b.follow_min_m_s || got >= b.follow_ratio * want) {
+      behind_since_us_[k] = 0;
+      continue;
+    }
+    if (behind_since_us_[k] == 0) behind_since_us_[k] = now_us_;
+    if (now_us_ - behind_since_us_[k] > b.follow_timeout_us) {
+      base_stop(k == 0 ? "base: left axis: wheel not following its setpoint (0x00000000)"
+                       : "base: right axis: wheel not following its setpoint (0x00000000)",
+                StopKind::kCoast);
+      return;
+    }
+  }
+}
+
+// Setpoints that have crossed a delayed bus take effect (all at once when it is not delayed).
+void SimWorld::apply_due_setpoints() {
+  while (pending_count_ > 0 && pending_[pending_head_].due_us <= now_us_) {
+    const PendingSetpoint& p = pending_[pending_head_];
+    if (base_health_ == BaseHealth::kReady) {
+      target_left_m_s_ = p.left_m_s;
+      target_right_m_s_ = p.right_m_s;
+    }
+    pending_head_ = (pending_head_ + 1) % kPendingSetpoints;
+    --pending_count_;
+  }
+}
+
+Odometry SimWorld::odometry() const {
+  FaultType type = FaultType::kOff;
+  if (!faults_.failing(FaultDevice::kCan, type) || type != FaultType::kDelayed) {
+    odometry_given_us_ = odometry_.timestamp_us;
+    return odometry_;
+  }
+  // The newest sample at least can_delay_us old, never older than one already handed out (a
+  // late estimate does not take the odometry back in time).
+  const std::uint64_t want_us = std::max(
+      odometry_given_us_,
+      now_us_ > params_.base.can_delay_us ? now_us_ - params_.base.can_delay_us : std::uint64_t{0});
+  std::size_t i = odometry_history_head_;
+  for (std::size_t n = 0; n + 1 < kOdometryHistory; ++n) {
+    if (odometry_history_[i].timestamp_us <= want_us) break;
+    i = (i + kOdometryHistory - 1) % kOdometryHistory;
+  }
+  odometry_given_us_ = odometry_history_[i].timestamp_us;
+  return odometry_history_[i];
 }
 
 void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
@@ -423,14 +514,34 @@ void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
   const BaseParams& b = params_.base;
   const float v = std::clamp(v_m_s, -b.max_speed_m_s, b.max_speed_m_s);
   const float w = std::clamp(omega_rad_s, -b.max_turn_rate_rad_s, b.max_turn_rate_rad_s);
-  target_left_m_s_ = v - 0.5F * w * b.track_width_m;
-  target_right_m_s_ = v + 0.5F * w * b.track_width_m;
+  const float left = v - 0.5F * w * b.track_width_m;
+  const float right = v + 0.5F * w * b.track_width_m;
+  FaultType type = FaultType::kOff;
+  const bool delayed = faults_.failing(FaultDevice::kCan, type) && type == FaultType::kDelayed;
+  if (!delayed && pending_count_ == 0) {
+    target_left_m_s_ = left;
+    target_right_m_s_ = right;
+    return;
+  }
+  // Over a delayed bus (or behind setpoints still on their way): in order, can_delay_us late.
+  if (pending_count_ == kPendingSetpoints) {  // full: the oldest arrives now
+    target_left_m_s_ = pending_[pending_head_].left_m_s;
+    target_right_m_s_ = pending_[pending_head_].right_m_s;
+    pending_head_ = (pending_head_ + 1) % kPendingSetpoints;
+    --pending_count_;
+  }
+  PendingSetpoint& p = pending_[(pending_head_ + pending_count_) % kPendingSetpoints];
+  p.due_us = now_us_ + (delayed ? params_.base.can_delay_us : 0U);
+  p.left_m_s = left;
+  p.right_m_s = right;
+  ++pending_count_;
 }
 
 void SimWorld::base_stop(const char* reason, StopKind kind) {
   const bool was_running = base_health_ != BaseHealth::kStopped;
   if (was_running) last_base_stop_us_ = now_us_;
   target_left_m_s_ = target_right_m_s_ = 0.0F;
+  pending_count_ = 0;  // setpoints still on their way are dropped (the sim does not delay a stop)
   if (kind == StopKind::kImmediate) {
     if (wheel_left_m_s_ != 0.0F || wheel_right_m_s_ != 0.0F) {
       last_rest_us_ = now_us_;
@@ -457,6 +568,7 @@ bool SimWorld::base_resume() {
   if (base_fault() != nullptr) return false;  // the axis or the bus is still gone
   if (base_health_ == BaseHealth::kStopped) {
     braking_ = axes_idle_ = false;  // closed loop again (from the wheels' speed now)
+    behind_since_us_[0] = behind_since_us_[1] = 0;
     base_health_ = now_us_ >= base_ready_at_us_ ? BaseHealth::kReady : BaseHealth::kStarting;
     base_error_ = base_health_ == BaseHealth::kReady ? "" : "starting";
   }

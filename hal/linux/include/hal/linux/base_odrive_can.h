@@ -27,7 +27,13 @@ struct BaseOdriveCanConfig {
   // and idles the axes once both measured wheel speeds are below standstill_turns_s, or after
   // brake_timeout_ms at the latest (stop category 1).
   std::uint32_t brake_timeout_ms = 500;
-  float standstill_turns_s = 0.05F;        // [turns/s]
+  float standstill_turns_s = 0.05F;  // [turns/s]
+  // A wheel that does not follow its setpoint (a jammed wheel, or estimates that stopped
+  // changing: a frozen encoder): measured speed in the setpoint's direction below
+  // follow_ratio of a setpoint of at least follow_min_turns_s, for follow_timeout_ms.
+  std::uint32_t follow_timeout_ms = 1000;
+  float follow_min_turns_s = 0.1F;  // [turns/s]
+  float follow_ratio = 0.25F;
   std::uint32_t encoder_timeout_ms = 100;  // no encoder estimate from an axis that long: stop
   bool request_encoder = false;            // send an RTR for Get_Encoder_Estimates every update()
                                            // (when the ODrives do not send it cyclically)
@@ -45,8 +51,9 @@ struct BaseOdriveCanConfig {
 //   or after brake_timeout_ms, Set_Axis_State(IDLE); a heartbeat lost or an axis error while
 //   braking turns it into the next kind;
 // - idled at once (heartbeat lost, axis error, an axis out of closed loop, bus-off, a socket
-//   error, a failed start-up): Set_Input_Vel(0) and Estop; the axes are out of closed loop or
-//   out of reach, so braking cannot work, and both wheels coast.
+//   error, a failed start-up, a wheel not following its setpoint): Set_Input_Vel(0) and
+//   Estop; the axes are out of closed loop or out of reach, or their loop cannot be trusted,
+//   so braking cannot work or help, and both wheels coast.
 // While stopped the final frames (Set_Input_Vel(0) and IDLE or Estop) go to both axes every
 // stop_resend_ms (a stop that could not be sent, e.g. with the link down, is sent once the
 // link is back).
@@ -89,6 +96,7 @@ class BaseOdriveCan final : public hal::Base {
     bool encoder_seen = false;
     bool encoder_fresh = false;
     std::uint64_t last_encoder_us = 0;
+    std::uint64_t behind_since_us = 0;  // not following its setpoint since (0: following)
   };
   void send(const codec::odrive::CanFrame& frame);
   void receive(std::uint64_t now_us);
@@ -105,6 +113,7 @@ class BaseOdriveCan final : public hal::Base {
   bool open_socket();
   bool interface_usable();
   bool encoders_current(std::uint64_t now_us) const;
+  bool wheel_behind(Axis& a, float setpoint_turns_s, std::uint64_t now_us);
 
   BaseOdriveCanConfig config_;
   hal::Clock& clock_;

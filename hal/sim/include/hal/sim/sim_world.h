@@ -39,6 +39,15 @@ struct BaseParams {
   float brake_decel_m_s2 = 1.0F;
   float coast_decel_m_s2 = 0.2F;
   std::uint32_t brake_timeout_us = 500000;
+  // The driver's check of a wheel against its setpoint (BaseOdriveCanConfig follow_*): a
+  // measured speed below follow_ratio of a setpoint of at least follow_min_m_s for
+  // follow_timeout_us stops the base, the axes idled.
+  std::uint32_t follow_timeout_us = 1000000;
+  float follow_min_m_s = 0.05F;
+  float follow_ratio = 0.25F;
+  // `can delayed`: every setpoint reaches the axes, and every encoder estimate the firmware,
+  // this late [µs].
+  std::uint32_t can_delay_us = 50000;
   // Odometry errors of a real base (Borenstein & Feng 1996, UMBmark): what the wheels do
   // against what the odometry assumes. The encoders count the commanded wheel turns; the
   // ground moves by the true diameters and track. 1, 1, 1, 0, 0 is perfect odometry.
@@ -133,7 +142,8 @@ class SimWorld {
   double rim_travel_m() const { return rim_travel_m_; }
   double rim_travel_at_rest_m() const { return rim_travel_at_rest_m_; }
   const char* base_error() const { return base_error_; }
-  Odometry odometry() const { return odometry_; }
+  // The odometry as the firmware has it (with `can delayed`, can_delay_us old).
+  Odometry odometry() const;
   // The true pose at which the odometry frame was fixed (the last base start).
   core::Pose2 odometry_origin() const { return odometry_origin_; }
 
@@ -211,6 +221,23 @@ class SimWorld {
   bool axes_idle_ = false;
   std::uint64_t brake_deadline_us_ = 0;
   std::uint64_t last_rest_us_ = 0;
+  std::uint64_t behind_since_us_[2] = {0, 0};  // a wheel behind its setpoint since (0: not)
+  // Setpoints on their way over a delayed bus, and the odometry's recent past (one sample
+  // per physics step) for estimates that arrive late.
+  struct PendingSetpoint {
+    std::uint64_t due_us = 0;
+    float left_m_s = 0.0F, right_m_s = 0.0F;
+  };
+  static constexpr std::size_t kPendingSetpoints = 32;
+  PendingSetpoint pending_[kPendingSetpoints] = {};
+  std::size_t pending_head_ = 0, pending_count_ = 0;
+  static constexpr std::size_t kOdometryHistory = 128;
+  Odometry odometry_history_[kOdometryHistory] = {};
+  std::size_t odometry_history_head_ = 0;
+  mutable std::uint64_t odometry_given_us_ = 0;  // the newest sample handed out
+  bool axis_failing(FaultDevice device, FaultType type) const;
+  void apply_due_setpoints();
+  void check_wheels_follow();
   double rim_travel_m_ = 0.0;
   double rim_travel_at_rest_m_ = 0.0;
   char base_fault_error_[96] = {};
