@@ -204,3 +204,44 @@ TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {
   board->describe_active(reply);
   STRCMP_EQUAL("", reply.c_str());
 }
+
+// A short soak (the bench's `soak` runs 2 h): random faults the robot rides out, the operator's
+// resets, and at every quiet check the state file holding the last submitted state; every
+// kCorruptEvery-th check damages the newest copy and the store must fall back to the
+// previous one.
+TEST(Faults, AShortSoakLosesNoStateAndFallsBackFromADamagedNewestCopy) {
+  boticelli::hal::sim::PlanGeneratorConfig plan_config;
+  plan_config.seed = 3;
+  plan_config.run_s = 150.0;
+  plan_config.warmup_s = 5.0;
+  plan_config.max_duration_s = 6.0;
+  plan_config.count = 20;
+  static boticelli::hal::sim::FaultPlan plan;
+  boticelli::hal::sim::generate_fault_plan(plan_config, plan);
+  AllocationWindow window;
+  FaultScenarioConfig config;
+  config.world_file = world.c_str();
+  config.state_dir = dir.c_str();
+  config.seed = 3;
+  config.camera_fps = 1.0F;
+  config.loop_started = start_counting;
+  config.loop_ended = stop_counting;
+  config.context = &window;
+  static boticelli::boards::sim::FaultSoakResult r;
+  CHECK_TEXT(boticelli::boards::sim::run_fault_soak(*board, plan, plan_config.run_s, config, r),
+             r.error);
+  char summary[400];
+  std::snprintf(summary, sizeof summary,
+                "quiet_checks=%u unsafe=%u (%s) not_current=%u corruptions=%u recovered=%u "
+                "loads_failed=%u stop_violations=%llu",
+                r.quiet_checks, r.ended_unsafe, r.first_unsafe, r.state_not_current, r.corruptions,
+                r.corruptions_recovered, r.state_loads_failed,
+                static_cast<unsigned long long>(r.stop_violations));
+  std::printf("\nshort soak: %s\n", summary);
+  CHECK_TEXT(r.quiet_checks >= 2U * boticelli::boards::sim::kCorruptEvery, summary);
+  CHECK_TEXT(r.ended_unsafe == 0U && r.state_not_current == 0U && r.state_loads_failed == 0U,
+             summary);
+  CHECK_TEXT(r.corruptions >= 2U && r.corruptions_recovered == r.corruptions, summary);
+  CHECK_TEXT(r.stop_violations == 0U, summary);
+  UNSIGNED_LONGS_EQUAL_TEXT(0U, window.allocations, "heap allocations during the soak");
+}

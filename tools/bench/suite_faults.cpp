@@ -199,7 +199,9 @@ std::string seen_text(const FaultExpectation& e, const FaultScenarioResult& r) {
     std::snprintf(buf, sizeof buf, "; saves %llu ok, %llu failed, file %s",
                   static_cast<unsigned long long>(r.saves),
                   static_cast<unsigned long long>(r.save_failures),
-                  r.state_loadable ? "loads" : "DOES NOT LOAD");
+                  !r.state_loadable ? "DOES NOT LOAD"
+                  : r.state_current ? "loads with the last submitted state"
+                                    : "loads but LOST the last submitted state");
     s += buf;
   }
   if (r.frame_overruns > 0) {
@@ -301,6 +303,7 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
           .flag("moving_after", g_result.moving_after)
           .integer("watchdog_expirations", g_result.watchdog_expirations)
           .integer("save_failures", static_cast<std::int64_t>(g_result.save_failures))
+          .flag("state_current", g_result.state_current)
           .text("mission_result", m.result.c_str())
           .text("mission_reason", m.reason.c_str())
           .integer("mission_collisions", m.collisions)

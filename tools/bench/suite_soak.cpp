@@ -118,7 +118,9 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
   }
   const boards::sim::FaultSoakResult& r = g_result;
   const bool ok = g_allocations == 0 && r.ended_unsafe == 0 && r.stop_violations == 0 &&
-                  r.collisions == 0 && r.state_loads_failed == 0 && r.faults_ended > 0;
+                  r.collisions == 0 && r.state_loads_failed == 0 && r.state_not_current == 0 &&
+                  r.corruptions > 0 && r.corruptions_recovered == r.corruptions &&
+                  r.faults_ended > 0;
   JsonLine("soak", "run")
       .integer("seed", static_cast<std::int64_t>(plan_config.seed))
       .num("sim_s", r.sim_s)
@@ -138,6 +140,9 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
       .integer("saves", static_cast<std::int64_t>(r.saves))
       .integer("save_failures", static_cast<std::int64_t>(r.save_failures))
       .integer("state_loads_failed", r.state_loads_failed)
+      .integer("state_not_current", r.state_not_current)
+      .integer("corruptions", r.corruptions)
+      .integer("corruptions_recovered", r.corruptions_recovered)
       .integer("frame_overruns", static_cast<std::int64_t>(r.frame_overruns))
       .integer("missed_frames", static_cast<std::int64_t>(r.missed_frames))
       .integer("worst_jitter_us", r.worst_jitter_us)

@@ -2,6 +2,10 @@
 // one injected fault, measured frame by frame (see fault_scenario.h).
 #include "fault_scenario.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -319,6 +323,22 @@ bool wheels_at_rest(const hal::sim::SimWorld& sim) {
   return sim.wheel_speed_m_s() < 1e-6F;
 }
 
+// Flips every bit of the byte in the middle of `path` (a damaged copy); false when it cannot.
+// POSIX calls only: nothing allocates.
+bool flip_middle_byte(const char* path) {
+  const int fd = ::open(path, O_RDWR | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat st {};
+  bool ok = ::fstat(fd, &st) == 0 && st.st_size > 0;
+  unsigned char byte = 0;
+  const off_t at = ok ? st.st_size / 2 : 0;
+  ok = ok && ::pread(fd, &byte, 1, at) == 1;
+  byte = static_cast<unsigned char>(byte ^ 0xFFU);
+  ok = ok && ::pwrite(fd, &byte, 1, at) == 1;
+  ::close(fd);
+  return ok;
+}
+
 bool contains(std::string_view text, const char* what) {
   return what[0] == '\0' || text.find(what) != std::string_view::npos;
 }
@@ -559,6 +579,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
     const fw::LoadResult loaded = g_store.load(g_loaded, error, sizeof error);
     out.state_loadable =
         loaded == fw::LoadResult::kLoaded || (loaded == fw::LoadResult::kMissing && out.saves == 0);
+    out.state_current =
+        out.saves == 0 || (loaded == fw::LoadResult::kLoaded && g_loaded == rig.state);
   }
   const std::string_view text = rig.port.written();
   const std::size_t n = text.size() < out.console.size() - 1 ? text.size() : out.console.size() - 1;
@@ -566,7 +588,7 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   out.console[n] = '\0';
   out.says_expected = contains(text, expected.console_says);
   // The verdict, on everything the expectation names.
-  bool ok = out.collisions == 0 && out.state_loadable && out.says_expected;
+  bool ok = out.collisions == 0 && out.state_loadable && out.state_current && out.says_expected;
   if (expected.stops_base) {
     ok = ok && out.moving_before && out.stayed_stopped && out.stop_latency_ms >= 0.0 &&
          out.stop_latency_ms * 1e3 <= static_cast<double>(allowed_us) && out.stop_time_ms >= 0.0 &&
@@ -671,19 +693,33 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
         rig.runtime.executive.all_healthy() && rig.runtime.console->storage_healthy();
     const bool moving = !wheels_at_rest(sim);
     bool loads = true;
+    bool current = true;
     if (config.state_dir != nullptr && rig.runtime.saver.saved() > 0) {
       char error[256] = "";
       loads = g_store.load(g_loaded, error, sizeof error) == fw::LoadResult::kLoaded;
       if (!loads) ++out.state_loads_failed;
+      // Nothing lost: the newest copy is the last state submitted (every save since the
+      // fault ended went through).
+      current = loads && g_loaded == rig.state;
+      if (loads && !current) ++out.state_not_current;
+      if (current && out.quiet_checks % kCorruptEvery == 0) {
+        // A damaged newest copy: the other one, the previous submission, must load.
+        ++out.corruptions;
+        if (flip_middle_byte(g_store.loaded_path()) &&
+            g_store.load(g_loaded, error, sizeof error) == fw::LoadResult::kLoaded &&
+            g_store.load_warning()[0] != '\0' && g_loaded.cycle + 1 == rig.state.cycle) {
+          ++out.corruptions_recovered;
+        }
+      }
     }
-    if (healthy && moving && loads) {
+    if (healthy && moving && loads && current) {
       ++out.ended_safe;
     } else {
       if (out.ended_unsafe == 0) {
         fw::TextBuffer<200> what;
-        what.appendf("t_s=%.1f moving=%d state_loads=%d storage=%d",
+        what.appendf("t_s=%.1f moving=%d state_loads=%d state_current=%d storage=%d",
                      static_cast<double>(now) * 1e-6, moving ? 1 : 0, loads ? 1 : 0,
-                     rig.runtime.console->storage_healthy() ? 1 : 0);
+                     current ? 1 : 0, rig.runtime.console->storage_healthy() ? 1 : 0);
         for (std::size_t i = 0; i < rig.runtime.executive.task_count(); ++i) {
           if (const char* why = rig.runtime.executive.task_health(i); why != nullptr) {
             what.appendf(" %s: %s", rig.runtime.executive.spec(i).name, why);

@@ -116,6 +116,8 @@ struct FaultScenarioResult {
   std::uint64_t saves = 0;
   std::uint64_t save_failures = 0;
   bool state_loadable = true;  // the state file loads at the end (when there is one)
+  // ... and holds the last state the stand-in submitted (nothing lost once saves work again).
+  bool state_current = true;
   // Met the expectation in every respect it names.
   bool passed = false;
 };
@@ -142,6 +144,13 @@ struct FaultSoakResult {
   std::uint64_t saves = 0;
   std::uint64_t save_failures = 0;
   std::uint32_t state_loads_failed = 0;  // the state file did not load at a quiet check
+  // The state file loaded at a quiet check but did not hold the last submitted state.
+  std::uint32_t state_not_current = 0;
+  // Every kCorruptEvery-th quiet check flips a byte in the newest copy: the store must then
+  // load the other copy (the previous submission, with a warning), and the next save
+  // replaces the damaged one (the next quiet check finds the newest state again).
+  std::uint32_t corruptions = 0;
+  std::uint32_t corruptions_recovered = 0;
   std::uint64_t frame_overruns = 0;
   std::uint64_t missed_frames = 0;
   std::uint32_t worst_jitter_us = 0;
@@ -149,6 +158,7 @@ struct FaultSoakResult {
   std::uint64_t console_dropped_bytes = 0;
   std::uint32_t watchdog_expirations = 0;
 };
+inline constexpr std::uint32_t kCorruptEvery = 8;
 bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run_s,
                     const FaultScenarioConfig& config, FaultSoakResult& out);
 

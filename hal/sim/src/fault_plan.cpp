@@ -299,7 +299,8 @@ void generate_fault_plan(const PlanGeneratorConfig& config, FaultPlan& out) {
                              (device == FaultDevice::kCamera &&
                               (type == FaultType::kIntermittent || type == FaultType::kSlow ||
                                type == FaultType::kDelayed)) ||
-                             (device == FaultDevice::kMainLoop && type == FaultType::kSlow);
+                             (device == FaultDevice::kMainLoop && type == FaultType::kSlow) ||
+                             (device == FaultDevice::kCan && type == FaultType::kDelayed);
       if (!rides_out && !config.include_terminal) continue;
       pairs[pair_count].device = device;
       pairs[pair_count].type = type;
