@@ -179,7 +179,10 @@ std::string seen_text(const FaultExpectation& e, const FaultScenarioResult& r) {
   std::string s;
   if (r.stop_latency_ms >= 0.0) {
     std::snprintf(buf, sizeof buf, "base stopped commanding after %.0f ms%s; ", r.stop_latency_ms,
-                  r.stayed_stopped ? ", stayed stopped" : ", moved again during it");
+                  e.restarts_into_it
+                      ? (r.stayed_stopped ? ", stopped again after each restart"
+                                          : ", drove on after a restart")
+                      : (r.stayed_stopped ? ", stayed stopped" : ", moved again during it"));
   } else {
     std::snprintf(buf, sizeof buf, "base %s; ", r.moving_before ? "kept moving" : "was not moving");
   }
