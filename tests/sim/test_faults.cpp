@@ -127,7 +127,8 @@ FAULT_PAIR(TheLeftAxisLosingItsHeartbeatStopsTheBaseWithinAFrameAndTheRetryResta
            kOff)
 FAULT_PAIR_MORE(AnErrorOfTheLeftAxisStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kAxisLeft,
                 kWrong)
-FAULT_PAIR(AFrozenLeftEncoderIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisLeft, kStuck)
+FAULT_PAIR_MORE(AFrozenLeftEncoderIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisLeft,
+                kStuck)
 FAULT_PAIR_MORE(AJammedLeftWheelIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisLeft, kSlow)
 FAULT_PAIR_MORE(TheLeftAxisHeartbeatComingAndGoingStopsTheBaseInEveryGap, kAxisLeft, kIntermittent)
 FAULT_PAIR_MORE(TheRightAxisLosingItsHeartbeatStopsTheBaseWithinAFrameAndTheRetryRestartsIt,
@@ -136,7 +137,7 @@ FAULT_PAIR_MORE(AnErrorOfTheRightAxisStopsTheBaseWithinAFrameAndTheRetryRestarts
                 kWrong)
 FAULT_PAIR_MORE(AFrozenRightEncoderIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisRight,
                 kStuck)
-FAULT_PAIR(AJammedRightWheelIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisRight, kSlow)
+FAULT_PAIR_MORE(AJammedRightWheelIsSeenAsAWheelNotFollowingAndTheAxesCoastToRest, kAxisRight, kSlow)
 FAULT_PAIR_MORE(TheRightAxisHeartbeatComingAndGoingStopsTheBaseInEveryGap, kAxisRight,
                 kIntermittent)
 FAULT_PAIR_MORE(ACanBusOffStopsTheBaseWithinAFrameAndTheRetryRestartsIt, kCan, kOff)
@@ -208,8 +209,12 @@ TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {
 // A short soak (the bench's `soak` runs 2 h): random faults the robot rides out, the operator's
 // resets, and at every quiet check the state file holding the last submitted state; every
 // kCorruptEvery-th check damages the newest copy and the store must fall back to the
-// previous one.
+// previous one. Ignored under the sanitizers (BOTICELLI_FAULTS_QUICK) like most pairs.
+#ifdef BOTICELLI_FAULTS_QUICK
+IGNORE_TEST(Faults, AShortSoakLosesNoStateAndFallsBackFromADamagedNewestCopy) {
+#else
 TEST(Faults, AShortSoakLosesNoStateAndFallsBackFromADamagedNewestCopy) {
+#endif
   boticelli::hal::sim::PlanGeneratorConfig plan_config;
   plan_config.seed = 3;
   plan_config.run_s = 150.0;
