@@ -507,6 +507,7 @@ TEST(BaseOdriveCan, TheWheelCountersAreTheOdrivesPositionsAsForwardTravelAndOutl
   rig.cycle();
   DOUBLES_EQUAL(left_before, rig.base->odometry().wheel_left_m, 0.006);
   DOUBLES_EQUAL(rig.emu.pos_turns(kLeft) * per_turn, rig.base->odometry().wheel_left_m, 1e-6);
+}
 
 TEST(BaseOdriveCan, AJammedWheelStopsTheBaseAfterTheFollowTimeAndIdlesBothAxes) {
   Rig rig(Rig::emu_config());
