@@ -177,9 +177,15 @@ TEST(SimBoard, ARestartedBoardPutsTheRobotWhereTheWorldLeftItRollingUntilTheWatc
   // The firmware believed itself at its start: the board goes by the world's file instead.
   CHECK_TEXT(board->place_robot({0.0F, 0.0F, 0.0F}, g_error, sizeof g_error), g_error);
   const auto now = board->sim().physical_state();
-  // Rolled on for the watchdog's 0.2 s at 0.2 m/s, then stopped: 4 cm further, straight on.
+  // Rolled on for the watchdog's 0.2 s at 0.2 m/s, then coasted to rest with the axes idle
+  // (v²/2a at the coasting deceleration): 0.04 + 0.1 m further, straight on.
+  const auto& base = board->sim().params().base;
+  const double v = left.wheel_left_m_s;
+  const double expected = v * static_cast<double>(base.command_timeout_us) * 1e-6 +
+                          v * v / (2.0 * static_cast<double>(base.coast_decel_m_s2));
   const double rolled = std::hypot(now.x_m - left.x_m, now.y_m - left.y_m);
-  DOUBLES_EQUAL(0.04, rolled, 0.005);
+  DOUBLES_EQUAL(0.14, expected, 0.005);
+  DOUBLES_EQUAL(expected, rolled, 0.005);
   DOUBLES_EQUAL(left.yaw_rad, now.yaw_rad, 1e-6);
   CHECK_EQUAL(0.0F, now.wheel_left_m_s);
   CHECK_EQUAL(0.0F, now.wheel_right_m_s);
