@@ -2,6 +2,8 @@
 // device_tasks.h).
 #include "firmware/app/device_tasks.h"
 
+#include <algorithm>
+
 namespace boticelli::firmware {
 
 void CameraTask::run(std::uint64_t now_us) {
@@ -107,20 +109,37 @@ const char* led_pattern_name(LedPattern pattern) {
 
 void BaseTask::run(std::uint64_t now_us) {
   base_.update();
-  if (base_.health() != hal::BaseHealth::kStopped || safety_.holds()) {
+  const bool stopped = base_.health() == hal::BaseHealth::kStopped;
+  if (!stopped) {
+    if (running_since_us_ == 0) running_since_us_ = now_us != 0 ? now_us : 1;
+    if (now_us - running_since_us_ >= kStableUs) {
+      interval_us_ = kRetryIntervalUs;  // well again: the next fault starts at a second
+      quick_restops_ = 0;
+      resumed_ = false;
+    }
+  } else if (running_since_us_ != 0) {
+    running_since_us_ = 0;
+    // Restarted by our retry and stopped again before it ran for kStableUs: past a few such
+    // restarts (an intermittent fault that ends soon), back off.
+    if (resumed_ && ++quick_restops_ > kGraceRestarts) {
+      interval_us_ = std::min(2 * interval_us_, kMaxRetryIntervalUs);
+    }
+    resumed_ = false;
+  }
+  if (!stopped || safety_.holds()) {
     retry_at_us_ = 0;  // running, starting, or the operator's to restart
     return;
   }
   if (retry_at_us_ == 0) {
-    retry_at_us_ = now_us + kRetryIntervalUs;  // the first try a second after the stop
+    retry_at_us_ = now_us + interval_us_;  // the first try a while after the stop
     return;
   }
   if (now_us < retry_at_us_) return;
   // Refused while the fault lasts (a lost heartbeat, bus-off); else the start-up sequence runs
   // and the base is ready again with no velocity commanded.
-  (void)base_.resume();
+  resumed_ = base_.resume() && base_.health() != hal::BaseHealth::kStopped;
   ++retries_;
-  retry_at_us_ = now_us + kRetryIntervalUs;
+  retry_at_us_ = now_us + interval_us_;
 }
 
 void WatchdogTask::run(std::uint64_t now_us) {

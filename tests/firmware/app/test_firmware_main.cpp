@@ -18,7 +18,9 @@
 #include "child_process.h"
 #include "fake_clock.h"
 #include "fake_serial_port.h"
+#include "firmware/app/device_tasks.h"
 #include "firmware/app/firmware_main.h"
+#include "firmware/safety/safety.h"
 #include "firmware/state/persistence.h"
 #include "firmware_fakes.h"
 
@@ -571,6 +573,48 @@ TEST(FirmwareMain, ABaseThatCannotBeRestartedIsRetriedEverySecondThenGivenUpForA
   CHECK(store.open(dir.c_str(), error, sizeof error));
   CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
   CHECK(state.end == MissionEnd::kRunning);
+}
+
+// A base restarted into the same fault (accepted, stopped again half a second later: a
+// jammed wheel, an intermittent bus) is retried a second after each stop three times more (an
+// intermittent fault that ends soon), then 2, 4, 8, 8 s after each stop; once it runs 10 s
+// the next stop is retried after a second again.
+TEST(FirmwareMain, ABaseRestartedIntoTheSameFaultIsRetriedLessAndLessOftenUntilItRunsAgain) {
+  FakeInput estop, bumper;
+  FakeBase base;
+  boticelli::firmware::Safety safety{estop, bumper, base};
+  boticelli::firmware::BaseTask task{base, safety};
+  std::vector<double> resumes_s;
+  std::uint64_t stop_at_us = 0;
+  base.stop();
+  int calls = 0;
+  for (std::uint64_t t = 10000; t <= 40000000; t += 10000) {
+    if (stop_at_us != 0 && t >= stop_at_us) {
+      base.stop();  // the fault is still there
+      stop_at_us = 0;
+    }
+    task.run(t);
+    if (base.resume_calls != calls) {
+      calls = base.resume_calls;
+      resumes_s.push_back(static_cast<double>(t) * 1e-6);
+      stop_at_us = t + 500000;
+    }
+  }
+  CHECK(resumes_s.size() >= 8);
+  const double expected_gaps[] = {1.5, 1.5, 1.5, 2.5, 4.5, 8.5, 8.5};  // 0.5 s running, then
+  for (std::size_t i = 0; i + 1 < resumes_s.size() && i < 7; ++i) {
+    DOUBLES_EQUAL(expected_gaps[i], resumes_s[i + 1] - resumes_s[i], 0.011);
+  }
+  DOUBLES_EQUAL(1.0, resumes_s[0] - 0.01, 0.011);  // the first a second after the stop
+  // Well again: runs 10 s, then a new stop is retried after a second.
+  std::uint64_t t = 40000000;
+  for (; t <= 62000000; t += 10000) task.run(t);  // the next retry (8 s at most), 10 s running
+  CHECK(base.health() != boticelli::hal::BaseHealth::kStopped);
+  CHECK_EQUAL(boticelli::firmware::BaseTask::kRetryIntervalUs, task.retry_interval_us());
+  base.stop();
+  const int before = base.resume_calls;
+  for (std::uint64_t end = t + 1000000; t <= end; t += 10000) task.run(t);
+  CHECK_EQUAL(before + 1, base.resume_calls);
 }
 
 namespace {

@@ -30,12 +30,23 @@ class EstopTask final : public Task {
 // again (Base::resume, the drivers' start-up sequence) every retry interval while the latch
 // does not hold it: the fault policy (docs/reliability.md) holds the robot stopped and
 // retries the device; only the mission commands motion after that, and it looks first.
+// The base's retry after it stopped by itself: resume() a second after the stop and every
+// second while it is refused (the fault lasts). Past kGraceRestarts resumes that were
+// accepted but followed by another stop within kStableUs (a jammed wheel, an intermittent bus
+// that does not end: the base is restarted into the same fault), each such stop doubles the
+// wait, up to kMaxRetryIntervalUs; a base that runs kStableUs without stopping is well again
+// and the wait is back to a second.
 class BaseTask final : public Task {
  public:
   static constexpr std::uint64_t kRetryIntervalUs = 1000000;
+  static constexpr std::uint64_t kMaxRetryIntervalUs = 8000000;
+  static constexpr std::uint64_t kStableUs = 10000000;
+  static constexpr int kGraceRestarts = 3;
   BaseTask(hal::Base& base, const Safety& safety) : base_(base), safety_(safety) {}
   void run(std::uint64_t now_us) override;
   std::uint64_t retries() const { return retries_; }
+  // The wait before the next retry once the base stops (grows with restarts into a fault).
+  std::uint64_t retry_interval_us() const { return interval_us_; }
   bool healthy() const override {
     return base_.health() != hal::BaseHealth::kStopped || safety_.holds();
   }
@@ -49,6 +60,10 @@ class BaseTask final : public Task {
   const Safety& safety_;
   std::uint64_t retry_at_us_ = 0;  // 0: not stopped by itself
   std::uint64_t retries_ = 0;
+  std::uint64_t interval_us_ = kRetryIntervalUs;
+  std::uint64_t running_since_us_ = 0;  // 0: stopped
+  bool resumed_ = false;                // the last retry was accepted (the base restarted)
+  int quick_restops_ = 0;               // restarts stopped again within kStableUs
 };
 
 // Services the PTU; unhealthy while the unit reports a fault, or while a move has not
