@@ -18,8 +18,8 @@ using hal::sim::FaultDevice;
 using hal::sim::FaultType;
 
 // The state directory's faults at the firmware's file calls: off = unwritable (EACCES when
-// the temporary file is created), wrong = full (ENOSPC on a write), intermittent = I/O
-// errors (EIO on a write) in its failing slots.
+// the temporary file is created), stuck = a read-only file system (EROFS there), wrong = full
+// (ENOSPC on a write), intermittent = I/O errors (EIO on a write) in its failing slots.
 int storage_fault(firmware::StorageCall call, void* context) {
   const auto* world = static_cast<const hal::sim::SimWorld*>(context);
   FaultType type = FaultType::kOff;
@@ -27,6 +27,8 @@ int storage_fault(firmware::StorageCall call, void* context) {
   switch (type) {
     case FaultType::kOff:
       return call == firmware::StorageCall::kCreate ? EACCES : 0;
+    case FaultType::kStuck:  // a read-only file system (a card remounted read-only)
+      return call == firmware::StorageCall::kCreate ? EROFS : 0;
     case FaultType::kWrong:
       return call == firmware::StorageCall::kWrite ? ENOSPC : 0;
     case FaultType::kIntermittent:

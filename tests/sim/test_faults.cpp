@@ -152,6 +152,7 @@ FAULT_PAIR_MORE(AStuckBumperStopsTheBaseForGood, kBumper, kStuck)
 FAULT_PAIR_MORE(AChatteringBumperStopsTheBaseForGood, kBumper, kIntermittent)
 FAULT_PAIR_MORE(AnUnwritableStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kOff)
 FAULT_PAIR(AFullStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kWrong)
+FAULT_PAIR_MORE(AReadOnlyStateDirectoryIsReportedAndTheLastGoodFileStays, kStorage, kStuck)
 FAULT_PAIR_MORE(StateSavesFailingNowAndThenAreReportedAndTheLastGoodFileStays, kStorage,
                 kIntermittent)
 FAULT_PAIR_MORE(AStalledMainLoopIsCaughtByTheOdrivesWatchdogAndTheBaseRestartedAfter, kMainLoop,

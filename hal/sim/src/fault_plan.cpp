@@ -32,7 +32,8 @@ constexpr std::array<std::uint8_t, kFaultDeviceCount> kApplies = {
     bit(FaultType::kOff) | bit(FaultType::kDelayed) | bit(FaultType::kIntermittent),  // can
     bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),    // estop
     bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),    // bumper
-    bit(FaultType::kOff) | bit(FaultType::kWrong) | bit(FaultType::kIntermittent),    // storage
+    bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kWrong) |
+        bit(FaultType::kIntermittent),  // storage
     bit(FaultType::kStuck) | bit(FaultType::kSlow),                                   // main loop
 };
 
