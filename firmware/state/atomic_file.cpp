@@ -100,7 +100,9 @@ bool write_file_atomically(const char* dir, const char* name, std::string_view d
       return false;
     }
   }
-  if (::fsync(fd) != 0) {
+  const int sync_fault = injected(StorageCall::kSync);
+  if (sync_fault != 0) errno = sync_fault;
+  if (sync_fault != 0 || ::fsync(fd) != 0) {
     set_error(error, error_size, "cannot sync", tmp_path.data());
     ::close(fd);
     ::unlink(tmp_path.data());

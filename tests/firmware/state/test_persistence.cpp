@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cerrno>
+#include <condition_variable>
 #include <cstdint>
 #include <cmath>
 #include <cstdio>
@@ -15,8 +17,10 @@
 #include <cstring>
 #include <ctime>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <tuple>
 
 #include "firmware/state/mission_state.h"
@@ -698,6 +702,49 @@ TEST(Persistence, AKilledRunResumesWithNothingLostAndNothingCorrupt) {
   CHECK(last_loaded >= 6U);
 }
 
+namespace {
+// Counts a save's storage calls in their order; fails the temporary file's sync with EIO when
+// asked.
+struct SyncWatch {
+  int writes = 0;
+  int syncs = 0;
+  int writes_after_sync = 0;
+  bool fail = false;
+};
+int watch_syncs(StorageCall call, void* context) {
+  auto* w = static_cast<SyncWatch*>(context);
+  if (call == StorageCall::kWrite) {
+    ++w->writes;
+    if (w->syncs > 0) ++w->writes_after_sync;
+  }
+  if (call != StorageCall::kSync) return 0;
+  ++w->syncs;
+  return w->fail ? EIO : 0;
+}
+}  // namespace
+
+TEST(Persistence, ASaveSyncsTheWholeTemporaryFileBeforeTheRenameAndAFailedSyncKeepsTheOldState) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static SyncWatch watch;
+  watch = {};
+  set_storage_fault_hook(watch_syncs, &watch);
+  make_state(7, g_a);
+  CHECK(g_store.save(g_a, error, sizeof error));
+  CHECK(watch.writes >= 1);
+  CHECK_EQUAL(1, watch.syncs);
+  CHECK_EQUAL(0, watch.writes_after_sync);
+  // Unsynced data must never replace a state: after a power cut it may read back empty.
+  watch.fail = true;
+  make_state(8, g_b);
+  CHECK_FALSE(g_store.save(g_b, error, sizeof error));
+  STRCMP_CONTAINS("cannot sync", error);
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK(access((dir + "/mission.state.a.tmp").c_str(), F_OK) != 0);
+  CHECK(access((dir + "/mission.state.b.tmp").c_str(), F_OK) != 0);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+
 TEST(Persistence, WithoutItsThreadTheSaverWritesEachStateAtOnce) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   auto owner = std::make_unique<StateSaver>(g_store);
@@ -771,6 +818,90 @@ TEST(Persistence, TheWriterThreadRetriesAFailedSaveWithoutANewSubmission) {
   }
   set_storage_fault_hook(nullptr, nullptr);
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+namespace {
+// Holds the writer thread inside a save: the first creation of a temporary file waits until
+// the test opens the gate (later ones pass).
+struct SaveGate {
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool entered = false;
+  bool open = false;
+  void wait_entered() {
+    std::unique_lock<std::mutex> lock(mutex);
+    changed.wait(lock, [this] { return entered; });
+  }
+  // Opens the gate after `ms` from another thread (what the test does meanwhile is blocked).
+  std::thread open_after_ms(int ms) {
+    return std::thread([this, ms] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        open = true;
+      }
+      changed.notify_all();
+    });
+  }
+};
+int gate_creates(StorageCall call, void* context) {
+  auto* g = static_cast<SaveGate*>(context);
+  if (call != StorageCall::kCreate) return 0;
+  std::unique_lock<std::mutex> lock(g->mutex);
+  g->entered = true;
+  g->changed.notify_all();
+  g->changed.wait(lock, [g] { return g->open; });
+  return 0;
+}
+}  // namespace
+
+TEST(Persistence, FlushReturnsOnlyOnceTheSaveTheWriterIsMakingIsOnDisk) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static SaveGate gate;
+  gate.entered = false;
+  gate.open = false;
+  set_storage_fault_hook(gate_creates, &gate);
+  std::uint64_t saved_at_flush = 0;
+  {
+    auto owner = std::make_unique<StateSaver>(g_store);
+    StateSaver& saver = *owner;
+    saver.start();
+    make_state(9, g_a);
+    CHECK(saver.submit(g_a));
+    gate.wait_entered();  // the writer took the state: nothing is pending, the save is under way
+    std::thread opener = gate.open_after_ms(100);
+    saver.flush();
+    saved_at_flush = saver.saved();
+    opener.join();
+  }
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK_EQUAL(1U, saved_at_flush);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+
+TEST(Persistence, AStateSubmittedWhileTheWriterIsSavingIsWrittenBeforeTheSaverIsDestroyed) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static SaveGate gate;
+  gate.entered = false;
+  gate.open = false;
+  set_storage_fault_hook(gate_creates, &gate);
+  auto owner = std::make_unique<StateSaver>(g_store);
+  owner->start();
+  make_state(10, g_a);
+  CHECK(owner->submit(g_a));
+  gate.wait_entered();  // state 10 is being saved
+  make_state(11, g_a);
+  while (!owner->submit(g_a)) {
+  }
+  // No flush (an exit path that skips it): the destructor stops the writer while it is still
+  // in the first save, with state 11 pending. The gate opens well after the stop is asked for.
+  std::thread opener = gate.open_after_ms(100);
+  owner.reset();
+  opener.join();
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK_EQUAL(11U, g_b.cycle);
   CHECK(g_a == g_b);
 }
 #endif

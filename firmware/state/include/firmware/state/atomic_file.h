@@ -19,8 +19,9 @@ enum class SaveStep : std::uint8_t {
 using SaveCrashHook = bool (*)(SaveStep step, void* context);
 
 // The system calls a board's fault injection can make fail (the sim board's storage faults:
-// a full or unwritable state directory, docs/reliability.md).
-enum class StorageCall : std::uint8_t { kCreate, kWrite };
+// a full or unwritable state directory, docs/reliability.md; kSync, the temporary file's
+// fsync before the rename, lets tests see that the data is synced before it replaces the file).
+enum class StorageCall : std::uint8_t { kCreate, kWrite, kSync };
 // Returns 0 to let the call run, or the errno it fails with instead (EACCES, ENOSPC, EIO).
 using StorageFaultHook = int (*)(StorageCall call, void* context);
 // Installs the process-wide hook (nullptr: none, the default). Set by a board at init,
