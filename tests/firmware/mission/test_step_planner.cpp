@@ -1,7 +1,9 @@
 // Tests of the StepPlanner: the step's outcome on hand-made polygons and maps (turning round,
 // no safe step, backing off along the breadcrumbs, giving up, the next step on the same look).
+#include <cmath>
 #include <cstddef>
 
+#include "algo/core/angles.h"
 #include "algo/core/geometry.h"
 #include "algo/mapping/map_points.h"
 #include "algo/mapping/star_polygon.h"
@@ -191,6 +193,32 @@ TEST(StepPlanner, AnotherStepOnTheSameLookStaysInsideTheLooksPolygonSeenFromWher
   CHECK(planner.end_next_on_look() == StepOutcome::kMove);
   CHECK(planner.target().x_m > here.x_m);  // on towards the exploration point
   CHECK(look_disc.contains(to_robot(origin, planner.target())));
+}
+
+// A narrow notch cuts the look's 1 m disc from its centre outwards along +y (a thin post
+// seen edge on). The robot stands left of it, an exploration point draws it right: seen from
+// where the robot is, the heading along +x leaves the polygon at the notch and comes back
+// into it beyond, and no step may cross the notch.
+TEST(StepPlanner, AnotherStepOnTheSameLookEndsEachHeadingWhereItFirstLeavesThePolygon) {
+  StarPolygon notched = disc(1.0F);
+  for (std::size_t k = 0; k < notched.vertex_count(); ++k) {
+    const float a = notched.angle_rad(k);
+    if (std::fabs(a - 0.5F * boticelli::core::kPi<float>) <= 0.18F) notched.set_rho_m(k, 0.1F);
+  }
+  const Pose2 here{-0.2F, 0.4F, 0.0F};
+  CHECK(!notched.contains({0.0F, 0.4F}));  // the notch lies across the heading
+  CHECK(notched.contains({0.2F, 0.4F}));   // and the polygon goes on beyond it
+  (void)map.exploration().push_back({1.0F, 0.4F});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  CHECK_TRUE(planner.begin_next_on_look(here, origin, notched));
+  choose();
+  if (planner.end_next_on_look() != StepOutcome::kMove) return;  // no step: nothing crossed
+  const Point2 target = planner.target();
+  for (int i = 1; i <= 100; ++i) {
+    const float t = static_cast<float>(i) / 100.0F;
+    const Point2 p{here.x_m + t * (target.x_m - here.x_m), here.y_m + t * (target.y_m - here.y_m)};
+    CHECK_TEXT(notched.contains(p), "the step crosses the notch");
+  }
 }
 
 TEST(StepPlanner, AnotherStepOnTheSameLookIsNoSafeStepWhenThePolygonLeavesNoRoom) {
