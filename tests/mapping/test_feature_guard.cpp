@@ -407,6 +407,31 @@ TEST(FeatureGuard, SortedCandidatesKeepTheSamePointsAsTheAllPairsSearch) {
   }
 }
 
+// Rows of five readings 3 cm apart along x, 0.4 m away at the four diagonal pans: each pair is
+// as far along its line of sight as across it, so the ends of a row are neighbours, |Δx| =
+// 0.12 m, though farther apart in x than the range error alone allows (0.1 m): the sorted
+// search must reach over the lateral radius too to keep them as the all-pairs search does.
+TEST(FeatureGuard, SortedCandidatesKeepTheAllPairsPointsOfRowsAcrossObliqueLinesOfSight) {
+  GuardCandidatesFor<64> candidates;
+  for (const float pan : {0.25F, 0.75F, 1.25F, 1.75F}) {
+    const float cx = 0.4F * std::cos(pan * 3.14159265F);
+    const float cy = 0.4F * std::sin(pan * 3.14159265F);
+    for (int k = -2; k <= 2; ++k) {
+      const float x = cx + 0.03F * static_cast<float>(k);
+      (void)candidates.push_back({x, cy, 0.0F, std::hypot(x, cy), 0.9F});
+    }
+  }
+  FixedVector<Point2, 64> all_pairs;
+  FixedVector<Point2, 64> sorted;
+  CHECK_TRUE(
+      mapping::corroborated_points(candidates.span(), mapping::FeatureGuardParams{}, all_pairs));
+  LONGS_EQUAL(candidates.size(), all_pairs.size());  // every reading has its four neighbours
+  mapping::sort_guard_candidates(candidates.span());
+  CHECK_TRUE(
+      mapping::corroborated_points(candidates.span(), mapping::FeatureGuardParams{}, sorted));
+  LONGS_EQUAL(all_pairs.size(), sorted.size());
+}
+
 namespace {
 // A candidate at pan α, horizontal distance ρ and height h (PTU frame), as
 // collect_unexplained_features makes it.
