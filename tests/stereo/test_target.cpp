@@ -182,6 +182,55 @@ TEST(Target, AGreenTriangleOffWhitePaperOrOfAnotherShapeIsNotTheTarget) {
   LONGS_EQUAL(0, false_detections);
 }
 
+namespace {
+
+// A green triangle drawn pixel by pixel on white paper that fills a 160x120 frame: its
+// vertex at (80, 40), 24 rows, row k half as wide as 0.577 k px (equilateral, head-on);
+// from the fourth row on, rows alternately `ragged_px` wider and narrower each side.
+void draw_triangle(image::LowResFrame& f, float ragged_px) {
+  f.width = 160;
+  f.height = 120;
+  for (std::size_t i = 0; i < std::size_t{f.width} * f.height; ++i) {
+    f.luma[i] = 200.0F;
+    f.chroma_u[i] = 128;
+    f.chroma_v[i] = 128;
+  }
+  for (int k = 0; k < 24; ++k) {
+    float half = 0.5F + 0.577F * static_cast<float>(k);
+    if (k >= 3) half += k % 2 == 1 ? ragged_px : -ragged_px;
+    half = std::fmax(half, 0.5F);
+    const auto v = static_cast<std::uint32_t>(40 + k);
+    for (auto u = static_cast<std::uint32_t>(std::lround(80.0F - half));
+         u <= static_cast<std::uint32_t>(std::lround(80.0F + half)); ++u) {
+      const std::size_t i = f.index(u, v);
+      f.luma[i] = 80.0F;
+      f.chroma_u[i] = 108;
+      f.chroma_v[i] = 88;
+    }
+  }
+}
+
+}  // namespace
+
+// A decoy whose confidence lies between half the threshold and the threshold: the same
+// triangle with edges ragged by 2 px is still shaped like the target (a detector with
+// half the threshold takes it) but its edges are not straight lines.
+TEST(Target, ATriangleWithRaggedEdgesIsBelowTheConfidenceThresholdAndNotTheTarget) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  const image::TargetDetection straight = detector.detect(frame());
+  CHECK(straight.found);
+  DOUBLES_EQUAL(80.0, straight.u_px, 1.0);
+  draw_triangle(frame(), 2.0F);
+  image::TargetParams lax;
+  lax.min_confidence = 0.5F * image::TargetParams{}.min_confidence;
+  static image::TargetDetector lax_detector(lax);
+  const image::TargetDetection seen = lax_detector.detect(frame());
+  CHECK(seen.found);
+  CHECK(seen.confidence < 0.5F);
+  CHECK_FALSE(detector.detect(frame()).found);
+}
+
 TEST(Target, CornerIsTriangulatedFromBothFramesOfAPair) {
   const stereo::RigModel rig;
   static stereo::StereoProcessor processor{rig};
