@@ -120,6 +120,97 @@ TEST_GROUP(Persistence) {
   }
 };
 
+TEST_GROUP(MissionState){};
+
+namespace {
+// Copies g_a into g_b, changes one field of g_b and tells whether the two still compare
+// equal, either way round.
+template <typename Change>
+bool equal_after(Change change) {
+  g_b = g_a;
+  change(g_b);
+  const bool ab = g_a == g_b;
+  CHECK_EQUAL(ab, g_b == g_a);
+  return ab;
+}
+}  // namespace
+
+TEST(MissionState, TwoStatesThatDifferInAnyOneFieldAreNotEqual) {
+  make_state(15, g_a);  // a goal, obstacles, exploration points, a model, a log and an end
+  CHECK(g_a.has_goal && g_a.obstacles.size() > 1 && g_a.exploration.size() > 1);
+  CHECK(equal_after([](MissionState&) {}));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.end = MissionEnd::kFound; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.set_end(s.end, "another reason"); }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.cycle; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.seed; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.pose.x_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.pose.y_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.pose.yaw_rad += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.pose_time_ms; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.has_goal = false; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.goal.x_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.goal.y_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.goal_height_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.obstacles.pop_back(); }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.obstacles[1].x_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.obstacles[1].y_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.exploration.pop_back(); }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.exploration[1].x_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.exploration[1].y_m += 0.5F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { CHECK(s.set_model("VARIABLES 3\n")); }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.log.pop_back(); }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.log[2].cycle; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.log[2].text[0] = '#'; }));
+  // Without a goal, where the goal would be does not count.
+  g_a.has_goal = false;
+  CHECK(equal_after([](MissionState& s) {
+    s.goal.x_m += 0.5F;
+    s.goal_height_m += 0.5F;
+  }));
+}
+
+TEST(MissionState, ClearingGivesTheStateOfANewMission) {
+  make_state(15, g_a);
+  for (std::size_t i = 0; i < MissionState::kMaxLogEntries; ++i) g_a.add_log(99, "more");
+  CHECK(g_a.log_dropped > 0U);
+  g_a.clear();
+  static const MissionState fresh;
+  CHECK(g_a == fresh);
+  CHECK_EQUAL(0U, g_a.log_dropped);
+  CHECK_EQUAL(0U, g_a.obstacles.size());
+  STRCMP_EQUAL("", g_a.end_reason.data());
+  CHECK_EQUAL(0, g_a.pose_time_ms);
+}
+
+TEST(MissionState, AFullLogDropsItsOldestLinesAndCountsThem) {
+  g_a.clear();
+  const std::size_t n = MissionState::kMaxLogEntries;
+  for (std::size_t c = 1; c <= n + 2; ++c) g_a.add_log(c, "cycle " + std::to_string(c));
+  CHECK_EQUAL(n, g_a.log.size());
+  CHECK_EQUAL(2U, g_a.log_dropped);
+  CHECK_EQUAL(3U, g_a.log[0].cycle);
+  STRCMP_EQUAL("cycle 3", g_a.log[0].text.data());
+  CHECK_EQUAL(n + 2, g_a.log[n - 1].cycle);
+}
+
+TEST(MissionState, TextIsCutToItsCapacityAndOnlyPrintableAsciiIsKept) {
+  g_a.clear();
+  const std::string longest(MissionLogEntry::kMaxTextBytes + 7, 'x');
+  g_a.add_log(1, longest);
+  CHECK_EQUAL(MissionLogEntry::kMaxTextBytes, g_a.log[0].view().size());
+  const std::string one_short(MissionLogEntry::kMaxTextBytes - 1, 'y');
+  g_a.add_log(1, one_short);
+  STRCMP_EQUAL(one_short.c_str(), g_a.log[1].text.data());
+  g_a.log.pop_back();
+  // Space and tilde are the ends of printable ASCII; the unit separator and DEL lie outside.
+  g_a.add_log(2, "\x1f \x7e\x7f");
+  STRCMP_EQUAL("? ~?", g_a.log[1].text.data());
+  g_a.set_end(MissionEnd::kAborted, longest);
+  CHECK_EQUAL(MissionLogEntry::kMaxTextBytes, g_a.end_reason_text().size());
+  g_a.set_end(MissionEnd::kAborted, "a\tb");
+  STRCMP_EQUAL("a?b", g_a.end_reason.data());
+}
+
 TEST(Persistence, ComputesTheStandardCrc32) {
   CHECK_EQUAL(0xCBF43926U, crc32("123456789", 9));
   CHECK_EQUAL(0U, crc32("", 0));
