@@ -1,9 +1,11 @@
 // Tests of the configuration file (good and bad files, the shipped conffile), the saved
 // parameters' round trip and the atomic write both stores share.
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -561,6 +563,93 @@ TEST(AtomicWrite, TheStateStoreSavesItsParametersTheSameWay) {
   CHECK_FALSE(store.save_parameters("gain = 2\n", error, sizeof error));
   store.set_crash_hook(nullptr, nullptr);
   STRCMP_EQUAL("gain = 1\n", read_file(dir + "/parameters.conf").c_str());
+}
+
+namespace {
+// The process's open file descriptors.
+int open_descriptors() {
+  DIR* d = opendir("/proc/self/fd");
+  CHECK(d != nullptr);
+  int n = 0;
+  while (readdir(d) != nullptr) ++n;
+  closedir(d);
+  return n;
+}
+// Fails every call of one kind with EIO.
+int fail_call(StorageCall call, void* context) {
+  return call == *static_cast<StorageCall*>(context) ? EIO : 0;
+}
+}  // namespace
+
+TEST(AtomicWrite, AWriteCutShortOrFailedClosesWhatItOpenedAndAFailureLeavesNoTemporaryFile) {
+  char error[320] = "";
+  const std::string text(2 * kAtomicWriteChunkBytes + 5, 'n');
+  const int before = open_descriptors();
+  for (Crash c : {Crash{SaveStep::kTempCreated}, Crash{SaveStep::kChunkWritten, 1},
+                  Crash{SaveStep::kTempSynced}}) {
+    CHECK_FALSE(
+        write_file_atomically(dir.c_str(), "a.txt", text, error, sizeof error, crash_at, &c));
+    CHECK_EQUAL(before, open_descriptors());
+  }
+  for (StorageCall call : {StorageCall::kWrite, StorageCall::kSync}) {
+    set_storage_fault_hook(fail_call, &call);
+    CHECK_FALSE(write_file_atomically(dir.c_str(), "a.txt", text, error, sizeof error));
+    set_storage_fault_hook(nullptr, nullptr);
+    STRCMP_CONTAINS(std::strerror(EIO), error);
+    CHECK_EQUAL(before, open_descriptors());
+    CHECK(access((dir + "/a.txt.tmp").c_str(), F_OK) != 0);
+  }
+}
+
+TEST(AtomicWrite, TheFileIsReadableAndWritableByItsOwnerAndReadableByItsGroup) {
+  char error[320] = "";
+  const mode_t old_mask = umask(022);
+  const bool written = write_file_atomically(dir.c_str(), "a.txt", "x", error, sizeof error);
+  umask(old_mask);
+  CHECK(written);
+  struct stat st {};
+  CHECK(stat((dir + "/a.txt").c_str(), &st) == 0);
+  LONGS_EQUAL(0640, st.st_mode & 07777);
+}
+
+TEST(AtomicWrite, ATemporaryFileItCannotRemoveFailsTheSaveWithItsPath) {
+  char error[320] = "";
+  CHECK(write_file_atomically(dir.c_str(), "a.txt", "old", error, sizeof error));
+  CHECK(mkdir((dir + "/a.txt.tmp").c_str(), 0700) == 0);  // unlink() fails on a directory
+  const bool written = write_file_atomically(dir.c_str(), "a.txt", "new", error, sizeof error);
+  rmdir((dir + "/a.txt.tmp").c_str());
+  CHECK_FALSE(written);
+  STRCMP_CONTAINS(("cannot remove the stale " + dir + "/a.txt.tmp").c_str(), error);
+  STRCMP_EQUAL("old", read_file(dir + "/a.txt").c_str());
+}
+
+// The paths are built in 512-byte buffers: a temporary file's path of 511 bytes fits, one of
+// 512 would be cut short and is refused.
+TEST(AtomicWrite, ATemporaryPathThatJustFitsIsWrittenAndOneByteLongerIsRefused) {
+  char error[600] = "";
+  const std::string deep = dir + "/" + std::string(200, 'd');
+  const std::string deeper = deep + "/" + std::string(200, 'e');
+  CHECK(mkdir(deep.c_str(), 0700) == 0);
+  CHECK(mkdir(deeper.c_str(), 0700) == 0);
+  const std::size_t fits = 511 - deeper.size() - 1 - 4;  // "/" and ".tmp"
+  const std::string name(fits, 'f');
+  const std::string longer(fits + 1, 'f');
+  const bool written =
+      write_file_atomically(deeper.c_str(), name.c_str(), "x", error, sizeof error);
+  const std::string text = read_file(deeper + "/" + name);
+  const bool refused =
+      !write_file_atomically(deeper.c_str(), longer.c_str(), "x", error, sizeof error);
+  const bool longer_exists = access((deeper + "/" + longer).c_str(), F_OK) == 0;
+  unlink((deeper + "/" + name).c_str());
+  unlink((deeper + "/" + longer).c_str());
+  unlink((deeper + "/" + longer + ".tm").c_str());  // what a cut path would name
+  rmdir(deeper.c_str());
+  rmdir(deep.c_str());
+  CHECK(written);
+  STRCMP_EQUAL("x", text.c_str());
+  CHECK(refused);
+  CHECK_FALSE(longer_exists);
+  STRCMP_CONTAINS("path too long", error);
 }
 
 TEST(AtomicWrite, AMissingDirectoryIsAnErrorWithItsPath) {
