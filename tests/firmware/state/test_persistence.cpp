@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cerrno>
@@ -836,6 +837,18 @@ TEST(Persistence, ASaveSyncsTheWholeTemporaryFileBeforeTheRenameAndAFailedSyncKe
   CHECK(g_a == g_b);
 }
 
+namespace {
+// Fails the first `failures` creations of a temporary file with EIO.
+struct FailingCreates {
+  std::atomic<int> failures{0};
+};
+int fail_creates(StorageCall call, void* context) {
+  auto* f = static_cast<FailingCreates*>(context);
+  if (call != StorageCall::kCreate) return 0;
+  return f->failures.fetch_sub(1) > 0 ? EIO : 0;
+}
+}  // namespace
+
 TEST(Persistence, WithoutItsThreadTheSaverWritesEachStateAtOnce) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   auto owner = std::make_unique<StateSaver>(g_store);
@@ -847,6 +860,21 @@ TEST(Persistence, WithoutItsThreadTheSaverWritesEachStateAtOnce) {
   }
   owner->flush();
   CHECK_EQUAL(3U, owner->saved());
+  CHECK_FALSE(owner->failing());
+  // A failed save is counted at once, with its reason, until the next one succeeds.
+  static FailingCreates failing;
+  failing.failures = 1;
+  set_storage_fault_hook(fail_creates, &failing);
+  CHECK(owner->submit(g_a));
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK_EQUAL(1U, owner->failures());
+  CHECK_TRUE(owner->failing());
+  char reason[256] = "";
+  owner->last_error(reason, sizeof reason);
+  STRCMP_CONTAINS("cannot create", reason);
+  CHECK(owner->submit(g_a));
+  CHECK_EQUAL(4U, owner->saved());
+  CHECK_FALSE(owner->failing());
 }
 
 // qemu-user (the cross presets' test runner) hangs in thread creation on some hosts; the
@@ -873,17 +901,6 @@ TEST(Persistence, TheWriterThreadEndsWithTheNewestSubmittedState) {
   make_state(30, g_a);
   CHECK(g_a == g_b);
 }
-namespace {
-// Fails the first `failures` creations of a temporary file with EIO.
-struct FailingCreates {
-  std::atomic<int> failures{0};
-};
-int fail_creates(StorageCall call, void* context) {
-  auto* f = static_cast<FailingCreates*>(context);
-  if (call != StorageCall::kCreate) return 0;
-  return f->failures.fetch_sub(1) > 0 ? EIO : 0;
-}
-}  // namespace
 
 TEST(Persistence, TheWriterThreadRetriesAFailedSaveWithoutANewSubmission) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
@@ -906,6 +923,9 @@ TEST(Persistence, TheWriterThreadRetriesAFailedSaveWithoutANewSubmission) {
     CHECK_EQUAL(2U, saver.failures());
     CHECK_EQUAL(2U, saver.retries());
     CHECK_FALSE(saver.failing());
+    char reason[256] = "";
+    saver.last_error(reason, sizeof reason);
+    STRCMP_CONTAINS("cannot create", reason);  // the last failure's, kept after the success
   }
   set_storage_fault_hook(nullptr, nullptr);
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
@@ -994,5 +1014,112 @@ TEST(Persistence, AStateSubmittedWhileTheWriterIsSavingIsWrittenBeforeTheSaverIs
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
   CHECK_EQUAL(11U, g_b.cycle);
   CHECK(g_a == g_b);
+}
+TEST(Persistence, StartingTheWriterTwiceKeepsOneWriterThread) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  {
+    auto owner = std::make_unique<StateSaver>(g_store);
+    owner->start();
+    owner->start();
+    make_state(4, g_a);
+    CHECK(owner->submit(g_a));
+    owner->flush();
+    CHECK_EQUAL(1U, owner->saved());
+  }
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+
+namespace {
+// Fails the first `failures` creations with EIO and notes when each creation was tried.
+struct TimedFailures {
+  std::atomic<int> failures{0};
+  std::atomic<int> tries{0};
+  std::array<std::chrono::steady_clock::time_point, 8> at{};
+};
+int fail_creates_timed(StorageCall call, void* context) {
+  auto* f = static_cast<TimedFailures*>(context);
+  if (call != StorageCall::kCreate) return 0;
+  const int n = f->tries.fetch_add(1);
+  if (n < static_cast<int>(f->at.size()))
+    f->at[static_cast<std::size_t>(n)] = std::chrono::steady_clock::now();
+  return f->failures.fetch_sub(1) > 0 ? EIO : 0;
+}
+}  // namespace
+
+TEST(Persistence, AFailedSaveIsTriedAgainOnlyOnceTheRetryIntervalHasPassed) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static TimedFailures failing;
+  failing.failures = 2;
+  failing.tries = 0;
+  set_storage_fault_hook(fail_creates_timed, &failing);
+  {
+    auto owner = std::make_unique<StateSaver>(g_store);
+    owner->set_retry_interval_ms(60);
+    owner->start();
+    make_state(5, g_a);
+    CHECK(owner->submit(g_a));
+    for (int i = 0; i < 500 && owner->saved() == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    CHECK_EQUAL(1U, owner->saved());
+  }
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK_EQUAL(3, failing.tries.load());
+  for (std::size_t i = 1; i < 3; ++i) {
+    CHECK(failing.at[i] - failing.at[i - 1] >= std::chrono::milliseconds(60));
+  }
+}
+
+TEST(Persistence, ParametersAndAStateHandedOverTogetherAreBothSaved) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static SaveGate gate;
+  gate.entered = false;
+  gate.open = false;
+  set_storage_fault_hook(gate_creates, &gate);
+  auto owner = std::make_unique<StateSaver>(g_store);
+  owner->start();
+  make_state(6, g_a);
+  CHECK(owner->submit(g_a));
+  gate.wait_entered();  // state 6 is being saved: what follows waits for the writer together
+  CHECK(owner->submit_parameters("gain = 2\n") == StateSaver::Submitted::kQueued);
+  make_state(7, g_a);
+  while (!owner->submit(g_a)) {
+  }
+  gate.open_after_ms(0).join();
+  for (int i = 0; i < 500 && (owner->saved() < 2 || owner->parameter_saves() < 1); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const std::uint64_t saved = owner->saved();
+  const std::uint64_t parameters = owner->parameter_saves();
+  owner.reset();
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK_EQUAL(2U, saved);
+  CHECK_EQUAL(1U, parameters);
+  STRCMP_EQUAL("gain = 2\n", read_file(dir + "/parameters.conf").c_str());
+  CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+
+TEST(Persistence, FlushReturnsOnlyOnceTheParameterSaveUnderWayIsOnDisk) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static SaveGate gate;
+  gate.entered = false;
+  gate.open = false;
+  set_storage_fault_hook(gate_creates, &gate);
+  std::uint64_t saved_at_flush = 0;
+  {
+    auto owner = std::make_unique<StateSaver>(g_store);
+    owner->start();
+    CHECK(owner->submit_parameters("gain = 3\n") == StateSaver::Submitted::kQueued);
+    gate.wait_entered();
+    std::thread opener = gate.open_after_ms(100);
+    owner->flush();
+    saved_at_flush = owner->parameter_saves();
+    opener.join();
+  }
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK_EQUAL(1U, saved_at_flush);
+  STRCMP_EQUAL("gain = 3\n", read_file(dir + "/parameters.conf").c_str());
 }
 #endif
