@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -259,6 +260,69 @@ TEST(ConfigFile, ATextKeyOfExactlyItsCapacityIsRefusedAndOneByteLessIsAccepted) 
   CHECK(checked >= 3);
 }
 
+TEST(ConfigFile, EveryStandardBaudRateIsAcceptedAndTheRatesBesideItAreNot) {
+  const std::uint32_t rates[] = {1200,  2400,   4800,   9600,   19200,  38400,
+                                 57600, 115200, 230400, 460800, 500000, 921600};
+  for (const std::uint32_t rate : rates) {
+    Rpi4Keys k;
+    char error[320] = "";
+    const std::string line = "[console]\nbaud = " + std::to_string(rate) + "\n";
+    CHECK_TRUE_TEXT(apply_config_text(line, "b.conf", k.schema, error, sizeof error), error);
+    CHECK_EQUAL(rate, k.config.console_baud);
+    for (const std::uint32_t beside : {rate - 1, rate + 1}) {
+      const std::string bad = "[console]\nbaud = " + std::to_string(beside) + "\n";
+      CHECK_FALSE(apply_config_text(bad, "b.conf", k.schema, error, sizeof error));
+      STRCMP_CONTAINS("is not a standard baud rate", error);
+    }
+  }
+}
+
+TEST(ConfigFile, AnInterfaceNameTakesLettersDigitsUnderscoreDashAndDotAndNothingElse) {
+  {
+    Rpi4Keys k;
+    char error[320] = "";
+    CHECK_TRUE_TEXT(apply_config_text("[base]\ncan_interface = \"azAZ09_-.\"\n", "n.conf", k.schema,
+                                      error, sizeof error),
+                    error);
+    STRCMP_EQUAL("azAZ09_-.", k.devices.can_interface.data());
+  }
+  // The characters just outside each accepted range, and a few others.
+  for (const char c : std::string("`{@[/:~!+")) {
+    Rpi4Keys k;
+    char error[320] = "";
+    const std::string text = std::string("[base]\ncan_interface = \"can") + c + "\"\n";
+    CHECK_FALSE_TEXT(apply_config_text(text, "n.conf", k.schema, error, sizeof error),
+                     text.c_str());
+    STRCMP_CONTAINS("may hold only letters, digits", error);
+  }
+}
+
+TEST(ConfigFile, ADevicePathTakesPrintableAsciiFromTheExclamationMarkToTheTilde) {
+  Rpi4Keys k;
+  char error[320] = "";
+  CHECK_TRUE_TEXT(apply_config_text("[camera]\ndevice = \"/dev/!~\"\n", "p.conf", k.schema, error,
+                                    sizeof error),
+                  error);
+  STRCMP_EQUAL("/dev/!~", k.devices.camera_device.data());
+  for (const char* bad : {"/dev/a b", "/dev/a\\u007F", "/dev/a\\t"}) {
+    const std::string text = std::string("[camera]\ndevice = \"") + bad + "\"\n";
+    CHECK_FALSE_TEXT(apply_config_text(text, "p.conf", k.schema, error, sizeof error), bad);
+    STRCMP_CONTAINS("must be printable ASCII without spaces", error);
+  }
+}
+
+TEST(ConfigFile, AReasonLongerThanTheErrorBufferIsCutInsideIt) {
+  Rpi4Keys k;
+  for (const std::size_t size : {std::size_t{30}, std::size_t{6}}) {
+    std::array<char, 64> buffer{};
+    buffer.fill('#');
+    CHECK_FALSE(apply_config_text("[camera]\nwidth_px = 2000\n", "long-file-name.conf", k.schema,
+                                  buffer.data(), size));
+    CHECK_EQUAL(size - 1, std::strlen(buffer.data()));
+    for (std::size_t i = size; i < buffer.size(); ++i) CHECK_EQUAL('#', buffer[i]);
+  }
+}
+
 // The watchdog's timeout stays where a hang restarts the service before the board resets
 // (docs/flashing.md, "Watchdogs"), and 0 no longer switches it off: only `enabled = false`.
 TEST(ConfigFile, TheWatchdogTimeoutIsBoundedByTheRestartChainAndOnlyAKeySwitchesItOff) {
@@ -383,6 +447,14 @@ TEST(ConfigFile, TheShippedConffileDocumentsEveryKeyWithItsDefault) {
   CHECK_EQUAL(k.schema.size(), seen.size());
 }
 
+// A table named by an empty quoted key is unknown like any other (no key has an empty table).
+TEST(ConfigFile, ATableWithAnEmptyNameIsUnknown) {
+  Rpi4Keys k;
+  char error[320] = "";
+  CHECK_FALSE(apply_config_text("[\"\"]\nx = 1\n", "e.conf", k.schema, error, sizeof error));
+  STRCMP_EQUAL("e.conf:1: unknown table ''", error);
+}
+
 TEST(ConfigFile, TheSchemaRefusesATakenKey) {
   ConfigSchema schema;
   std::uint32_t a = 0;
@@ -406,6 +478,17 @@ TEST_GROUP(SavedParameters) {
     static_cast<std::vector<std::string>*>(context)->push_back(message);
   }
 };
+
+// A double beyond a float's range would become infinite as a float: it is out of range, not
+// "not a finite number" (which only inf and nan in the file are).
+TEST(SavedParameters, AValueBeyondTheFloatRangeIsOutOfRangeAndTheDefaultKept) {
+  char error[320] = "";
+  CHECK(apply_parameters_text("gain = 1e39\n", "p.conf", table, error, sizeof error, warn,
+                              &warnings) == ConfigLoad::kLoaded);
+  CHECK_EQUAL(1U, warnings.size());
+  STRCMP_EQUAL("p.conf:1: gain: value out of range; default kept", warnings[0].c_str());
+  CHECK(gain == 0.5F);
+}
 
 TEST(SavedParameters, OnlyTheChangedValuesAreWrittenAndTheyReadBackExactly) {
   char text[ParameterTable::kMaxFileBytes];
