@@ -447,6 +447,57 @@ TEST(ConfigFile, TheShippedConffileDocumentsEveryKeyWithItsDefault) {
   CHECK_EQUAL(k.schema.size(), seen.size());
 }
 
+// docs/configuration.md's table of keys gives each number key's range (and a width's or
+// height's multiple): the schema checks exactly those, so neither can drift from the other.
+TEST(ConfigFile, EveryRangeTheConfigurationDocGivesIsTheOneItsKeyChecks) {
+  const Rpi4Keys k;
+  std::istringstream doc(read_file(BOTICELLI_SOURCE_DIR "/docs/configuration.md"));
+  const std::regex row(R"(^\| (`[^|]+`) \| (c|rpi4) \| [^|]* \| ([^|]+) \|$)");
+  const std::regex key_name("`([a-z_0-9.]+)`");
+  const std::regex range("(-?[0-9.]+) … (-?[0-9.]+)");
+  const std::regex multiple("multiple of ([0-9]+)");
+  std::size_t checked = 0;
+  std::string line;
+  while (std::getline(doc, line)) {
+    std::smatch m;
+    if (!std::regex_match(line, m, row)) continue;
+    const std::string names = m[1].str();
+    const std::string cell = m[3].str();
+    if (cell.rfind("the board's range", 0) == 0) continue;  // watchdog.timeout_ms: per board
+    std::vector<std::pair<double, double>> ranges;
+    for (std::sregex_iterator r(cell.begin(), cell.end(), range), end; r != end; ++r) {
+      ranges.emplace_back(std::stod((*r)[1].str()), std::stod((*r)[2].str()));
+    }
+    if (ranges.empty()) continue;
+    std::smatch mult;
+    const bool has_multiple = std::regex_search(cell, mult, multiple);
+    std::string table;
+    std::size_t i = 0;
+    for (std::sregex_iterator n(names.begin(), names.end(), key_name), end; n != end; ++n, ++i) {
+      std::string name = (*n)[1].str();
+      const std::size_t dot = name.find('.');
+      if (dot != std::string::npos) {
+        table = name.substr(0, dot);
+        name = name.substr(dot + 1);
+      }
+      const ConfigKey* key = k.schema.find(table, name);
+      const std::string what = table + "." + name;
+      CHECK_TEXT(key != nullptr, what.c_str());
+      const auto& [lo, hi] = ranges[ranges.size() == 1 ? 0 : i];
+      DOUBLES_EQUAL_TEXT(lo, key->min, 0.0, what.c_str());
+      DOUBLES_EQUAL_TEXT(hi, key->max, 0.0, what.c_str());
+      if (key->kind == ConfigKind::kWhole) {
+        const unsigned expected =
+            has_multiple ? static_cast<unsigned>(std::stoul(mult[1].str())) : 1U;
+        CHECK_EQUAL_TEXT(expected, std::max(1U, static_cast<unsigned>(key->multiple_of)),
+                         what.c_str());
+      }
+      ++checked;
+    }
+  }
+  CHECK(checked >= 28U);  // every number key of both tables
+}
+
 // A table named by an empty quoted key is unknown like any other (no key has an empty table).
 TEST(ConfigFile, ATableWithAnEmptyNameIsUnknown) {
   Rpi4Keys k;
