@@ -236,6 +236,7 @@ TEST(Persistence, HoldsAStateFilledToEveryCapacity) {
   }
   while (g_a.exploration.push_back({3.40282347e38F, -0.0F})) {
   }
+  g_a.set_end(MissionEnd::kAborted, std::string(MissionLogEntry::kMaxTextBytes, '~'));
   CHECK(g_a.set_model(std::string(MissionState::kMaxModelBytes, 'M')));
   // One byte more, or a NUL inside, is refused and leaves the model as it was.
   CHECK_FALSE(g_a.set_model(std::string(MissionState::kMaxModelBytes + 1, 'X')));
@@ -261,6 +262,19 @@ TEST(Persistence, HoldsAStateFilledToEveryCapacity) {
   const char* why = "";
   CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
   CHECK(g_a == g_b);
+}
+
+// The encoder writes each line with its terminating NUL: a buffer of exactly the file's size
+// is too small (nothing is returned), one byte more holds the same file.
+TEST(Persistence, AStateIsEncodedOnlyIntoABufferLongerThanItsFile) {
+  make_state(7, g_a);
+  const std::size_t n = encode_state(g_a, g_file, sizeof g_file, 5);
+  CHECK(n > 0);
+  const std::string file(g_file, n);
+  static char again[kMaxStateFileBytes];
+  CHECK_EQUAL(0U, encode_state(g_a, again, n, 5));
+  CHECK_EQUAL(n, encode_state(g_a, again, n + 1, 5));
+  CHECK(file == std::string(again, n));
 }
 
 TEST(Persistence, RejectsEveryTruncationOfAFile) {
@@ -300,7 +314,10 @@ TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
   for (const std::string& body :
        {head + "obstacles 3000\n" + tail, head + "obstacles 1\n1 nan\n" + tail,
         head + "obstacles 1\n1 2 3\n" + tail, head + "obstacles 2\n1 2\n" + tail,
-        head + "obstacles -1\n" + tail, std::string("BOTICELLI-STATE 2\n") + "cycle 3\n",
+        head + "obstacles 1\n1 1e39\n" + tail,   // beyond a float: infinite
+        head + "obstacles 1\n1 1.5.2\n" + tail,  // not all of it a number
+        head + "obstacles 1\n1 -\n" + tail, head + "obstacles -1\n" + tail,
+        std::string("BOTICELLI-STATE 2\n") + "cycle 3\n",
         "BOTICELLI-STATE 4" + head.substr(17) + "obstacles 0\n" + tail,
         // Version 3 has a sequence number and the mission's result.
         "BOTICELLI-STATE 3" + head.substr(17) + "obstacles 0\n" + tail,
@@ -324,6 +341,8 @@ TEST(Persistence, RejectsAWellChecksummedFileThatBreaksTheFormat) {
         "BOTICELLI-STATE 2\ncycle 3\nseed 1\npose 0 0 0\ngoal 1 2\nobstacles 0\n" + tail,
         head + "obstacles 0\nexploration 0\nmodel 5\nab\n\nlog 0\nend\n",
         head + "obstacles 0\n" + tail + "extra\n", head + "obstacles 0\n" + tail.substr(0, 20),
+        head.substr(0, head.size() - 10) + "obstacles 0\n" + tail,  // no goal line
+        head.substr(0, head.size() - 10),                           // nothing after the pose
         std::string("cycle 3\n")}) {
     f = with_crc(body);
     CHECK_FALSE_TEXT(decode_state(f, g_b, &why), body.c_str());
@@ -494,6 +513,52 @@ TEST(Persistence, SavesAlternateBetweenTwoCopiesEachWithTheNextSequenceNumber) {
   STRCMP_CONTAINS("sequence 5\ncycle 5\n", read_file(dir + "/mission.state.a").c_str());
 }
 
+// A store opened on copies an earlier run left, where copy A holds the newer state, writes its
+// first save over copy B: the newest state is never the one replaced.
+TEST(Persistence, AReopenedStoreSavesOverTheOlderCopyWhicheverItIs) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  for (std::uint64_t c = 1; c <= 3; ++c) {  // A, B, A
+    make_state(c, g_a);
+    CHECK(g_store.save(g_a, error, sizeof error));
+  }
+  const std::string newest = read_file(dir + "/mission.state.a");
+  static StateStore reopened;
+  CHECK(reopened.open(dir.c_str(), error, sizeof error));
+  make_state(4, g_a);
+  CHECK(reopened.save(g_a, error, sizeof error));
+  CHECK(read_file(dir + "/mission.state.a") == newest);
+  CHECK(reopened.load(g_b, error, sizeof error) == LoadResult::kLoaded);
+  STRCMP_CONTAINS("mission.state.b", reopened.loaded_path());
+  CHECK(g_a == g_b);
+}
+
+// A copy that cannot be read at all (here a directory in its place) does not stop the store
+// from looking at the others.
+TEST(Persistence, ACopyThatCannotBeReadIsPassedOverForTheOther) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  for (std::uint64_t c = 1; c <= 2; ++c) {  // A, B
+    make_state(c, g_a);
+    CHECK(g_store.save(g_a, error, sizeof error));
+  }
+  CHECK(unlink((dir + "/mission.state.a").c_str()) == 0);
+  CHECK(mkdir((dir + "/mission.state.a").c_str(), 0700) == 0);
+  static StateStore reopened;
+  CHECK(reopened.open(dir.c_str(), error, sizeof error));
+  const LoadResult loaded = reopened.load(g_b, error, sizeof error);
+  rmdir((dir + "/mission.state.a").c_str());
+  CHECK(loaded == LoadResult::kLoaded);
+  CHECK(g_a == g_b);
+}
+
+TEST(Persistence, AStoreThatWasNeverOpenedSavesNothingAndSaysWhy) {
+  static StateStore closed;
+  make_state(1, g_a);
+  CHECK_FALSE(closed.save(g_a, error, sizeof error));
+  STRCMP_EQUAL("no state directory", error);
+  CHECK_FALSE(closed.save_parameters("gain = 1\n", error, sizeof error));
+  STRCMP_EQUAL("no state directory", error);
+}
+
 TEST(Persistence, AFlippedByteInTheNewestCopyFallsBackToTheOtherWithAWarning) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   for (std::uint64_t c = 20; c <= 21; ++c) {
@@ -586,6 +651,30 @@ TEST(Persistence, ANewMissionKeepsTheNewestValidCopyAndClearsBoth) {
   STRCMP_CONTAINS("sequence 1\n", read_file(dir + "/mission.state.a").c_str());
 }
 
+TEST(Persistence, WithOnlyADamagedCopyANewMissionStillKeepsIt) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  make_state(40, g_a);
+  CHECK(g_store.save(g_a, error, sizeof error));
+  std::string a = read_file(dir + "/mission.state.a");
+  a[60] = static_cast<char>(a[60] ^ 0x04);
+  write_file(dir + "/mission.state.a", a);
+  char kept[600] = "";
+  CHECK(g_store.keep_previous(kept, sizeof kept, error, sizeof error) == LoadResult::kLoaded);
+  STRCMP_EQUAL((dir + "/mission.state.1").c_str(), kept);
+  CHECK(read_file(dir + "/mission.state.1") == a);
+}
+
+TEST(Persistence, AFileWhereTheStateDirectoryShouldBeIsRefusedWithTheReason) {
+  const std::string file = dir + "/not-a-dir";
+  write_file(file, "x");
+  const bool opened = g_store.open(file.c_str(), error, sizeof error);
+  unlink(file.c_str());
+  CHECK_FALSE(opened);
+  CHECK(g_store.refused());
+  CHECK_FALSE(g_store.is_open());
+  STRCMP_EQUAL(("state path " + file + " is not a directory").c_str(), error);
+}
+
 TEST(Persistence, SavesAtomicallyAndLoadsBack) {
   CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
   CHECK(g_store.load(g_b, error, sizeof error) == LoadResult::kMissing);
@@ -673,6 +762,7 @@ TEST(Persistence, ADirectoryOfAnotherUserIsRefused) {
   CHECK_FALSE(g_store.open(dir.c_str(), error, sizeof error));
   CHECK(g_store.refused());
   STRCMP_CONTAINS("refused: owned by uid 54321, not by this user (uid 0)", error);
+  CHECK_FALSE(g_store.is_open());
   CHECK_EQUAL(0, chown(dir.c_str(), 0, static_cast<gid_t>(-1)));
   CHECK_TRUE_TEXT(g_store.open(dir.c_str(), error, sizeof error), error);
 }
