@@ -491,6 +491,129 @@ TEST(FeatureGuard, ACandidateTheCameraSawPastOnItsLineOfSightIsDroppedAndOthersS
   LONGS_EQUAL(4, run(0).size());
 }
 
+namespace {
+// The see-through test by its definition alone, without the guard's cone or buckets: reading
+// q, seen from its view, lies farther than the candidate by both range errors and within the
+// angle of the candidate's line of sight. Candidates no farther than the camera's lever from
+// the PTU centre are never tested.
+template <std::size_t N>
+bool seen_through_by_definition(const FixedVector<Reading, N>& readings,
+                                const mapping::GuardPoint& c,
+                                const mapping::FeatureGuardParams& g) {
+  float lever = 0.0F;
+  for (const Reading& q : readings) {
+    lever = std::fmax(lever, std::sqrt(q.view_x_m * q.view_x_m + q.view_y_m * q.view_y_m +
+                                       q.view_z_m * q.view_z_m));
+  }
+  if (!(std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m + c.h_m * c.h_m) > lever)) return false;
+  const float far_factor = (1.0F + g.delta_r_fraction) / (1.0F - g.delta_r_fraction);
+  const float cos_max = std::cos(g.see_through_angle_rad);
+  std::size_t through = 0;
+  for (const Reading& q : readings) {
+    const Point2 qp = boticelli::evidence::floor_point_m(q);
+    const float ux = qp.x_m - q.view_x_m;
+    const float uy = qp.y_m - q.view_y_m;
+    const float uz = q.h_m - q.view_z_m;
+    const float wx = c.x_m - q.view_x_m;
+    const float wy = c.y_m - q.view_y_m;
+    const float wz = c.h_m - q.view_z_m;
+    const float u = std::sqrt(ux * ux + uy * uy + uz * uz);
+    const float w = std::sqrt(wx * wx + wy * wy + wz * wz);
+    if (u > w * far_factor && ux * wx + uy * wy + uz * wz >= cos_max * u * w) ++through;
+  }
+  return through >= g.see_through_readings;
+}
+}  // namespace
+
+// Readings from views on a 0.21 m lever (the pan-tilt unit's camera), some lying just past
+// candidates near and far, above and below: both scans drop exactly the candidates the
+// definition drops (their cones and buckets only skip readings that cannot count).
+TEST(FeatureGuard, BothScansDropExactlyTheCandidatesTheDefinitionOfSeeingPastDrops) {
+  static FixedVector<Reading, 3000> readings;
+  readings.clear();
+  boticelli::test::Random rng(43);
+  static GuardCandidatesFor<400> plain;
+  static GuardCandidatesFor<400> ordered;
+  plain.clear();
+  ordered.clear();
+  for (int k = 0; k < 400; ++k) {
+    const float alpha = rng.uniform(-3.14F, 3.14F);
+    const mapping::GuardPoint c =
+        candidate_at(alpha, rng.uniform(0.22F, 3.5F), rng.uniform(-0.8F, 0.5F));
+    (void)plain.push_back(c);
+    (void)ordered.push_back(c);
+    // Three readings from views on the lever, beyond the candidate by 1.1 to 1.6 times, up to
+    // 0.12 rad off its line of sight (the test's angle is 0.05 rad).
+    for (int j = 0; j < 3; ++j) {
+      const float view = rng.uniform(0.0F, 6.2831853F);
+      const float vx = 0.21F * std::cos(view);
+      const float vy = 0.21F * std::sin(view);
+      const float vz = rng.uniform(-0.05F, 0.05F);
+      const float t = rng.uniform(1.1F, 1.6F);
+      const float off = rng.uniform(-0.12F, 0.12F) * t * std::hypot(c.x_m - vx, c.y_m - vy);
+      const float px = vx + t * (c.x_m - vx) + off;
+      const float py = vy + t * (c.y_m - vy) - off;
+      const float pz = vz + t * (c.h_m - vz) + 0.5F * off;
+      float a = std::atan2(py, px);
+      if (a < 0.0F) a += 6.2831853F;
+      Reading q = at(a, std::hypot(px, py), pz);
+      q.view_x_m = vx;
+      q.view_y_m = vy;
+      q.view_z_m = vz;
+      (void)readings.push_back(q);
+    }
+  }
+  mapping::FeatureGuardParams g;
+  g.see_through_readings = 2;
+  g.see_through_angle_rad = 0.05F;
+  std::size_t expected = 0;
+  for (const mapping::GuardPoint& c : plain) expected += seen_through_by_definition(readings, c, g);
+  CHECK(expected > 40 && expected < 360);  // the test has both kinds
+  static std::array<std::uint32_t, 3000> scratch;
+  LONGS_EQUAL(expected, mapping::drop_seen_through(readings, g, plain));
+  LONGS_EQUAL(expected, mapping::drop_seen_through(readings, g, ordered, scratch));
+  for (const mapping::GuardPoint& c : plain)
+    CHECK_FALSE(seen_through_by_definition(readings, c, g));
+  for (const mapping::GuardPoint& c : ordered) {
+    CHECK_FALSE(seen_through_by_definition(readings, c, g));
+  }
+}
+
+// The ordered scan visits every pan bucket within the cone once: a reading alone in its bucket
+// counts once, however many buckets round it are looked at.
+TEST(FeatureGuard, AReadingSeenPastACandidateCountsOnceInEitherScan) {
+  FixedVector<Reading, 4> readings;
+  (void)readings.push_back(at(1.0F, 3.0F, 0.0F));  // straight behind the candidate
+  mapping::FeatureGuardParams g;
+  g.see_through_readings = 2;
+  std::array<std::uint32_t, 4> scratch{};
+  for (int behind = 1; behind <= 2; ++behind) {
+    GuardCandidatesFor<2> plain;
+    (void)plain.push_back(candidate_at(1.0F, 2.0F, 0.0F));
+    GuardCandidatesFor<2> ordered = plain;
+    const std::size_t expected = behind == 2 ? 1U : 0U;  // two readings needed
+    LONGS_EQUAL(expected, mapping::drop_seen_through(readings, g, plain));
+    LONGS_EQUAL(expected, mapping::drop_seen_through(readings, g, ordered, scratch));
+    (void)readings.push_back(at(1.001F, 3.5F, 0.0F));
+  }
+}
+
+// However coarse the range error (any fraction below the whole range), a reading far enough
+// behind a candidate shows the camera saw past it.
+TEST(FeatureGuard, WithARangeErrorOfMoreThanHalfTheRangeAReadingFarBehindStillSeesPast) {
+  FixedVector<Reading, 2> readings;
+  (void)readings.push_back(at(1.0F, 10.0F, 0.0F));  // 5 times as far: beyond both errors at 0.6
+  mapping::FeatureGuardParams g;
+  g.see_through_readings = 1;
+  g.delta_r_fraction = 0.6F;
+  std::array<std::uint32_t, 2> scratch{};
+  GuardCandidatesFor<2> plain;
+  (void)plain.push_back(candidate_at(1.0F, 2.0F, 0.0F));
+  GuardCandidatesFor<2> ordered = plain;
+  LONGS_EQUAL(1, mapping::drop_seen_through(readings, g, plain));
+  LONGS_EQUAL(1, mapping::drop_seen_through(readings, g, ordered, scratch));
+}
+
 TEST(FeatureGuard, OrderingTheReadingsByPanDropsTheSameCandidatesAsThePlainScan) {
   // A room's readings from views on a 0.21 m lever, and candidates among and in front of
   // them, many near the seam at pan 0 / 2π: both scans drop the same ones, in the same order.
