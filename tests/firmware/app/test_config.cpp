@@ -725,10 +725,14 @@ TEST(AtomicWrite, AWriteCutShortOrFailedClosesWhatItOpenedAndAFailureLeavesNoTem
         write_file_atomically(dir.c_str(), "a.txt", text, error, sizeof error, crash_at, &c));
     CHECK_EQUAL(before, open_descriptors());
   }
-  for (StorageCall call : {StorageCall::kWrite, StorageCall::kSync}) {
+  for (StorageCall call : {StorageCall::kWrite, StorageCall::kSync, StorageCall::kCreate}) {
     set_storage_fault_hook(fail_call, &call);
     CHECK_FALSE(write_file_atomically(dir.c_str(), "a.txt", text, error, sizeof error));
     set_storage_fault_hook(nullptr, nullptr);
+    const char* step = call == StorageCall::kCreate  ? "cannot create"
+                       : call == StorageCall::kWrite ? "cannot write"
+                                                     : "cannot sync";
+    STRCMP_CONTAINS(step, error);
     STRCMP_CONTAINS(std::strerror(EIO), error);
     CHECK_EQUAL(before, open_descriptors());
     CHECK(access((dir + "/a.txt.tmp").c_str(), F_OK) != 0);
