@@ -277,7 +277,10 @@ class Scratch:
             if os.path.isfile(target) and same_bytes(source, target):
                 continue
             os.makedirs(os.path.dirname(target), exist_ok=True)
-            shutil.copy2(source, target)
+            # A changed file gets the time of the copy, not its own: an object built in the
+            # scratch copy after the file was edited (but from its older text) would otherwise
+            # look newer than it, and the build would keep the stale object.
+            shutil.copy(source, target)
 
     def run(self, args, timeout=None):
         with open(self.log, "a", encoding="utf-8") as log:

@@ -19,14 +19,16 @@ src=$scratch/src
 mkdir -p "$src"
 
 # Copies the working tree (tracked and untracked, not ignored) into the scratch copy; files
-# that did not change keep their time stamps, so the build there stays incremental.
+# that did not change keep their time stamps, so the build there stays incremental, and a
+# changed one gets the copy's time (not its own, which can be older than an object built
+# there from its previous text).
 sync_tree() {
   (cd "$root" && git ls-files -co --exclude-standard -z) |
     while IFS= read -r -d '' f; do
       [ -f "$root/$f" ] || continue
       if ! cmp -s "$root/$f" "$src/$f"; then
         mkdir -p "$(dirname "$src/$f")"
-        cp -p "$root/$f" "$src/$f"
+        cp --preserve=mode "$root/$f" "$src/$f"
       fi
     done
 }
