@@ -424,6 +424,24 @@ TEST(OpenSpikes, WedgesNarrowerThanTheWindowGoAndWiderOpeningsStay) {
   for (std::size_t k = 0; k < 360; ++k) DOUBLES_EQUAL(before.rho_m(k), q.rho_m(k), 0.0);
 }
 
+// An opening exactly as wide as the window (2 × half width + 1 rays) stays whole, one ray
+// narrower goes; a polygon of three to five rays is opened too.
+TEST(OpenSpikes, AnOpeningExactlyAsWideAsTheWindowStaysAndOneRayNarrowerGoes) {
+  StarPolygon p(360);
+  p.fill(2.0F);
+  for (std::size_t k = 100; k < 105; ++k) p.set_rho_m(k, 3.0F);  // 5 rays: the window
+  for (std::size_t k = 200; k < 204; ++k) p.set_rho_m(k, 3.0F);  // 4 rays
+  boticelli::mapping::open_spikes(p, 2);
+  for (std::size_t k = 0; k < 360; ++k) {
+    DOUBLES_EQUAL(k >= 100 && k < 105 ? 3.0 : 2.0, p.rho_m(k), 1e-6);
+  }
+  StarPolygon small(5);
+  small.fill(1.0F);
+  small.set_rho_m(2, 4.0F);  // a spike one ray wide
+  boticelli::mapping::open_spikes(small, 1);
+  for (std::size_t k = 0; k < 5; ++k) DOUBLES_EQUAL(1.0, small.rho_m(k), 1e-6);
+}
+
 TEST_GROUP(KeepPointsThatCut){};
 
 namespace {
