@@ -409,6 +409,29 @@ TEST(ConfigFile, AMissingFileIsReportedAsMissingAndAnUnreadableOneAsInvalid) {
   remove_dir(dir);
 }
 
+// A file of up to 64 KiB is read (comments count too); a longer one is refused whole.
+TEST(ConfigFile, AFileOfUpTo64KiBIsReadAndALongerOneIsRefused) {
+  const std::string dir = temp_dir("config");
+  const std::string path = dir + "/boticelli.conf";
+  const std::string key = "[robot]\nradius_m = 0.3\n";
+  std::string text = key;
+  while (text.size() + 64 <= 64 * 1024) text += "# " + std::string(61, 'c') + "\n";
+  text += std::string(64 * 1024 - text.size() - 1, '#') + "\n";
+  CHECK_EQUAL(64U * 1024U, text.size());
+  write_file(path, text);
+  Rpi4Keys k;
+  char error[320] = "";
+  CHECK_TRUE_TEXT(
+      load_config_file(path.c_str(), k.schema, error, sizeof error) == ConfigLoad::kLoaded, error);
+  DOUBLES_EQUAL(0.3, static_cast<double>(k.config.robot_radius_m), 1e-7);
+  write_file(path, text + "\n");
+  Rpi4Keys fresh;
+  const ConfigLoad longer = load_config_file(path.c_str(), fresh.schema, error, sizeof error);
+  remove_dir(dir);
+  CHECK(longer == ConfigLoad::kInvalid);
+  STRCMP_EQUAL((path + ": larger than 64 KiB").c_str(), error);
+}
+
 // The shipped conffile names every key exactly once, commented out with the compiled-in
 // default: uncommented, it parses and changes nothing.
 TEST(ConfigFile, TheShippedConffileDocumentsEveryKeyWithItsDefault) {
