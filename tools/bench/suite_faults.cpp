@@ -116,9 +116,8 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
       if (m.back.empty() && text.rfind("devices back after ", 0) == 0) m.back = text;
     }
   }
-  for (const char* name :
-       {"plan.txt", "out.txt", "err.txt", "mission.state.a", "mission.state.b",
-        "sim-world.truth"}) {
+  for (const char* name : {"plan.txt", "out.txt", "err.txt", "mission.state.a", "mission.state.b",
+                           "sim-world.truth"}) {
     ::unlink((std::string(dir) + "/" + name).c_str());
   }
   ::rmdir(dir);

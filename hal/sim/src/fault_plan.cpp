@@ -33,8 +33,8 @@ constexpr std::array<std::uint8_t, kFaultDeviceCount> kApplies = {
     bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),    // estop
     bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),    // bumper
     bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kWrong) |
-        bit(FaultType::kIntermittent),  // storage
-    bit(FaultType::kStuck) | bit(FaultType::kSlow),                                   // main loop
+        bit(FaultType::kIntermittent),               // storage
+    bit(FaultType::kStuck) | bit(FaultType::kSlow),  // main loop
 };
 
 void say(char* error, std::size_t size, const char* name, std::size_t line, const char* why,
