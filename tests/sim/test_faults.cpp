@@ -171,7 +171,7 @@ TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
                  boticelli::hal::sim::fault_device_name(device));
     }
   }
-  CHECK_EQUAL(38, pairs);  // the FAULT_PAIR tests above
+  CHECK_EQUAL(39, pairs);  // the FAULT_PAIR tests above
 }
 
 TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {

@@ -162,12 +162,24 @@ TEST(MissionState, TwoStatesThatDifferInAnyOneFieldAreNotEqual) {
   CHECK_FALSE(equal_after([](MissionState& s) { s.log.pop_back(); }));
   CHECK_FALSE(equal_after([](MissionState& s) { ++s.log[2].cycle; }));
   CHECK_FALSE(equal_after([](MissionState& s) { s.log[2].text[0] = '#'; }));
+  CHECK(g_a.wheels_known && g_a.grid.size() > 1);
+  CHECK_FALSE(equal_after([](MissionState& s) { s.wheels_known = false; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.wheel_left_m += 0.5; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.wheel_right_m += 0.5; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.grid_cell_m = 0.1F; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { s.grid.pop_back(); }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.grid[1].tx; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.grid[1].ty; }));
+  CHECK_FALSE(equal_after([](MissionState& s) { ++s.grid[1].cells[200]; }));
   // Without a goal, where the goal would be does not count.
   g_a.has_goal = false;
   CHECK(equal_after([](MissionState& s) {
     s.goal.x_m += 0.5F;
     s.goal_height_m += 0.5F;
   }));
+  // Without the wheel counters, what they would read does not count either.
+  g_a.wheels_known = false;
+  CHECK(equal_after([](MissionState& s) { s.wheel_left_m += 0.5; }));
 }
 
 TEST(MissionState, ClearingGivesTheStateOfANewMission) {
