@@ -269,19 +269,35 @@ TEST_GROUP(JournalForwarder) {
   }
 };
 
-// Each line once, with its sd-daemon priority (warn 4, error 3, info 6), one line per entry.
+// Each line once, with its sd-daemon priority (warn 4, error 3, info 6), one line per entry
+// (the thread's work, done here by drain(): qemu-user cannot be trusted to start threads).
 TEST(JournalForwarder, WritesEachLineOnceWithItsPriorityAndNoNewlineInside) {
-  JournalForwarder journal;
+  static JournalForwarder journal;
+  journal.set_fd(fds[1]);
   CHECK(journal.push(LogLevel::kWarn, "camera: device gone (ENODEV), re-opening"));
   CHECK(journal.push(LogLevel::kError, "two\nlines"));
   CHECK(journal.push(LogLevel::kInfo, "back"));
-  CHECK(journal.start(fds[1]));
-  journal.stop();
+  journal.drain();
+  journal.drain();  // written once
   STRCMP_EQUAL("<4>camera: device gone (ENODEV), re-opening\n<3>two lines\n<6>back\n",
                read_pipe(fds[0]).c_str());
   CHECK_EQUAL(3U, journal.written());
-  CHECK_FALSE(journal.running());
 }
+
+// qemu-user (the cross presets' test runner) hangs in thread creation on some hosts: the
+// thread is tested by the native builds (and the ThreadSanitizer program).
+#ifndef BOTICELLI_TESTS_UNDER_EMULATOR
+TEST(JournalForwarder, ItsThreadWritesWhatIsQueuedAndStopWritesTheRest) {
+  static JournalForwarder journal;
+  CHECK(journal.push(LogLevel::kWarn, "before the start"));
+  CHECK(journal.start(fds[1]));
+  CHECK(journal.running());
+  CHECK(journal.push(LogLevel::kInfo, "while it runs"));
+  journal.stop();
+  CHECK_FALSE(journal.running());
+  STRCMP_EQUAL("<4>before the start\n<6>while it runs\n", read_pipe(fds[0]).c_str());
+}
+#endif
 
 // The executive's side never waits: a full queue drops the line and counts it, and pushing
 // allocates nothing; what was queued is written in order.
@@ -292,8 +308,8 @@ TEST(JournalForwarder, AFullQueueDropsAndCountsWithoutBlockingOrAllocating) {
   });
   CHECK_EQUAL(3U, journal.dropped());
   CHECK_FALSE(journal.push(LogLevel::kWarn, "still full"));
-  CHECK(journal.start(fds[1]));
-  journal.stop();
+  journal.set_fd(fds[1]);
+  journal.drain();
   const std::string out = read_pipe(fds[0]);
   CHECK_EQUAL(JournalForwarder::kSlots,
               static_cast<std::size_t>(std::count(out.begin(), out.end(), '\n')));
@@ -705,8 +721,8 @@ TEST(Console, LogLinesOfInfoAndAboveGoToTheJournalUnderTheirLevel) {
   console.log(LogLevel::kWarn, "PTU: no reply for %.1f s", 0.5);
   console.log(LogLevel::kInfo, "devices back");
   console.log(LogLevel::kDebug, "not for the journal");
-  CHECK(journal.start(fds[1]));
-  journal.stop();
+  journal.set_fd(fds[1]);
+  journal.drain();
   STRCMP_EQUAL("<4>PTU: no reply for 0.5 s\n<6>devices back\n", read_pipe(fds[0]).c_str());
   ::close(fds[0]);
   ::close(fds[1]);

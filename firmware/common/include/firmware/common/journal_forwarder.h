@@ -36,7 +36,9 @@ class JournalForwarder {
   bool push(LogLevel level, std::string_view text);
   std::uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
   std::uint64_t written() const { return written_.load(std::memory_order_relaxed); }
-  // Writes what is queued now (the thread's work; tests without the thread).
+  // Writes what is queued now to the fd set here or by start() (the thread's work; tests
+  // without the thread).
+  void set_fd(int fd) { fd_ = fd; }
   void drain();
 
  private:
