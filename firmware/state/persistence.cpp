@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <type_traits>
 
 namespace boticelli::firmware {
 namespace {
@@ -116,7 +117,12 @@ bool parse_u64(std::string_view text, std::uint64_t& out) {
   return true;
 }
 
-bool parse_float(std::string_view text, float& out) {
+// A float (or, for the wheel counters, a double written by "%.17g"): the whole text, plain
+// decimal or exponent notation, finite. Overflow gives ±inf (refused). Underflow (ERANGE with
+// a subnormal result) is accepted: the writer prints every value, subnormals included, so that
+// it reads back exactly.
+template <typename Real>
+bool parse_real(std::string_view text, Real& out) {
   constexpr std::size_t kMax = 40;
   if (text.empty() || text.size() > kMax) return false;
   for (const char c : text) {
@@ -128,34 +134,26 @@ bool parse_float(std::string_view text, float& out) {
   std::memcpy(copy, text.data(), text.size());
   copy[text.size()] = '\0';
   char* end = nullptr;
-  const float v = std::strtof(copy, &end);
-  // Overflow gives ±inf (refused). Underflow (ERANGE with a subnormal result) is accepted:
-  // the writer prints every float, subnormals included, so that it reads back exactly.
+  Real v{};
+  if constexpr (std::is_same_v<Real, float>) {
+    v = std::strtof(copy, &end);
+  } else {
+    v = std::strtod(copy, &end);
+  }
   if (end != copy + text.size() || !std::isfinite(v)) return false;
   out = v;
   return true;
+}
+
+bool parse_float(std::string_view text, float& out) {
+  return parse_real(text, out);
+}
+
+bool parse_double(std::string_view text, double& out) {
+  return parse_real(text, out);
 }
 
 // Exactly `n` floats separated by single spaces, nothing else.
-// A double as written by "%.17g" (the wheel counters: metres over a card's lifetime).
-bool parse_double(std::string_view text, double& out) {
-  constexpr std::size_t kMax = 40;
-  if (text.empty() || text.size() > kMax) return false;
-  for (const char c : text) {
-    if (!((c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E')) {
-      return false;
-    }
-  }
-  char copy[kMax + 1];
-  std::memcpy(copy, text.data(), text.size());
-  copy[text.size()] = '\0';
-  char* end = nullptr;
-  const double v = std::strtod(copy, &end);
-  if (end != copy + text.size() || !std::isfinite(v)) return false;
-  out = v;
-  return true;
-}
-
 bool parse_floats(std::string_view text, float* out, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     if (!parse_float(next_word(text), out[i])) return false;
