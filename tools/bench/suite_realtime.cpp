@@ -227,7 +227,7 @@ int run() {
   std::size_t parsed = 0;
   std::vector<std::string> dirs;
   const auto dir_for = [&](const std::string& name) {
-    const std::string dir = std::string(tmp) + "/" + name;
+    std::string dir = std::string(tmp) + "/" + name;  // returned: moved, not copied
     ::mkdir(dir.c_str(), 0755);
     dirs.push_back(dir);
     return dir;
@@ -368,7 +368,7 @@ int run() {
 
   // Frame start latency at --speed 1 with the robot's process set-up where permitted.
   if (paced_s > 0.0 && !names.empty()) {
-    const std::string name = names.front();
+    const std::string& name = names.front();
     const std::string world_path = std::string(folder).append("/").append(name).append(".sdf");
     const std::string dir = dir_for("paced");
     const std::string out = dir + "/console.txt";
