@@ -99,7 +99,8 @@ void feed_console(const std::string& out_path, std::size_t* scanned, int fd,
 
 }  // namespace
 
-// Runs the firmware with stdin from /dev/null (a pipe when `input` is given), stdout (the
+// Runs the firmware (args[0]: a path, or a program found on PATH such as an emulator that
+// runs it) with stdin from /dev/null (a pipe when `input` is given), stdout (the
 // stdio console and the MISSION line) into `out_path`, stderr into `err_path`. SIGTERM after
 // `timeout_s` (the firmware then aborts and still prints its MISSION line), SIGKILL 10 s
 // later. Returns the exit status (-1 when it could not be started or was killed by a
@@ -135,7 +136,7 @@ int run_firmware(const std::vector<std::string>& args, const std::string& out_pa
     ::dup2(in, STDIN_FILENO);
     ::dup2(out, STDOUT_FILENO);
     ::dup2(err, STDERR_FILENO);
-    ::execv(argv[0], argv.data());
+    ::execvp(argv[0], argv.data());  // a path runs as given; a bare name (an emulator) from PATH
     ::_exit(127);
   }
   if (input != nullptr) ::close(pipe_fds[0]);

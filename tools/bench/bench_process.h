@@ -24,7 +24,8 @@ struct ConsoleInput {
   std::string seen;  // out: the telemetry line it was typed after ("" when it was not typed)
 };
 
-// Runs the firmware with stdin from /dev/null (a pipe when `input` is given), stdout (the
+// Runs the firmware (args[0]: a path, or a program found on PATH such as an emulator that
+// runs it) with stdin from /dev/null (a pipe when `input` is given), stdout (the
 // stdio console and the MISSION line) into `out_path`, stderr into `err_path`. SIGTERM after
 // `timeout_s` (the firmware then aborts and still prints its MISSION line), SIGKILL 10 s
 // later. Returns the exit status (-1 when it could not be started or was killed by a

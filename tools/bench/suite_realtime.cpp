@@ -9,7 +9,10 @@
 // skips it), BOTICELLI_REALTIME_FIFO=1 (the missions with --realtime too: SCHED_FIFO where
 // permitted, so other processes do not preempt them; they then hold a core each while they
 // run), BOTICELLI_REALTIME_TIMEOUT_S (per mission, default 600), BOTICELLI_REALTIME_KEEP
-// (keep the outputs).
+// (keep the outputs), BOTICELLI_REALTIME_FIRMWARE (the firmware binary, default the one built
+// next to the bench), BOTICELLI_REALTIME_EMULATOR (a command the firmware is run through, words
+// split at spaces, e.g. "qemu-aarch64 -L /usr/aarch64-linux-gnu" for an aarch64 build: every
+// line then says "emulated" with the emulator's name, figures of the emulator, not a board).
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -172,6 +175,43 @@ double cpu_pressure_pct() {
   return field(" " + read_file("/proc/pressure/cpu"), "avg60");
 }
 
+// The firmware binary and the emulator it runs under (none: natively).
+struct Launch {
+  std::string path;
+  std::vector<std::string> emulator;  // program and arguments, before the firmware's path
+  std::string emulated = "no";        // the emulator program's name, on every output line
+  // The command line: the emulator's words, the firmware's path, then `args`.
+  std::vector<std::string> command(const std::vector<std::string>& args) const {
+    std::vector<std::string> out = emulator;
+    out.push_back(path);
+    out.insert(out.end(), args.begin(), args.end());
+    return out;
+  }
+};
+
+Launch firmware_launch() {
+  Launch f;
+  const char* path = std::getenv("BOTICELLI_REALTIME_FIRMWARE");
+  f.path = path != nullptr && *path != '\0' ? std::string(path) : own_directory() + "/boticelli";
+  if (const char* e = std::getenv("BOTICELLI_REALTIME_EMULATOR"); e != nullptr) {
+    std::istringstream words(e);
+    std::string word;
+    while (words >> word) f.emulator.push_back(word);
+  }
+  if (!f.emulator.empty()) {
+    const std::string& program = f.emulator.front();
+    f.emulated = program.substr(program.rfind('/') + 1);
+  }
+  return f;
+}
+
+// Every line of the suite says whether its figures are the emulator's.
+JsonLine output_line(const char* name, const Launch& launch) {
+  JsonLine line(kSuite, name);
+  line.text("emulated", launch.emulated.c_str());
+  return line;
+}
+
 std::vector<long> seed_list() {
   std::vector<long> seeds;
   const char* v = std::getenv("BOTICELLI_REALTIME_SEEDS");
@@ -188,10 +228,10 @@ std::vector<long> seed_list() {
 }
 
 int run() {
-  const std::string firmware_bin = own_directory() + "/boticelli";
-  if (::access(firmware_bin.c_str(), X_OK) != 0) {
+  const Launch launch = firmware_launch();
+  if (::access(launch.path.c_str(), X_OK) != 0) {
     std::fprintf(stderr, "realtime: no firmware binary at %s (build the 'boticelli' target)\n",
-                 firmware_bin.c_str());
+                 launch.path.c_str());
     return 1;
   }
   const long cycles = env_long("BOTICELLI_REALTIME_CYCLES", 8);
@@ -240,33 +280,29 @@ int run() {
       const std::string out = dir + "/console.txt";
       const std::string err = dir + "/stderr.txt";
       // Snapshots on: the picture's units run in the background like every other unit.
-      std::vector<std::string> args = {firmware_bin,
-                                       "--world",
-                                       world_path,
-                                       "--seed",
-                                       std::to_string(seed),
-                                       "--max-cycles",
-                                       std::to_string(cycles),
-                                       "--snapshots",
-                                       dir + "/snapshots",
-                                       "--host-slices",
-                                       "--console",
+      std::vector<std::string> args = {"--world",       world_path,
+                                       "--seed",        std::to_string(seed),
+                                       "--max-cycles",  std::to_string(cycles),
+                                       "--snapshots",   dir + "/snapshots",
+                                       "--host-slices", "--console",
                                        "stdio"};
       if (fifo_missions) args.emplace_back("--realtime");
       bool timed_out = false;
       double cpu_s = 0.0;
       const double t0 = wall_s();
-      const int exit_code = run_firmware(args, out, err, timeout_s, timed_out, cpu_s);
+      const int exit_code =
+          run_firmware(launch.command(args), out, err, timeout_s, timed_out, cpu_s);
       const double wall = wall_s() - t0;
       ++runs;
       const RunOutput r = parse_run(out, err);
       if (r.tasks.empty()) {
-        std::fprintf(stderr, "realtime: %s seed %ld: no host timing lines (output in %s)\n",
-                     name.c_str(), seed, out.c_str());
+        std::fprintf(stderr,
+                     "realtime: %s seed %ld: no host timing lines (exit code %d, output in %s)\n",
+                     name.c_str(), seed, exit_code, out.c_str());
         continue;
       }
       ++parsed;
-      JsonLine line(kSuite, name.c_str());
+      JsonLine line = output_line(name.c_str(), launch);
       line.integer("seed", seed)
           .text("result", r.result.c_str())
           .integer("exit_code", exit_code)
@@ -314,7 +350,7 @@ int run() {
     const bool within_wall = t.wall_worst_us <= budget;
     tasks_within = tasks_within && within;
     tasks_within_wall = tasks_within_wall && within_wall;
-    JsonLine(kSuite, "task")
+    output_line("task", launch)
         .text("task", task.c_str())
         .num("budget_us", budget)
         .num("runs", t.count)
@@ -330,7 +366,7 @@ int run() {
   // the margin still ended before the next frame (the margin is there for the unit begun last).
   const bool slices_within = parsed > 0 && slice_over_limit == 0.0;
   const bool slices_within_frame = parsed > 0 && !(slice_overshoot_us > margin_us);
-  JsonLine(kSuite, "background")
+  output_line("background", launch)
       .num("limit_us", slice_limit_us)
       .num("slices", slices.count)
       .num("wall_p99_us", slices.wall_p99_us)
@@ -343,7 +379,7 @@ int run() {
       .flag("within_limit", slices_within)
       .flag("within_frame", slices_within_frame)
       .emit();
-  JsonLine(kSuite, "frame")
+  output_line("frame", launch)
       .integer("frame_us", firmware::kDefaultMinorFrameUs)
       .num("frames", work.count)
       .num("work_wall_p99_us", work.wall_p99_us)
@@ -355,7 +391,7 @@ int run() {
   const double half_frame_ms = firmware::kDefaultMinorFrameUs * 0.5e-3;
   bool units_within = parsed > 0;
   {
-    JsonLine line(kSuite, "units");
+    JsonLine line = output_line("units", launch);
     line.num("half_frame_ms", half_frame_ms);
     for (const char* unit : kUnitNames) {
       const double ms = longest_ms.count(unit) != 0U ? longest_ms[unit] : kNaN;
@@ -374,16 +410,16 @@ int run() {
     const std::string out = dir + "/console.txt";
     const std::string err = dir + "/stderr.txt";
     const std::vector<std::string> args = {
-        firmware_bin, "--world", world_path,   "--seed",        std::to_string(seeds.front()),
-        "--speed",    "1",       "--realtime", "--host-slices", "--console",
-        "stdio"};
+        "--world",   world_path, "--seed",     std::to_string(seeds.front()),
+        "--speed",   "1",        "--realtime", "--host-slices",
+        "--console", "stdio"};
     bool timed_out = false;
     double cpu_s = 0.0;
-    const int exit_code = run_firmware(args, out, err, paced_s, timed_out, cpu_s);
+    const int exit_code = run_firmware(launch.command(args), out, err, paced_s, timed_out, cpu_s);
     const RunOutput r = parse_run(out, err);
     const bool fifo = r.realtime.find("SCHED_FIFO priority") != std::string::npos;
     const bool locked = r.realtime.find("memory locked") != std::string::npos;
-    JsonLine(kSuite, "jitter")
+    output_line("jitter", launch)
         .text("world", name.c_str())
         .num("paced_s", paced_s)
         .integer("exit_code", exit_code)
@@ -403,7 +439,8 @@ int run() {
     }
   }
 
-  JsonLine(kSuite, "summary")
+  output_line("summary", launch)
+      .text("firmware", launch.path.c_str())
       .integer("worlds", static_cast<std::int64_t>(names.size()))
       .integer("seeds", static_cast<std::int64_t>(seeds.size()))
       .integer("runs", static_cast<std::int64_t>(runs))
