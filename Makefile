@@ -11,7 +11,7 @@ FUZZ_SECONDS ?= 60
 .PHONY: help deps deps-cross deps-armhf deps-bench deps-analyze deps-kernel deps-box test-kernel \
         test-robot run test check \
         bench bench-build format format-check sim asan rpi4 armhf fuzz-build test-sim test-asan \
-        test-rpi4 test-fuzz fuzz \
+        test-rpi4 test-fuzz fuzz bench-aarch64 \
         analyze mutants mutation-score clean
 
 help:
@@ -21,6 +21,8 @@ help:
 	@echo "make test-kernel  the drivers against the kernel's virtual devices under qemu"
 	@echo "make check     format-check, analyze and build the bench (about 15 min on two cores)"
 	@echo "make bench     build the sim preset and run boticelli-bench \$$SUITE (default all)"
+	@echo "make bench-aarch64  the realtime suite on the sim board built for aarch64, under"
+	@echo "               qemu-aarch64: an emulated upper bound, not Pi figures (not in make test)"
 	@echo "make armhf     cross build for 32-bit ARM (arm-linux-gnueabihf)"
 	@echo "make package-rpi4 / make deploy HOST=user@robot   build the arm64 .deb / install it over ssh"
 	@echo "make test-robot  the .deb as a service on a virtual robot computer under qemu (not in make test)"
@@ -137,6 +139,29 @@ bench: deps-bench
 	$(call build,sim)
 	cmake --build --preset sim --target boticelli-bench -j $(JOBS)
 	build/sim/bin/boticelli-bench $(SUITE) --json
+
+# The realtime suite (docs/benchmarks.md) on the sim board's firmware cross built for aarch64
+# (preset sim-aarch64: the firmware only), each mission run through qemu-aarch64 by the host's
+# bench; every output line says "emulated":"qemu-aarch64". Only this suite runs the firmware
+# through the emulator, so SUITE may only be realtime. The paced run is skipped unless
+# BOTICELLI_REALTIME_PACED_S is set: under emulation it would measure the emulator falling
+# behind the wall clock, on a core held with SCHED_FIFO. Not part of make test or make check.
+# No -L /usr/aarch64-linux-gnu: that prefix puts the cross package's loader (libc6-arm64-cross)
+# in front of the :arm64 libc.so.6 of another glibc build, and with that pair pthread_create
+# and fork hang; without it loader and libraries are the :arm64 packages' (libc6:arm64 comes
+# with deps-cross's libraries), as on a Debian arm64 system.
+AARCH64_EMULATOR := qemu-aarch64
+bench-aarch64: deps-bench deps-cross
+	@test "$(SUITE)" = realtime || test "$(SUITE)" = all \
+	  || { echo "make bench-aarch64: only SUITE=realtime runs under the emulator" >&2; exit 2; }
+	cmake --preset sim-aarch64 >/dev/null
+	cmake --build --preset sim-aarch64 --target boticelli -j $(JOBS)
+	cmake --preset sim >/dev/null
+	cmake --build --preset sim --target boticelli-bench -j $(JOBS)
+	BOTICELLI_REALTIME_FIRMWARE=build/sim-aarch64/bin/boticelli \
+	  BOTICELLI_REALTIME_EMULATOR="$(AARCH64_EMULATOR)" \
+	  BOTICELLI_REALTIME_PACED_S=$${BOTICELLI_REALTIME_PACED_S:-0} \
+	  build/sim/bin/boticelli-bench realtime --json
 
 format:
 	@git ls-files '*.h' '*.hpp' '*.cpp' | xargs clang-format -i
