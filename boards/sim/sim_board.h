@@ -87,13 +87,19 @@ class SimBoard final : public firmware::Board,
  private:
   static constexpr firmware::BoardInfo kInfo{"sim", "host simulation board", true};
 
-  // The POSIX clocks, less the simulator's own CPU work inside device calls (the camera's
-  // rendering, SimWorld::simulator_cpu_ns): the thread CPU time the executive sees is the
-  // firmware's. Wall time stays the host's: what a deadline on this host sees.
+  // The POSIX clocks, less the simulator's own work inside device calls (the camera's
+  // rendering, SimWorld::simulator_cpu_ns and simulator_wall_ns): the thread CPU time and the
+  // wall time the executive sees are the firmware's. The wall clock stands still while the
+  // simulator renders, as a robot's camera works beside the firmware; everything else on the
+  // host (preemption, other processes) stays in it.
   class SimHostClock final : public firmware::HostClock {
    public:
     explicit SimHostClock(const hal::sim::SimWorld& world) : world_(world) {}
-    std::uint64_t monotonic_ns() override { return host_.monotonic_ns(); }
+    std::uint64_t monotonic_ns() override {
+      const std::uint64_t wall_ns = host_.monotonic_ns();
+      const std::uint64_t simulator_ns = world_.simulator_wall_ns();
+      return wall_ns > simulator_ns ? wall_ns - simulator_ns : 0;
+    }
     std::uint64_t thread_cpu_ns() override {
       const std::uint64_t cpu_ns = host_.thread_cpu_ns();
       const std::uint64_t simulator_ns = world_.simulator_cpu_ns();

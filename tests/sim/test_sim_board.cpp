@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <string>
 
@@ -259,4 +260,44 @@ TEST(SimBoard, ATornNewestRecordOfTheWorldsFileFallsBackToTheOneBefore) {
         WorldTruthFile::Load::kLoaded);
   DOUBLES_EQUAL(1.25, out.x_m, 0.0);
   remove_truth_dir(dir);
+}
+
+namespace {
+std::uint64_t host_monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000U +
+         static_cast<std::uint64_t>(ts.tv_nsec);
+}
+}  // namespace
+
+// The board's host clock is the firmware's: the simulator's rendering inside a camera poll
+// (what a robot's camera does beside the firmware) is left out of its wall time as of its CPU
+// time, and the clock still never goes back.
+TEST(SimBoard, TheHostClockLeavesTheSimulatorsRenderingOutOfTheFirmwaresWallTime) {
+  const std::string path = world_path("thesis_room");
+  boticelli::firmware::Options options;
+  options.world_file = path.c_str();
+  board->settings().camera_fps = 5.0F;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  hal::Hal& h = board->hal();
+  CHECK(h.camera.init());
+  boticelli::firmware::HostClock& clock = *board->host_clock();
+  const std::uint64_t booked_ns = board->sim().simulator_wall_ns();
+  const std::uint64_t host_before_ns = host_monotonic_ns();
+  const std::uint64_t before_ns = clock.monotonic_ns();
+  hal::Frame frame;
+  CHECK(h.camera.poll(frame) == hal::CameraPoll::kFrame);  // renders the first frame
+  h.camera.release();
+  const std::uint64_t after_ns = clock.monotonic_ns();
+  const std::uint64_t host_after_ns = host_monotonic_ns();
+  const std::uint64_t rendering_ns = board->sim().simulator_wall_ns() - booked_ns;
+  CHECK(rendering_ns > 0U);
+  CHECK(after_ns >= before_ns);
+  CHECK(after_ns - before_ns <= host_after_ns - host_before_ns - rendering_ns);
+  // A poll without a new frame renders nothing, and the clock moves on with the host's.
+  const std::uint64_t quiet_ns = clock.monotonic_ns();
+  CHECK(h.camera.poll(frame) == hal::CameraPoll::kNoFrame);
+  CHECK_EQUAL(board->sim().simulator_wall_ns() - booked_ns, rendering_ns);
+  CHECK(clock.monotonic_ns() >= quiet_ns);
 }

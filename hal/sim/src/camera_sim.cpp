@@ -15,6 +15,13 @@ std::uint64_t thread_cpu_ns() {
          static_cast<std::uint64_t>(ts.tv_nsec);
 }
 
+std::uint64_t wall_ns() {
+  timespec ts{};
+  if (::clock_gettime(CLOCK_MONOTONIC, &ts) != 0) return 0;
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000000U +
+         static_cast<std::uint64_t>(ts.tv_nsec);
+}
+
 }  // namespace
 
 bool CameraSim::setup(float fps, char* error, std::size_t error_size) {
@@ -48,12 +55,15 @@ void CameraSim::capture() {
   last_pose_ = world_.camera_pose();
   const std::uint32_t width = renderer_.width_px();
   // Rendering is the simulator's work, not the driver's (a V4L2 dequeue hands over a buffer):
-  // its CPU time is booked so that host timings can leave it out.
+  // its CPU and wall time are booked so that host timings can leave them out.
+  const std::uint64_t wall_start_ns = wall_ns();
   const std::uint64_t cpu_start_ns = thread_cpu_ns();
   renderer_.render(last_pose_, sequence_, image_.get(), std::size_t{2} * width,
                    depth_enabled_ ? depth_.get() : nullptr);
   const std::uint64_t cpu_end_ns = thread_cpu_ns();
+  const std::uint64_t wall_end_ns = wall_ns();
   if (cpu_end_ns > cpu_start_ns) world_.add_simulator_cpu_ns(cpu_end_ns - cpu_start_ns);
+  if (wall_end_ns > wall_start_ns) world_.add_simulator_wall_ns(wall_end_ns - wall_start_ns);
   has_frame_ = true;
 }
 

@@ -190,6 +190,11 @@ class SimWorld {
   // firmware's CPU figures are its own work.
   void add_simulator_cpu_ns(std::uint64_t ns) { simulator_cpu_ns_ += ns; }
   std::uint64_t simulator_cpu_ns() const { return simulator_cpu_ns_; }
+  // The same work's host wall time [ns] (CLOCK_MONOTONIC): on a robot the camera exposes and
+  // hands over its frames beside the firmware, so the board's host clock leaves this out of
+  // the firmware's wall time too (its deadlines and wall figures). Never decreases.
+  void add_simulator_wall_ns(std::uint64_t ns) { simulator_wall_ns_ += ns; }
+  std::uint64_t simulator_wall_ns() const { return simulator_wall_ns_; }
 
  private:
   void step(std::uint32_t dt_us);
@@ -267,6 +272,7 @@ class SimWorld {
   // Why the base cannot leave kStopped now (an axis or CAN fault is active), or nullptr.
   const char* base_fault() const;
   std::uint64_t simulator_cpu_ns_ = 0;
+  std::uint64_t simulator_wall_ns_ = 0;
 };
 
 }  // namespace boticelli::hal::sim
