@@ -203,7 +203,7 @@ bool SimBoard::inject(std::string_view device, std::string_view type, double sec
   if (!hal::sim::parse_fault_device(device, d)) {
     reply.append(
         "unknown device (camera, ptu, axis-left, axis-right, can, estop, bumper, "
-        "storage, main-loop)");
+        "storage, main-loop, watchdog)");
     return false;
   }
   if (!hal::sim::parse_fault_type(type, t)) {

@@ -162,7 +162,12 @@ void WatchdogTask::run(std::uint64_t now_us) {
     }
   }
   if (executive_.all_running() && !gave_up_) {
-    watchdog_.kick();
+    if (watchdog_.kick()) {
+      refusing_since_us_ = 0;
+    } else {
+      ++refused_;
+      if (refusing_since_us_ == 0) refusing_since_us_ = now_us != 0 ? now_us : 1;
+    }
     notifier_.watchdog();
     ++kicks_;
   } else {

@@ -278,7 +278,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   g_mission.emplace(mission::MissionContext{
       hal, config, rt.safety, rt.executive, g_state, store != nullptr ? &rt.saver : nullptr,
       board.truth(), options.trace_file != nullptr ? &g_trace : nullptr,
-      options.snapshots_dir != nullptr ? &g_snapshots : nullptr});
+      options.snapshots_dir != nullptr ? &g_snapshots : nullptr, &rt.watchdog_task});
   mission::Mission& mission = *g_mission;
   g_mission_task.emplace(mission);
   const char* why = "";

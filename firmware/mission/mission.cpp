@@ -111,6 +111,7 @@ Mission::Mission(const MissionContext& c)
       state_(c.state),
       saver_(c.saver),
       truth_(c.truth),
+      watchdog_(c.watchdog),
       trace_(c.trace),
       snapshots_(c.snapshots),
       params_(make_mission_params(c.config)),
@@ -290,6 +291,10 @@ void Mission::control(std::uint64_t now_us) {
     finish(Result::kAborted, "bumper contact", Ending::kFinal);
     return;
   }
+  if (watchdog_ != nullptr && !watchdog_->healthy() && phase_ != Phase::kHold) {
+    return hold_for_device("watchdog refusing keep-alives (a reset may come)",
+                           watchdog_->health_reason(), now_us);
+  }
   if (hold_needed() && phase_ != Phase::kHold) {
     held_phase_ = phase_;
     phase_ = Phase::kHold;
@@ -346,6 +351,7 @@ void Mission::control_hold(std::uint64_t now_us) {
     // and the camera's drivers re-open by themselves; the base task restarts the base).
     if (now_us < device_retry_at_us_ || hal_.pan_tilt.state().fault) return;
     if (hal_.base.health() != hal::BaseHealth::kReady) return;
+    if (watchdog_ != nullptr && !watchdog_->healthy()) return;
     device_hold_ = false;
   }
   // Latched, or reset and waiting for the console's `resume`: only the operator ends it (a

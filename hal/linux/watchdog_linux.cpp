@@ -76,13 +76,14 @@ bool WatchdogLinux::start(std::uint32_t timeout_ms) {
   return true;
 }
 
-void WatchdogLinux::kick() {
-  if (fd_ < 0) return;
+bool WatchdogLinux::kick() {
+  if (fd_ < 0) return true;
   int dummy = 0;
-  if (io_.ioctl(fd_, WDIOC_KEEPALIVE, &dummy) != 0) {
-    // Some drivers only take writes as keep-alive.
-    if (io_.write(fd_, "k", 1) != 1) set_error(error_, "watchdog: keep-alive failed", errno);
-  }
+  if (io_.ioctl(fd_, WDIOC_KEEPALIVE, &dummy) == 0) return true;
+  // Some drivers only take writes as keep-alive.
+  if (io_.write(fd_, "k", 1) == 1) return true;
+  set_error(error_, "watchdog: keep-alive refused", errno);
+  return false;
 }
 
 void WatchdogLinux::stop() {

@@ -108,9 +108,14 @@ class FakePanTilt final : public hal::PanTilt {
 class FakeWatchdog final : public hal::Watchdog {
  public:
   bool start(std::uint32_t) override { return true; }
-  void kick() override { ++kicks; }
+  bool kick() override {
+    ++kicks;
+    return !refuses;
+  }
   void stop() override {}
+  const char* error() const override { return refuses ? "watchdog: keep-alive refused: EIO" : ""; }
   int kicks = 0;
+  bool refuses = false;  // every keep-alive refused while set
 };
 
 }  // namespace boticelli::test

@@ -78,6 +78,10 @@ class FakeWatchdogIo final : public WatchdogIo {
       return 0;
     }
     if (request == WDIOC_KEEPALIVE) {
+      if (refuse_keepalive) {
+        errno = EIO;
+        return -1;
+      }
       ++keepalives;
       return 0;
     }
@@ -86,6 +90,10 @@ class FakeWatchdogIo final : public WatchdogIo {
   }
   long write(int fd, const void* data, std::size_t size) override {
     if (fd != 7 || !open_) return -1;
+    if (refuse_keepalive && size == 1 && *static_cast<const char*>(data) == 'k') {
+      errno = EIO;
+      return -1;
+    }
     log.push_back("write " + std::string(static_cast<const char*>(data), size));
     return static_cast<long>(size);
   }
@@ -98,6 +106,7 @@ class FakeWatchdogIo final : public WatchdogIo {
   int keepalives = 0;
   bool fail_open = false;
   bool fail_settimeout = false;
+  bool refuse_keepalive = false;  // the ioctl and the write both fail (EIO)
   int driver_timeout_s = 0;
 
  private:
@@ -134,10 +143,23 @@ TEST(WatchdogLinux, TheTimeoutTheDriverChoseIsReported) {
 TEST(WatchdogLinux, KickIsAKeepAliveIoctlAndDoesNotAllocate) {
   FakeWatchdogIo io;
   WatchdogLinux wd(WatchdogConfig{}, &io);
-  wd.kick();  // not started: nothing
+  CHECK_TRUE(wd.kick());  // not started: nothing to keep alive
   CHECK_EQUAL(0, io.keepalives);
   CHECK_TRUE(wd.start(1000));
   CHECK_NO_ALLOCATION(wd.kick());
+  CHECK_EQUAL(1, io.keepalives);
+}
+
+TEST(WatchdogLinux, AKeepAliveRefusedByIoctlAndWriteIsReportedWithTheError) {
+  FakeWatchdogIo io;
+  WatchdogLinux wd(WatchdogConfig{}, &io);
+  CHECK_TRUE(wd.start(1000));
+  io.refuse_keepalive = true;
+  CHECK_FALSE(wd.kick());
+  STRCMP_CONTAINS("keep-alive refused", wd.error());
+  STRCMP_CONTAINS("Input/output error", wd.error());
+  io.refuse_keepalive = false;
+  CHECK_TRUE(wd.kick());
   CHECK_EQUAL(1, io.keepalives);
 }
 

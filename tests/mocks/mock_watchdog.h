@@ -17,7 +17,9 @@ class MockWatchdog final : public hal::Watchdog {
         .withParameter("timeout_ms", static_cast<unsigned int>(timeout_ms))
         .returnBoolValueOrDefault(true);
   }
-  void kick() override { mock().actualCall("Watchdog.kick").onObject(this); }
+  bool kick() override {
+    return mock().actualCall("Watchdog.kick").onObject(this).returnBoolValueOrDefault(true);
+  }
   void stop() override { mock().actualCall("Watchdog.stop").onObject(this); }
   const char* error() const override {
     return mock().actualCall("Watchdog.error").onObject(this).returnStringValueOrDefault("");

@@ -402,6 +402,36 @@ TEST(SimDevices, TheLedAndTheWatchdogStandInRecordWhatTheFirmwareDoes) {
   UNSIGNED_LONGS_EQUAL(n, g_sim.watchdog_expirations());
 }
 
+TEST(SimDevices, AWatchdogFaultRefusesKeepAlivesOrTheStartAsTheKernelWould) {
+  start("rectangular_room");
+  ClockSim clock(g_sim);
+  WatchdogSim dog(g_sim);
+  // Busy: another process holds the device while the fault lasts.
+  CHECK(g_sim.faults().inject(FaultDevice::kWatchdog, FaultType::kStuck, 0, 100000));
+  CHECK_FALSE(dog.start(100));
+  STRCMP_CONTAINS("busy", dog.error());
+  clock.sleep_until_us(150000);
+  CHECK(dog.start(100));
+  STRCMP_EQUAL("", dog.error());
+  clock.sleep_until_us(200000);
+  CHECK(dog.kick());
+  // Keep-alives refused: they do not reach the stand-in, which expires as the board would
+  // reset; once they are taken again it counts no more.
+  CHECK(g_sim.faults().inject(FaultDevice::kWatchdog, FaultType::kOff, 200000, 300000));
+  for (std::uint64_t t = 210000; t < 500000; t += 10000) {
+    clock.sleep_until_us(t);
+    CHECK_FALSE(dog.kick());
+  }
+  STRCMP_CONTAINS("keep-alive refused", dog.error());
+  CHECK(g_sim.watchdog_expirations() >= 1);
+  const auto n = g_sim.watchdog_expirations();
+  for (std::uint64_t t = 500000; t < 900000; t += 10000) {
+    clock.sleep_until_us(t);
+    CHECK(dog.kick());
+  }
+  UNSIGNED_LONGS_EQUAL(n, g_sim.watchdog_expirations());
+}
+
 TEST(SimDevices, TheClockAdvancesOnlyWhenSleptAndExactlyToTheDeadline) {
   start("rectangular_room");
   ClockSim clock(g_sim);
@@ -441,15 +471,19 @@ TEST(SimDevices, TheCameraDeliversFramesAtItsRateFromTheCurrentPose) {
   // Rendering is the simulator's work: its CPU time is booked (the board's host clock leaves it
   // out of the firmware's figures); a poll without a new frame renders nothing.
   std::uint64_t booked_ns = g_sim.simulator_cpu_ns();
+  const std::uint64_t booked_wall_ns = g_sim.simulator_wall_ns();
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kFrame);
   CHECK(g_sim.simulator_cpu_ns() > booked_ns);
+  CHECK(g_sim.simulator_wall_ns() > booked_wall_ns);
   UNSIGNED_LONGS_EQUAL(0, frame.sequence);
   UNSIGNED_LONGS_EQUAL(320, frame.stride_bytes);
   std::vector<std::uint8_t> first(frame.data, frame.data + 320 * 120);
   camera.release();
   booked_ns = g_sim.simulator_cpu_ns();
+  const std::uint64_t wall_before_ns = g_sim.simulator_wall_ns();
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kNoFrame);
   CHECK_EQUAL(booked_ns, g_sim.simulator_cpu_ns());
+  CHECK_EQUAL(wall_before_ns, g_sim.simulator_wall_ns());
   clock.sleep_until_us(20000);
   CHECK(camera.poll(frame) == boticelli::hal::CameraPoll::kNoFrame);
   clock.sleep_until_us(33333);

@@ -158,6 +158,11 @@ FAULT_PAIR_MORE(StateSavesFailingNowAndThenAreReportedAndTheLastGoodFileStays, k
 FAULT_PAIR_MORE(AStalledMainLoopIsCaughtByTheOdrivesWatchdogAndTheBaseRestartedAfter, kMainLoop,
                 kStuck)
 FAULT_PAIR_MORE(ASlowMainLoopOverrunsItsFramesAndKeepsTheBaseUnderControl, kMainLoop, kSlow)
+FAULT_PAIR_MORE(AWatchdogRefusingKeepAlivesMakesItsTaskUnhealthyUntilOneIsTakenAgain, kWatchdog,
+                kOff)
+FAULT_PAIR_MORE(ABusyWatchdogDeviceAtTheStartLeavesTheRobotRunningAndStatusSaysUnavailable,
+                kWatchdog, kStuck)
+FAULT_PAIR_MORE(AWatchdogRefusingKeepAlivesNowAndThenIsReportedEachTime, kWatchdog, kIntermittent)
 
 TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
   int pairs = 0;
@@ -171,7 +176,7 @@ TEST(Faults, EveryApplicablePairHasAnExpectationAndATest) {
                  boticelli::hal::sim::fault_device_name(device));
     }
   }
-  CHECK_EQUAL(39, pairs);  // the FAULT_PAIR tests above
+  CHECK_EQUAL(42, pairs);  // the FAULT_PAIR tests above
 }
 
 TEST(Faults, TheBoardInjectsAFaultFromTheConsoleThatTheDeviceSeesAndListsIt) {

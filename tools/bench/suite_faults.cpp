@@ -54,6 +54,8 @@ struct MissionOutcome {
   // The mission log's hold for a device and its end (Mission::hold_for_device), if any.
   std::string held;
   std::string back;
+  // A fault from the start: the firmware's start-up warning about it (stderr), if any.
+  std::string start_warning;
 };
 
 // The MISSION line's fields: result=WORD ... reason="TEXT".
@@ -71,7 +73,7 @@ void parse_mission(const std::string& out, MissionOutcome& m) {
 }
 
 MissionOutcome run_mission(const std::string& firmware, const std::string& world,
-                           FaultDevice device, FaultType type, bool operator_reset) {
+                           FaultDevice device, FaultType type, bool operator_reset, bool at_start) {
   MissionOutcome m;
   char dir_template[] = "/tmp/boticelli-faults-XXXXXX";
   const char* dir = ::mkdtemp(dir_template);
@@ -79,8 +81,9 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
   const std::string plan = std::string(dir) + "/plan.txt";
   if (std::FILE* f = std::fopen(plan.c_str(), "w"); f != nullptr) {
     std::fprintf(f, "# one fault in the first look\n%.1f %s %s %.1f\n",
-                 boards::sim::kMissionFaultStartS, hal::sim::fault_device_name(device),
-                 hal::sim::fault_type_name(type), boards::sim::kMissionFaultS);
+                 at_start ? 0.0 : boards::sim::kMissionFaultStartS,
+                 hal::sim::fault_device_name(device), hal::sim::fault_type_name(type),
+                 boards::sim::kMissionFaultS);
     std::fclose(f);
   }
   const std::string out = std::string(dir) + "/out.txt";
@@ -96,6 +99,11 @@ MissionOutcome run_mission(const std::string& firmware, const std::string& world
                       plan, "--state", dir, "--console", "stdio"},
                      out, err, 600.0, timed_out, m.cpu_s, operator_reset ? &input : nullptr);
   parse_mission(read_file(out), m);
+  if (at_start) {
+    const std::string text = read_file(err);
+    const std::size_t w = text.find("watchdog not armed");
+    if (w != std::string::npos) m.start_warning = text.substr(w, text.find('\n', w) - w);
+  }
   if (operator_reset) {
     m.reset_seen = input[0].seen;
     m.resume_seen = input[1].seen;
@@ -134,7 +142,9 @@ std::string cell(std::string text) {
 }
 
 std::string expected_text(const FaultExpectation& e) {
-  std::string s = !e.stops_base ? "base keeps moving; "
+  std::string s = e.at_start      ? "from the board's start (the fault a start meets), for 3 s: "
+                                    "base keeps moving; "
+                  : !e.stops_base ? "base keeps moving; "
                   : e.detect_us > 0
                       ? "base stops commanding within a frame of the driver's 1 s check of the "
                         "wheels against their setpoints, "
@@ -183,7 +193,10 @@ std::string seen_text(const FaultExpectation& e, const FaultScenarioResult& r) {
                                           : ", drove on after a restart")
                       : (r.stayed_stopped ? ", stayed stopped" : ", moved again during it"));
   } else {
-    std::snprintf(buf, sizeof buf, "base %s; ", r.moving_before ? "kept moving" : "was not moving");
+    std::snprintf(buf, sizeof buf, "base %s; ",
+                  e.at_start        ? "moved through it (from the start)"
+                  : r.moving_before ? "kept moving"
+                                    : "was not moving");
   }
   s += buf;
   s += r.says_expected ? "console said it; " : "console did NOT say it; ";
@@ -281,14 +294,16 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
         }
         ::rmdir(dir);
       }
-      const MissionOutcome m = run_mission(firmware, world, device, type, e.operator_reset);
+      const MissionOutcome m =
+          run_mission(firmware, world, device, type, e.operator_reset, e.at_start);
       // The MISSION line counts bumper contacts: a faulted bumper line's are not the world's
       // (the stand-in's run checks the simulator's own count, which stays 0).
       const bool contacts_ok = m.collisions == 0 || device == FaultDevice::kBumper;
       const bool reset_ok = !e.operator_reset || (m.held_until_reset && m.held_until_resume);
       const bool holds_ok = !e.mission_holds || (!m.held.empty() && !m.back.empty());
+      const bool start_ok = !e.at_start || !m.start_warning.empty();
       const bool mission_ok = m.ran && contacts_ok && m.state_loadable && reset_ok && holds_ok &&
-                              (m.result == "aborted") == e.mission_aborts;
+                              start_ok && (m.result == "aborted") == e.mission_aborts;
       const bool ok = ran && g_result.passed && mission_ok;
       passed += ok ? 1 : 0;
       JsonLine(kSuite, "pair")
@@ -329,6 +344,9 @@ BOTICELLI_BENCH_SUITE(faults, "every injected (device, fault type) pair: firmwar
                                                  : ", COLLISIONS=" + std::to_string(m.collisions)) +
                (m.state_loadable ? "" : ", state file NOT loadable") +
                (m.held.empty() ? "" : "; mission log: `" + m.held + "`, `" + m.back + "`") +
+               (!e.at_start               ? ""
+                : m.start_warning.empty() ? "; NO start-up warning"
+                                          : "; at start: `" + m.start_warning + "`") +
                (!e.operator_reset ? ""
                 : m.reset_seen.empty()
                     ? "; clear-estop NOT typed (no telemetry line for it)"

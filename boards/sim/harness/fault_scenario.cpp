@@ -58,6 +58,10 @@ constexpr const char* kHoldsUntilReset =
 // The driver's check of a wheel against its setpoint trips after 1 s (BaseParams
 // follow_timeout_us), seen at the next frame; a jammed wheel first slows to a quarter of its
 // setpoint (0.06 s at the brake deceleration).
+constexpr const char* kWatchdogHold =
+    "holds while the keep-alives are refused (a board that resets mid-drive lets the robot "
+    "coast), carries on once one is taken; on a robot a refusal longer than the timeout resets "
+    "the board and the service resumes at boot";
 constexpr std::uint32_t kFollowDetectUs = 1010000;
 constexpr std::uint32_t kJamDetectUs = 1100000;
 constexpr ExpectationRow kExpectations[] = {
@@ -195,6 +199,20 @@ constexpr ExpectationRow kExpectations[] = {
     {FaultDevice::kMainLoop,
      FaultType::kSlow,
      {false, "LOG warn overruns frame=", true, "carries on; frames overrun"}},
+    {FaultDevice::kWatchdog,
+     FaultType::kOff,
+     {false, "watchdog unhealthy: watchdog: keep-alive refused", true, kWatchdogHold, false, false,
+      true}},
+    {FaultDevice::kWatchdog,
+     FaultType::kStuck,
+     {false, "watchdog=unavailable", true,
+      "carries on without the hardware watchdog (the start's warning names the holder; systemd's "
+      "own watchdog still restarts a hung firmware)",
+      false, false, false, false, 0, false, true}},
+    {FaultDevice::kWatchdog,
+     FaultType::kIntermittent,
+     {false, "watchdog unhealthy: watchdog: keep-alive refused", true, kWatchdogHold, false, false,
+      true}},
 };
 
 constexpr FaultExpectation kNoExpectation{};
@@ -412,7 +430,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   hal::sim::Fault fault;
   fault.device = device;
   fault.type = type;
-  fault.start_us = static_cast<std::uint64_t>(std::llround(config.fault_start_s * 1e6));
+  fault.start_us =
+      expected.at_start ? 0U : static_cast<std::uint64_t>(std::llround(config.fault_start_s * 1e6));
   fault.duration_us = static_cast<std::uint64_t>(std::llround(config.fault_s * 1e6));
   board.default_faults().clear();
   (void)board.default_faults().add(fault);
@@ -422,7 +441,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
   Rig& rig = *g_rig;
   hal::Hal& hal = board.hal();
   hal::sim::SimWorld& sim = board.sim();
-  const std::uint64_t onset_us = fault.start_us;
+  // (1 µs for a fault from the start: 0 is "none" in the bookkeeping below.)
+  const std::uint64_t onset_us = fault.start_us != 0 ? fault.start_us : 1U;
   const std::uint64_t end_us = fault.end_us();
   const std::uint64_t stop_us =
       end_us + static_cast<std::uint64_t>(std::llround(config.after_s * 1e6));
@@ -598,7 +618,8 @@ bool run_fault_scenario(SimBoard& board, FaultDevice device, FaultType type,
          out.stop_latency_ms * 1e3 <= static_cast<double>(allowed_us) && out.stop_time_ms >= 0.0 &&
          out.stop_distance_m <= out.stop_distance_bound_m;
   } else {
-    ok = ok && out.moving_before && !stopped_seen;  // nothing made a stop necessary
+    // Nothing made a stop necessary (a fault from the start has no "before").
+    ok = ok && (out.moving_before || expected.at_start) && !stopped_seen;
   }
   if (expected.operator_reset) ok = ok && out.held_until_reset && out.held_until_resume;
   if (expected.recovers) {

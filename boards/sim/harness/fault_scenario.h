@@ -52,6 +52,9 @@ struct FaultExpectation {
   // base task's retry restarts it into the fault, and each time it must stop again within
   // detect_us (instead of staying stopped).
   bool restarts_into_it = false;
+  // A fault a start meets (the watchdog device busy when it is opened): injected from the
+  // board's start instead of fault_start_s; the base is to keep moving through it.
+  bool at_start = false;
 };
 inline constexpr std::uint64_t kResetToResumeUs = 500000;
 // The fault in the whole-mission runs: from 5 s for 5 s of simulated time (longer than the

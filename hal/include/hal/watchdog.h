@@ -12,8 +12,10 @@ class Watchdog : private NonCopyable {
   virtual ~Watchdog() = default;
   // Arms the watchdog with a timeout [ms]; false when unavailable (see error()).
   virtual bool start(std::uint32_t timeout_ms) = 0;
-  // Keep-alive; call only while every task is healthy.
-  virtual void kick() = 0;
+  // Keep-alive; call only while every task is healthy. False when the device refused it (see
+  // error()): unless a later one is taken, the board resets when the timeout runs out. True
+  // when the watchdog is not armed (nothing to keep alive).
+  virtual bool kick() = 0;
   // Disarms on an orderly shutdown (magic close on /dev/watchdog).
   virtual void stop() = 0;
   virtual const char* error() const { return ""; }

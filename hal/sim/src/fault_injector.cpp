@@ -21,6 +21,7 @@ void FaultInjector::set_plan(const FaultPlan& plan) {
   seen_end_ = {};
   next_event_us_ = 0;
   started_ = ended_ = 0;
+  recompute(now_us_);  // a fault from now on is active before the time next moves
 }
 
 bool FaultInjector::inject(FaultDevice device, FaultType type, std::uint64_t now_us,

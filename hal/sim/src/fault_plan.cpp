@@ -11,7 +11,8 @@ namespace boticelli::hal::sim {
 namespace {
 
 constexpr const char* const kDeviceNames[kFaultDeviceCount] = {
-    "camera", "ptu", "axis-left", "axis-right", "can", "estop", "bumper", "storage", "main-loop"};
+    "camera", "ptu",    "axis-left", "axis-right", "can",
+    "estop",  "bumper", "storage",   "main-loop",  "watchdog"};
 constexpr const char* const kTypeNames[kFaultTypeCount] = {
     "off", "stuck", "garbage", "wrong", "slow", "delayed", "intermittent"};
 
@@ -35,6 +36,8 @@ constexpr std::array<std::uint8_t, kFaultDeviceCount> kApplies = {
     bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kWrong) |
         bit(FaultType::kIntermittent),               // storage
     bit(FaultType::kStuck) | bit(FaultType::kSlow),  // main loop
+    // The watchdog device: keep-alives refused (off, intermittent), busy when opened (stuck).
+    bit(FaultType::kOff) | bit(FaultType::kStuck) | bit(FaultType::kIntermittent),
 };
 
 void say(char* error, std::size_t size, const char* name, std::size_t line, const char* why,
@@ -194,7 +197,7 @@ bool parse_fault_plan(std::string_view text, const char* name, FaultPlan& out, c
     if (!parse_fault_device(words[1], f.device)) {
       say(error, error_size, name, line_no,
           "unknown device (camera, ptu, axis-left, axis-right, can, estop, bumper, storage, "
-          "main-loop)",
+          "main-loop, watchdog)",
           words[1]);
       out.clear();
       return false;
@@ -296,6 +299,7 @@ void generate_fault_plan(const PlanGeneratorConfig& config, FaultPlan& out) {
       const auto device = static_cast<FaultDevice>(d);
       const auto type = static_cast<FaultType>(t);
       if (!fault_applies(device, type)) continue;
+      // (Not the watchdog refusing keep-alives: on a robot that is a reset once it lasts.)
       const bool rides_out = device == FaultDevice::kEstop || device == FaultDevice::kStorage ||
                              (device == FaultDevice::kCamera &&
                               (type == FaultType::kIntermittent || type == FaultType::kSlow ||

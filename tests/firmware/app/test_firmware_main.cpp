@@ -31,7 +31,8 @@ using namespace boticelli::test;
 
 namespace {
 
-// Refuses to arm unless `accept` (then counts its starts and keeps the timeout asked for).
+// Refuses to arm unless `accept` (then counts its starts and keeps the timeout asked for);
+// refuses keep-alives while `clock` reads within [refuse_from_us, refuse_until_us).
 class NullWatchdog final : public boticelli::hal::Watchdog {
  public:
   bool start(std::uint32_t timeout_ms) override {
@@ -40,12 +41,22 @@ class NullWatchdog final : public boticelli::hal::Watchdog {
     started_ms = timeout_ms;
     return true;
   }
-  void kick() override {}
+  bool kick() override {
+    const std::uint64_t now = clock != nullptr ? clock->now_us() : 0;
+    refusing = clock != nullptr && now >= refuse_from_us && now < refuse_until_us;
+    return !refusing;
+  }
   void stop() override {}
-  const char* error() const override { return "no watchdog in tests"; }
+  const char* error() const override {
+    return refusing ? "watchdog: keep-alive refused: Input/output error" : "no watchdog in tests";
+  }
   bool accept = false;
   int starts = 0;
   std::uint32_t started_ms = 0;
+  boticelli::hal::Clock* clock = nullptr;
+  std::uint64_t refuse_from_us = 0;
+  std::uint64_t refuse_until_us = 0;
+  bool refusing = false;
 };
 
 // A camera whose frames are of no use (2x2, no time stamp: the look never takes one) until
@@ -282,6 +293,39 @@ TEST(FirmwareMain, ACameraBackWithinTheRetryTimeLetsTheLookGoOnWithNothingGivenU
   CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
   CHECK(state.log.size() >= 2U);
   STRCMP_CONTAINS("held: no camera frame", std::string(state.log[0].view()).c_str());
+  STRCMP_CONTAINS("devices back after ", std::string(state.log[1].view()).c_str());
+}
+
+// Keep-alives the watchdog device refuses (the board may reset any moment) hold the robot
+// stopped; once one is taken again the mission carries on.
+TEST(FirmwareMain, TheMissionHoldsWhileTheWatchdogRefusesKeepAlivesAndCarriesOnAfter) {
+  static SigtermAt stop;
+  static MainHooks hooks;
+  hooks.after_frame = sigterm_at;
+  hooks.context = &stop;
+  const Run r = run_firmware({"--state", dir.c_str()}, [&](FakeBoard& b) {
+    b.config_.camera_width_px = 160;
+    b.config_.camera_height_px = 120;
+    b.camera.good_after_us = 1;
+    b.watchdog.accept = true;
+    b.watchdog.clock = &b.clock;
+    b.watchdog.refuse_from_us = 2000000;
+    b.watchdog.refuse_until_us = 6000000;
+    stop = SigtermAt{&b.clock, 20000000};
+    b.hooks = &hooks;
+  });
+  CHECK_EQUAL(kExitNotFound, r.exit_code);
+  CHECK(r.err.find("gave up") == std::string::npos);
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(state.log.size() >= 2U);
+  STRCMP_CONTAINS(
+      "held: watchdog refusing keep-alives (a reset may come): "
+      "watchdog: keep-alive refused",
+      std::string(state.log[0].view()).c_str());
   STRCMP_CONTAINS("devices back after ", std::string(state.log[1].view()).c_str());
 }
 

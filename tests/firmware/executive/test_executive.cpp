@@ -721,6 +721,35 @@ TEST(WatchdogTask, KeepsKickingThroughADeviceFaultForItsRetryTimeThenGivesUp) {
   CHECK(task.withheld() >= 5U);
 }
 
+// A keep-alive the device refuses (the board resets unless one is taken within its timeout)
+// makes the task unhealthy in the device's words, and healthy again once one is taken; past
+// the retry time it is given up on like any device.
+TEST(WatchdogTask, AKeepAliveTheDeviceRefusesMakesItUnhealthyUntilOneIsTakenAgain) {
+  CHECK(exec.add_task({"watchdog", 100000, 200}, task, &error));
+  task.set_retry_us(2000000);
+  CHECK(exec.start(ExecutiveConfig{}, &error));
+  for (int i = 0; i < 20; ++i) exec.run_frame();
+  CHECK(task.healthy());
+  watchdog.refuses = true;
+  for (int i = 0; i < 10; ++i) exec.run_frame();
+  CHECK_FALSE(task.healthy());
+  CHECK_FALSE(exec.all_healthy());
+  STRCMP_EQUAL("watchdog: keep-alive refused: EIO", task.health_reason());
+  CHECK_EQUAL(1U, task.refused());
+  for (int i = 0; i < 100; ++i) exec.run_frame();  // still tried every run
+  CHECK_EQUAL(11U, task.refused());
+  watchdog.refuses = false;
+  for (int i = 0; i < 10; ++i) exec.run_frame();
+  CHECK(task.healthy());
+  STRCMP_EQUAL("", task.health_reason());
+  CHECK_FALSE(task.gave_up());
+  watchdog.refuses = true;
+  for (int i = 0; i < 230; ++i) exec.run_frame();
+  CHECK(task.gave_up());
+  STRCMP_CONTAINS("watchdog unhealthy for 2 s: watchdog: keep-alive refused",
+                  task.give_up_reason());
+}
+
 // A hang (a task over its budget again and again, or starved) withholds it at once.
 TEST(WatchdogTask, WithholdsAtOnceWhileATaskKeepsOverrunningItsBudget) {
   TimedTask device(clock, 10);

@@ -164,7 +164,10 @@ const char* led_pattern_name(LedPattern pattern);
 // Kicks /dev/watchdog and sends WATCHDOG=1 to systemd while the executive runs (no task
 // overrunning or starved: a hang) and no task has been unhealthy for longer than the device
 // retry time; a device fault within that time is the fault policy's to hold and retry, not a
-// hang. Past it the task gives up (gave_up(): the firmware exits for a restart);
+// hang. Past it the task gives up (gave_up(): the firmware exits for a restart). A keep-alive
+// the device refuses makes this task unhealthy until one is taken again (the board resets if
+// none is within its timeout; the mission holds the robot stopped meanwhile), and like any
+// device fault it is given up on after the retry time;
 // drives the status LED with the pattern of the robot's condition; once a second, when it
 // changed, reports the state to systemd as "STATUS=state=... cycle=N healthy=0|1 estop=...
 // target=..." (what `systemctl status` shows). Runs every 100 ms (kTaskTable).
@@ -179,6 +182,10 @@ class WatchdogTask final : public Task {
     view_ = view;
   }
   void run(std::uint64_t now_us) override;
+  bool healthy() const override { return refusing_since_us_ == 0; }
+  const char* health_reason() const override {
+    return refusing_since_us_ != 0 ? watchdog_.error() : "";
+  }
   // How long a task may stay unhealthy before the firmware gives up on it [µs].
   void set_retry_us(std::uint64_t us) { retry_us_ = us; }
   // A task was unhealthy for longer than the retry time; give_up_reason() says which and why
@@ -187,6 +194,8 @@ class WatchdogTask final : public Task {
   const char* give_up_reason() const { return give_up_reason_.c_str(); }
   std::uint64_t kicks() const { return kicks_; }
   std::uint64_t withheld() const { return withheld_; }
+  // Keep-alives the device refused since the start.
+  std::uint64_t refused() const { return refused_; }
   LedPattern pattern() const { return pattern_; }
   // The last STATUS= text sent (without the "STATUS=" prefix).
   const char* status_text() const {
@@ -209,6 +218,8 @@ class WatchdogTask final : public Task {
   TextBuffer<160> status_;
   std::uint64_t kicks_ = 0;
   std::uint64_t withheld_ = 0;
+  std::uint64_t refused_ = 0;
+  std::uint64_t refusing_since_us_ = 0;  // 0: the last keep-alive was taken
   std::uint64_t retry_us_ = 30000000;
   std::array<std::uint64_t, Executive::kMaxTasks> unhealthy_since_us_{};  // 0: healthy
   bool gave_up_ = false;

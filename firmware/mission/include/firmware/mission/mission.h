@@ -80,6 +80,9 @@ struct MissionContext {
   const TruthSource* truth = nullptr;   // sim ground truth (trace, target error)
   TraceWriter* trace = nullptr;         // --trace
   SnapshotWriter* snapshots = nullptr;  // --snapshots
+  // The watchdog task: while the hardware watchdog refuses keep-alives the board may reset
+  // any moment, so the mission holds the robot stopped (a reset mid-drive would let it coast).
+  const Task* watchdog = nullptr;
 };
 
 class Mission final : public MissionView, public BackgroundWork, public FrameConsumer {
@@ -233,6 +236,7 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   MissionState& state_;
   StateSaver* saver_;
   const TruthSource* truth_;
+  const Task* watchdog_;
   TraceWriter* trace_;
   SnapshotWriter* snapshots_;
   MissionParams params_;

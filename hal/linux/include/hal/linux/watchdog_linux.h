@@ -43,7 +43,7 @@ class WatchdogLinux final : public hal::Watchdog {
   ~WatchdogLinux() override;
 
   bool start(std::uint32_t timeout_ms) override;
-  void kick() override;
+  bool kick() override;
   void stop() override;
   const char* error() const override { return error_; }
   int timeout_s() const { return timeout_s_; }

@@ -20,6 +20,7 @@ enum class FaultDevice : std::uint8_t {
   kBumper,     // the bumper ring's line
   kStorage,    // the state directory
   kMainLoop,   // the executive itself
+  kWatchdog,   // the hardware watchdog device (/dev/watchdog)
   kCount
 };
 
@@ -41,7 +42,7 @@ inline constexpr std::size_t kFaultDeviceCount = static_cast<std::size_t>(FaultD
 inline constexpr std::size_t kFaultTypeCount = static_cast<std::size_t>(FaultType::kCount);
 
 // Names as in the plan file and the console: camera, ptu, axis-left, axis-right, can, estop,
-// bumper, storage, main-loop; off, stuck, garbage, wrong, slow, delayed, intermittent.
+// bumper, storage, main-loop, watchdog; off, stuck, garbage, wrong, slow, delayed, intermittent.
 const char* fault_device_name(FaultDevice device);
 const char* fault_type_name(FaultType type);
 bool parse_fault_device(std::string_view name, FaultDevice& out);
