@@ -654,6 +654,10 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
   constexpr std::uint64_t kOperatorUs = 500000;
   bool reset_due = false;
   std::uint64_t reset_at_us = 0;
+  // A fault that is not ridden out was active since the last quiet check: the check may wait
+  // for the retries (until recover_until_us once it found something not yet back).
+  bool retried_since_check = false;
+  std::uint64_t recover_until_us = 0;
   if (config.loop_started != nullptr) config.loop_started(config.context);
   while (hal.clock.now_us() < end_us) {
     rig.runtime.executive.run_frame();
@@ -667,6 +671,7 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
       const auto device = static_cast<FaultDevice>(d);
       const bool active = faults.active(device, type);
       if (active) any_active = true;
+      if (active && !hal::sim::fault_rides_out(device, type)) retried_since_check = true;
       if (device == FaultDevice::kEstop || device == FaultDevice::kBumper) {
         line_fault = line_fault || active;
         if (faults.failing(device, type)) line_active = true;
@@ -706,17 +711,29 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
     if (faults.ended() != ended_seen) {
       ended_seen = faults.ended();
       check_at_us = now + kSettleUs;
+      recover_until_us = 0;
     }
     if (any_active) {
       if (check_at_us != 0 && now >= check_at_us) check_at_us = now + kSettleUs;  // wait on
+      recover_until_us = 0;
       continue;
     }
     if (check_at_us == 0 || now < check_at_us) continue;
-    check_at_us = 0;
-    ++out.quiet_checks;
     const bool healthy =
         rig.runtime.executive.all_healthy() && rig.runtime.console->storage_healthy();
     const bool moving = !wheels_at_rest(sim);
+    if (!(healthy && moving) && retried_since_check) {
+      if (recover_until_us == 0) recover_until_us = now + kSoakRecoverUs;
+      if (now < recover_until_us) continue;  // the retries have not had their time yet
+    }
+    if (healthy && moving && now > check_at_us) {
+      const double waited_s = static_cast<double>(now - check_at_us) * 1e-6;
+      if (waited_s > out.worst_recovery_s) out.worst_recovery_s = waited_s;
+    }
+    check_at_us = 0;
+    recover_until_us = 0;
+    retried_since_check = false;
+    ++out.quiet_checks;
     bool loads = true;
     bool current = true;
     if (config.state_dir != nullptr && rig.runtime.saver.saved() > 0) {

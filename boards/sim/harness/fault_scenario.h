@@ -136,6 +136,11 @@ struct FaultSoakResult {
   std::uint32_t faults_started = 0;
   std::uint32_t faults_ended = 0;
   std::uint32_t quiet_checks = 0;  // moments with no fault active, 1.5 s after one ended
+  // After a fault that is not ridden out (hal::sim::fault_rides_out: a device held and
+  // retried, the base restarted) a check that finds something not yet healthy or moving
+  // waits for the retries, up to kSoakRecoverUs, and passes once they have worked; the
+  // longest such wait [s] (0 when every check passed at once).
+  double worst_recovery_s = 0.0;
   std::uint32_t ended_safe = 0;    // ... where everything was healthy and moving again
   std::uint32_t ended_unsafe = 0;  // ... where something was not
   char first_unsafe[200] = "";     // what, the first time
@@ -162,6 +167,8 @@ struct FaultSoakResult {
   std::uint32_t watchdog_expirations = 0;
 };
 inline constexpr std::uint32_t kCorruptEvery = 8;
+// The base task's retry backs off to 8 s after quick re-stops; a check waits that and 2 s.
+inline constexpr std::uint64_t kSoakRecoverUs = 10000000;
 bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run_s,
                     const FaultScenarioConfig& config, FaultSoakResult& out);
 

@@ -288,6 +288,16 @@ std::size_t format_fault_plan(const FaultPlan& plan, char* out, std::size_t capa
   return used;
 }
 
+bool fault_rides_out(FaultDevice device, FaultType type) {
+  // (Not the watchdog refusing keep-alives: on a robot that is a reset once it lasts.)
+  return device == FaultDevice::kEstop || device == FaultDevice::kStorage ||
+         (device == FaultDevice::kCamera &&
+          (type == FaultType::kIntermittent || type == FaultType::kSlow ||
+           type == FaultType::kDelayed)) ||
+         (device == FaultDevice::kMainLoop && type == FaultType::kSlow) ||
+         (device == FaultDevice::kCan && type == FaultType::kDelayed);
+}
+
 void generate_fault_plan(const PlanGeneratorConfig& config, FaultPlan& out) {
   out.clear();
   std::uint64_t state = config.seed * 0xD1B54A32D192ED03ULL + 0x8CB92BA72F3D8DD7ULL;
@@ -299,14 +309,7 @@ void generate_fault_plan(const PlanGeneratorConfig& config, FaultPlan& out) {
       const auto device = static_cast<FaultDevice>(d);
       const auto type = static_cast<FaultType>(t);
       if (!fault_applies(device, type)) continue;
-      // (Not the watchdog refusing keep-alives: on a robot that is a reset once it lasts.)
-      const bool rides_out = device == FaultDevice::kEstop || device == FaultDevice::kStorage ||
-                             (device == FaultDevice::kCamera &&
-                              (type == FaultType::kIntermittent || type == FaultType::kSlow ||
-                               type == FaultType::kDelayed)) ||
-                             (device == FaultDevice::kMainLoop && type == FaultType::kSlow) ||
-                             (device == FaultDevice::kCan && type == FaultType::kDelayed);
-      if (!rides_out && !config.include_terminal) continue;
+      if (!fault_rides_out(device, type) && !config.include_terminal) continue;
       pairs[pair_count].device = device;
       pairs[pair_count].type = type;
       ++pair_count;

@@ -91,6 +91,12 @@ bool load_fault_plan(const char* path, FaultPlan& out, char* error, std::size_t 
 // returns the bytes written, 0 when `capacity` is too small.
 std::size_t format_fault_plan(const FaultPlan& plan, char* out, std::size_t capacity);
 
+// Whether the mission rides the pair out without a device being held and retried (the e-stop
+// latch and storage faults, a slow / late / intermittent camera, a slow main loop, a late
+// CAN bus): the soak's default plan. The rest stop a device (held and retried), the base (a
+// restart by the base task) or, for the watchdog refusing keep-alives, on a robot the board.
+bool fault_rides_out(FaultDevice device, FaultType type);
+
 // A random plan for a soak: `count` faults of applicable pairs (no main-loop stall longer
 // than `max_duration_s`), starts uniform over [warmup_s, run_s), durations uniform over
 // [0.2, max_duration_s] s, at most one fault per device at a time. The same seed gives the
@@ -101,7 +107,9 @@ struct PlanGeneratorConfig {
   double warmup_s = 60.0;
   double max_duration_s = 20.0;
   std::size_t count = 100;
-  bool include_terminal = false;  // also faults that end the mission (PTU, axes, bumper, ...)
+  // Also the pairs that are not ridden out (fault_rides_out false): devices held and retried,
+  // the base restarted, the bumper (latched until the operator's reset), the watchdog.
+  bool include_terminal = false;
 };
 void generate_fault_plan(const PlanGeneratorConfig& config, FaultPlan& out);
 
