@@ -352,11 +352,17 @@ fi
 # lists for the firmware's process, and its info lines are not among them.
 sleep 1
 ring_all=$(console "log show" 20 || true)
+# The ring keeps the last 64 lines; once it has wrapped the journal holds older ones too,
+# so only "every ring warning is in the journal, no ring info line is" can be checked.
+ring_lines=$(grep -c '^log t_s=' <<<"$ring_all" || true)
 ring=$(sed -n 's/^log t_s=[-0-9.]* \(warn\|error\) //p' <<<"$ring_all" | sort -u)
 ring_info=$(sed -n 's/^log t_s=[-0-9.]* info //p' <<<"$ring_all" | sort -u)
 journal=$(bx sudo journalctl -b "_PID=$pid" -p warning -o cat --no-pager | sort -u)
 missing=$(comm -23 <(echo "$ring") <(echo "$journal") | sed '/^$/d')
-extra=$(comm -13 <(echo "$ring") <(echo "$journal") | sed '/^$/d')
+extra=
+if [ "$ring_lines" -lt 64 ]; then
+  extra=$(comm -13 <(echo "$ring") <(echo "$journal") | sed '/^$/d')
+fi
 info_as_warning=$(comm -12 <(echo "$ring_info") <(echo "$journal") | sed '/^$/d')
 if [ -z "$ring" ]; then
   fail journal_priorities "the console's log show has no warning to compare"
@@ -365,7 +371,11 @@ elif [ -n "$missing" ]; then
 elif [ -n "$extra" ] || [ -n "$info_as_warning" ]; then
   fail journal_priorities "journalctl -p warning lists lines that are not warnings: $(echo "$extra" "$info_as_warning" | head -n 3 | tr '\n' ' ')"
 else
-  pass journal_priorities "$(wc -l <<<"$journal") warning/error lines, the same in journalctl -p warning and log show"
+  if [ "$ring_lines" -lt 64 ]; then
+    pass journal_priorities "$(wc -l <<<"$journal") warning/error lines, the same in journalctl -p warning and log show"
+  else
+    pass journal_priorities "the ring's $(wc -l <<<"$ring") warning/error lines all in journalctl -p warning, none of its info lines (the ring had wrapped: the journal's older lines not compared)"
+  fi
 fi
 
 # 7. A hung firmware (SIGSTOP) is killed by systemd's watchdog (WatchdogSec=2s) and restarted.
@@ -390,10 +400,10 @@ pid=$(main_pid)
 restarts=$(unit_prop NRestarts)
 bx sudo kill -TERM "$pid" || true
 sleep 6
-# The stopped process's exit status, from systemd's line about it (a restarted unit's
-# ExecMainStatus would be the new process's).
-code=$(bx sudo journalctl -b -u boticelli --no-pager -o cat |
-  grep "Main process exited" | tail -n1 | sed -n 's/.*status=\([0-9]*\).*/\1/p' || true)
+# The stopped process's exit status: ExecMainStatus while the unit is not restarted (a
+# restart, itself a failure here, would show the new process's). systemd logs "Main process
+# exited" only for a failure, and exit 3 is a success (SuccessExitStatus=3).
+code=$(unit_prop ExecMainStatus)
 state=$(active_state)
 if [ "$code" = 3 ] && [ "$state" != active ] && [ "$state" != activating ] && [ "$(unit_prop NRestarts)" = "$restarts" ]; then
   pass signal_exit_3_not_restarted "exit code 3, unit $state, not restarted"
