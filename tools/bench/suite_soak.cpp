@@ -3,7 +3,8 @@
 // (boards/sim/harness/fault_scenario.h's rig): allocations after init (counted by replacing the
 // global operator new here), statistics, every fault ended safe, the state file loadable at
 // every quiet moment. SOAK_SECONDS (default 7200), SOAK_SEED (default 1), SOAK_FAULTS (default
-// 250, at most 256), SOAK_TERMINAL (default 1; 0: only the pairs the robot rides out).
+// 250, at most 256), SOAK_TERMINAL (default 1; 0: only the pairs the robot rides out),
+// SOAK_PLAN_OUT=FILE (writes the plan in the --faults format).
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -95,6 +96,16 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
   plan_config.count = static_cast<std::size_t>(env_number("SOAK_FAULTS", 250.0));
   plan_config.include_terminal = env_number("SOAK_TERMINAL", 1.0) != 0.0;
   hal::sim::generate_fault_plan(plan_config, g_plan);
+  if (const char* plan_out = std::getenv("SOAK_PLAN_OUT"); plan_out != nullptr) {
+    // The plan in the --faults file format, to replay a soak's faults on the firmware.
+    static char text[hal::sim::FaultPlan::kMaxFileBytes];
+    const std::size_t n = hal::sim::format_fault_plan(g_plan, text, sizeof text);
+    std::FILE* f = std::fopen(plan_out, "w");
+    if (f == nullptr || n == 0 || std::fwrite(text, 1, n, f) != n) {
+      std::fprintf(stderr, "soak: cannot write the plan to %s\n", plan_out);
+    }
+    if (f != nullptr) std::fclose(f);
+  }
   char dir_template[] = "/tmp/boticelli-soak-XXXXXX";
   const char* dir = ::mkdtemp(dir_template);
   const std::string world = std::string(BOTICELLI_WORLDS_DIR) + "/thesis_room.sdf";
@@ -138,6 +149,7 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
       .integer("ended_unsafe", r.ended_unsafe)
       .text("first_unsafe", r.first_unsafe)
       .integer("stop_violations", static_cast<std::int64_t>(r.stop_violations))
+      .text("first_stop_violation", r.first_stop_violation)
       .integer("operator_resets", r.operator_resets)
       .integer("collisions", r.collisions)
       .integer("allocations_after_init", static_cast<std::int64_t>(g_allocations.load()))

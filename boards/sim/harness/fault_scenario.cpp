@@ -649,6 +649,8 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
   std::uint64_t must_rest_since_us = 0;
   std::uint64_t rest_due_us = 0;
   const float brake_decel = sim.params().base.brake_decel_m_s2;
+  const float coast_decel = sim.params().base.coast_decel_m_s2;
+  bool coast_allowed = false;  // the axes were idled by a fault: the wheels can only coast
   // The operator: after a stop line was active, the wheels stay at rest until they have typed
   // `clear-estop` and `resume`, which they do kOperatorUs after the line's last fault ended.
   constexpr std::uint64_t kOperatorUs = 500000;
@@ -683,14 +685,50 @@ bool run_fault_soak(SimBoard& board, const hal::sim::FaultPlan& plan, double run
     if (line_active || reset_due) {
       if (must_rest_since_us == 0) {
         must_rest_since_us = now;
+        coast_allowed = false;
         // Braked from this speed: at rest v/a later (and a frame for the stop, one for rounding).
         rest_due_us = now + 20000U +
                       static_cast<std::uint64_t>(static_cast<double>(sim.wheel_speed_m_s()) /
                                                  static_cast<double>(brake_decel) * 1e6);
       }
+      // A fault of another device (an axis, the bus, the ODrives' watchdog) idled the axes: no
+      // closed loop is left to brake with and the wheels coast, from the speed they have then.
+      if (!coast_allowed && sim.base_axes_idle() && !sim.base_braking() && !wheels_at_rest(sim)) {
+        FaultType t = FaultType::kOff;
+        bool base_fault = false;
+        for (const FaultDevice d : {FaultDevice::kAxisLeft, FaultDevice::kAxisRight,
+                                    FaultDevice::kCan, FaultDevice::kMainLoop}) {
+          base_fault = base_fault || faults.active(d, t);
+        }
+        if (base_fault) {
+          coast_allowed = true;
+          const std::uint64_t coast_due_us =
+              now + 20000U +
+              static_cast<std::uint64_t>(static_cast<double>(sim.wheel_speed_m_s()) /
+                                         static_cast<double>(coast_decel) * 1e6);
+          if (coast_due_us > rest_due_us) rest_due_us = coast_due_us;
+        }
+      }
       // Not driving after a frame's grace, and at rest once braked.
       if ((now - must_rest_since_us > 10000U && sim.base_health() == hal::BaseHealth::kReady) ||
           (now > rest_due_us && !wheels_at_rest(sim))) {
+        if (out.stop_violations == 0) {
+          fw::TextBuffer<200> what;
+          what.appendf(
+              "t_s=%.2f since_s=%.2f ready=%d speed=%.3f faults:", static_cast<double>(now) * 1e-6,
+              static_cast<double>(must_rest_since_us) * 1e-6,
+              sim.base_health() == hal::BaseHealth::kReady ? 1 : 0,
+              static_cast<double>(sim.wheel_speed_m_s()));
+          for (std::size_t d = 0; d < hal::sim::kFaultDeviceCount; ++d) {
+            FaultType t = FaultType::kOff;
+            if (faults.active(static_cast<FaultDevice>(d), t)) {
+              what.appendf(" %s %s", hal::sim::fault_device_name(static_cast<FaultDevice>(d)),
+                           hal::sim::fault_type_name(t));
+            }
+          }
+          std::snprintf(out.first_stop_violation, sizeof out.first_stop_violation, "%s",
+                        what.c_str());
+        }
         ++out.stop_violations;
       }
     } else {

@@ -147,6 +147,7 @@ struct FaultSoakResult {
   // Frames moving while the e-stop or bumper line was active, or after it before the operator's
   // reset (`clear-estop` and `resume`, typed 0.5 s after the line's fault ended).
   std::uint64_t stop_violations = 0;
+  char first_stop_violation[200] = "";  // when, and the faults then active, the first time
   std::uint32_t operator_resets = 0;
   std::uint32_t collisions = 0;
   std::uint64_t saves = 0;
