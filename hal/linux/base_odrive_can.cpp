@@ -511,9 +511,10 @@ void BaseOdriveCan::set_velocity(float v_m_s, float omega_rad_s) {
 
 void BaseOdriveCan::stop() {
   if (health_ == hal::BaseHealth::kStopped) {
-    // Already stopped (maybe by a fault): still tell the axes, the link may be back. A brake
-    // under way goes on.
-    if (!braking_) send_stop_frames();
+    // Already stopped (maybe by a fault): update() goes on commanding the stop every
+    // stop_resend_ms (a link that is back gets it then) and a brake under way goes on. Asked
+    // again (the e-stop task asks every frame while the button is held) nothing more is
+    // sent: four frames a frame were bus load and system calls on the e-stop's budget.
     return;
   }
   fault("stopped by request", nullptr, 0, StopKind::kBrake);

@@ -550,3 +550,29 @@ TEST(BaseOdriveCan, AWheelRampingUpOrReversingWithinTheFollowTimeIsNotAFault) {
   for (int i = 0; i < 200; ++i) rig.cycle();
   CHECK_TEXT(rig.base->health() == BaseHealth::kReady, rig.base->error());
 }
+
+// Asked to stop again and again while stopped (the e-stop task asks every 10 ms frame while
+// the button is held) the driver sends nothing more: the stop is re-sent by update() at its
+// own interval, which keeps an ODrive that came back stopped without loading the bus or the
+// e-stop task's budget with four frames a frame.
+TEST(BaseOdriveCan, AStopAskedAgainWhileStoppedSendsNothingAndUpdateResendsItAtItsInterval) {
+  Rig rig(Rig::emu_config());
+  CHECK_TRUE(rig.start());
+  rig.base->stop();
+  CHECK_TRUE(rig.run_until([&] { return !rig.base->braking(); }));
+  rig.emu.service(rig.clock.peek_us());
+  rig.emu.clear_log();
+  for (int i = 0; i < 10; ++i) rig.base->stop();
+  rig.emu.service(rig.clock.peek_us());
+  CHECK_EQUAL(0U, rig.emu.log().size());
+  // Over one second of frames, each asking again: the resends of update() only.
+  const std::uint32_t resend_ms = Rig::config().stop_resend_ms;
+  for (int i = 0; i < 100; ++i) {
+    rig.base->stop();
+    rig.cycle();
+  }
+  const std::size_t frames = rig.emu.log().size();
+  const std::size_t per_resend = 4;  // velocity 0 and IDLE to each axis
+  CHECK(frames >= per_resend);
+  CHECK(frames <= per_resend * (1000U / resend_ms + 1U));
+}
