@@ -18,4 +18,7 @@ if [ ! -d "$c" ]; then
 fi
 chip=$(ls -d /sys/devices/platform/gpio-sim.*/gpiochip*)
 echo pull-up >"$chip/sim_gpio27/pull"
+# The chip's udev rules (group gpio, 60-boticelli.rules) applied before boticelli.service,
+# which starts after this unit, opens it: at boot the events are otherwise still queued.
+udevadm settle --timeout=30 || true
 echo "box-devices: can0 (vcan), $(basename "$chip") (gpio-sim, 58 lines)"

@@ -263,7 +263,7 @@ if bx sudo systemctl start boticelli 2>"$work/start.err"; then
   fi
 else
   ready_s=
-  fail start_reaches_ready "systemctl start failed: $(cat "$work/start.err") $(bx sudo journalctl -u boticelli -n 5 --no-pager 2>&1 | tr '\n' ' ')"
+  fail start_reaches_ready "systemctl start failed: $(cat "$work/start.err") $(bx sudo journalctl -u boticelli -n 20 --no-pager -o cat 2>&1 | tr '\n' ' ')"
 fi
 
 # 3. systemctl status shows the mission's state (STATUS=, once a second).
@@ -471,6 +471,11 @@ if [ "$(status_field watchdog)" != armed ]; then
   fail hardware_watchdog_resets "the console's status says watchdog=$(status_field watchdog), not armed"
   boot_ready_s=
 else
+  # A reset loses what is not on the disk yet: the earlier checks' writes (the conffile's
+  # local change above, made with a plain shell redirection) are flushed first, as only the
+  # firmware's own files are written with fsync. (Without this the box came back with NULs
+  # in /etc/boticelli/boticelli.conf and the firmware rightly refused it.)
+  bx sudo sync || true
   t0=$(now)
   # ssh itself is starved once the loops run: the command is left to time out.
   bx 'sudo sh -c "echo -1 >/proc/sys/kernel/sched_rt_runtime_us;
@@ -504,7 +509,7 @@ else
       fail enabled_unit_ready_after_reset "running, but no 'Started boticelli.service' in this boot's journal"
     fi
   else
-    fail enabled_unit_ready_after_reset "the box or the firmware did not come back after the reset: $(active_state 2>&1)"
+    fail enabled_unit_ready_after_reset "the box or the firmware did not come back after the reset: $(active_state 2>&1); $(bx sudo journalctl -b -u boticelli --no-pager -o cat -n 6 2>&1 | tr '\n' ' ')"
   fi
 fi
 
