@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #include <string>
 
@@ -94,7 +95,9 @@ BOTICELLI_BENCH_SUITE(soak, "2 h of simulated time under random faults: allocati
   plan_config.run_s = run_s;
   plan_config.warmup_s = 5.0;
   plan_config.count = static_cast<std::size_t>(env_number("SOAK_FAULTS", 250.0));
-  plan_config.include_terminal = env_number("SOAK_TERMINAL", 1.0) != 0.0;
+  // (Not env_number, which takes only positive numbers: "0" is the value that matters here.)
+  const char* terminal = std::getenv("SOAK_TERMINAL");
+  plan_config.include_terminal = terminal == nullptr || std::strcmp(terminal, "0") != 0;
   hal::sim::generate_fault_plan(plan_config, g_plan);
   if (const char* plan_out = std::getenv("SOAK_PLAN_OUT"); plan_out != nullptr) {
     // The plan in the --faults file format, to replay a soak's faults on the firmware.

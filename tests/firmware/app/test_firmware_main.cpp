@@ -267,6 +267,19 @@ void sigterm_at(void* context) {
     std::raise(SIGTERM);
   }
 }
+
+// The saved mission log of a run that held for a device: its first line says why (`held`
+// begins it), the second that the devices came back.
+void check_held_then_back(const std::string& dir, const char* held) {
+  static MissionState state;
+  static StateStore store;
+  char error[256] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
+  CHECK(state.log.size() >= 2U);
+  STRCMP_CONTAINS(held, std::string(state.log[0].view()).c_str());
+  STRCMP_CONTAINS("devices back after ", std::string(state.log[1].view()).c_str());
+}
 }  // namespace
 
 // Shorter than the retry time, a fault is ridden out: a camera that delivers again after 10 s
@@ -286,14 +299,7 @@ TEST(FirmwareMain, ACameraBackWithinTheRetryTimeLetsTheLookGoOnWithNothingGivenU
   CHECK_EQUAL(kExitNotFound, r.exit_code);  // stopped by the signal, not a give-up (1)
   STRCMP_CONTAINS("reason=\"SIGTERM\"", last_line(r.out).c_str());
   CHECK(r.err.find("gave up") == std::string::npos);
-  static MissionState state;
-  static StateStore store;
-  char error[256] = "";
-  CHECK(store.open(dir.c_str(), error, sizeof error));
-  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
-  CHECK(state.log.size() >= 2U);
-  STRCMP_CONTAINS("held: no camera frame", std::string(state.log[0].view()).c_str());
-  STRCMP_CONTAINS("devices back after ", std::string(state.log[1].view()).c_str());
+  check_held_then_back(dir, "held: no camera frame");
 }
 
 // Keep-alives the watchdog device refuses (the board may reset any moment) hold the robot
@@ -316,17 +322,9 @@ TEST(FirmwareMain, TheMissionHoldsWhileTheWatchdogRefusesKeepAlivesAndCarriesOnA
   });
   CHECK_EQUAL(kExitNotFound, r.exit_code);
   CHECK(r.err.find("gave up") == std::string::npos);
-  static MissionState state;
-  static StateStore store;
-  char error[256] = "";
-  CHECK(store.open(dir.c_str(), error, sizeof error));
-  CHECK(store.load(state, error, sizeof error) == LoadResult::kLoaded);
-  CHECK(state.log.size() >= 2U);
-  STRCMP_CONTAINS(
-      "held: watchdog refusing keep-alives (a reset may come): "
-      "watchdog: keep-alive refused",
-      std::string(state.log[0].view()).c_str());
-  STRCMP_CONTAINS("devices back after ", std::string(state.log[1].view()).c_str());
+  check_held_then_back(dir,
+                       "held: watchdog refusing keep-alives (a reset may come): "
+                       "watchdog: keep-alive refused");
 }
 
 TEST(FirmwareMain, ExitsWithTheUsageCodeOnABadOption) {

@@ -1066,14 +1066,20 @@ int gate_creates(StorageCall call, void* context) {
   g->changed.wait(lock, [g] { return g->open; });
   return 0;
 }
-}  // namespace
-
-TEST(Persistence, FlushReturnsOnlyOnceTheSaveTheWriterIsMakingIsOnDisk) {
-  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+// The gate, closed, on every state file's creation from now on (the hook is cleared by each
+// test when it is done).
+SaveGate& install_save_gate() {
   static SaveGate gate;
   gate.entered = false;
   gate.open = false;
   set_storage_fault_hook(gate_creates, &gate);
+  return gate;
+}
+}  // namespace
+
+TEST(Persistence, FlushReturnsOnlyOnceTheSaveTheWriterIsMakingIsOnDisk) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  SaveGate& gate = install_save_gate();
   std::uint64_t saved_at_flush = 0;
   {
     auto owner = std::make_unique<StateSaver>(g_store);
@@ -1095,10 +1101,7 @@ TEST(Persistence, FlushReturnsOnlyOnceTheSaveTheWriterIsMakingIsOnDisk) {
 
 TEST(Persistence, AStateSubmittedWhileTheWriterIsSavingIsWrittenBeforeTheSaverIsDestroyed) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
-  static SaveGate gate;
-  gate.entered = false;
-  gate.open = false;
-  set_storage_fault_hook(gate_creates, &gate);
+  SaveGate& gate = install_save_gate();
   auto owner = std::make_unique<StateSaver>(g_store);
   owner->start();
   make_state(10, g_a);
@@ -1175,10 +1178,7 @@ TEST(Persistence, AFailedSaveIsTriedAgainOnlyOnceTheRetryIntervalHasPassed) {
 
 TEST(Persistence, ParametersAndAStateHandedOverTogetherAreBothSaved) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
-  static SaveGate gate;
-  gate.entered = false;
-  gate.open = false;
-  set_storage_fault_hook(gate_creates, &gate);
+  SaveGate& gate = install_save_gate();
   auto owner = std::make_unique<StateSaver>(g_store);
   owner->start();
   make_state(6, g_a);
@@ -1205,10 +1205,7 @@ TEST(Persistence, ParametersAndAStateHandedOverTogetherAreBothSaved) {
 
 TEST(Persistence, FlushReturnsOnlyOnceTheParameterSaveUnderWayIsOnDisk) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
-  static SaveGate gate;
-  gate.entered = false;
-  gate.open = false;
-  set_storage_fault_hook(gate_creates, &gate);
+  SaveGate& gate = install_save_gate();
   std::uint64_t saved_at_flush = 0;
   {
     auto owner = std::make_unique<StateSaver>(g_store);
