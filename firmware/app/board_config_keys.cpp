@@ -48,7 +48,8 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::flag_key("watchdog", "enabled", c.watchdog_enabled)) &&
          s.add(watchdog_timeout) &&
          s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner)) &&
-         s.add(ConfigKey::flag_key("mission", "register_looks", c.register_looks));
+         s.add(ConfigKey::flag_key("mission", "register_looks", c.register_looks)) &&
+         s.add(ConfigKey::number("mission", "floor_range_error", c.floor_range_error, 0.0, 0.3));
 }
 
 }  // namespace boticelli::firmware

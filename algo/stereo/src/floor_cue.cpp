@@ -15,6 +15,7 @@ namespace {
 constexpr float kLumaBlack = 16.0F;   // BT.601 limited range: Y = 16 + 219·luminance
 constexpr std::uint32_t kMaxRun = 8;  // cap of boundary_run [px]
 constexpr std::uint32_t kMaxReferenceRows = 64;
+constexpr std::size_t kRunBins = 101;  // runs of one colour, by whole cm up to 1 m and beyond
 
 // Median and robust spread (1.4826 · MAD) of one channel's histogram of `count` samples.
 void robust_stats(const std::array<std::uint32_t, 256>& histogram, std::size_t count, float& median,
@@ -60,6 +61,38 @@ float median_of(std::array<float, kMaxRun>& values, std::uint32_t n) {
 
 std::uint8_t to_byte(float x) {
   return static_cast<std::uint8_t>(std::clamp(std::lround(x), 0L, 255L));
+}
+
+// The histogram bin of compensated (Y, Cb − 128, Cr − 128) values.
+std::size_t bin_of(const std::array<float, 3>& values) {
+  const auto luma = static_cast<std::size_t>(std::clamp(values[0], 0.0F, 255.0F)) / 16U;
+  const auto chroma = [](float c) {
+    return static_cast<std::size_t>(std::clamp((c + 32.0F) / 8.0F, 0.0F, 7.0F));
+  };
+  return (std::min(luma, kFloorLumaBins - 1) * kFloorChromaBins + chroma(values[1])) *
+             kFloorChromaBins +
+         chroma(values[2]);
+}
+
+// share[b]: the mass of bin b and of every bin next to it (3 × 3 × 3 bins).
+void smooth_mass(const std::array<float, kFloorBins>& mass, std::array<float, kFloorBins>& share) {
+  constexpr auto kL = static_cast<long>(kFloorLumaBins);
+  constexpr auto kC = static_cast<long>(kFloorChromaBins);
+  for (long y = 0; y < kL; ++y) {
+    for (long u = 0; u < kC; ++u) {
+      for (long v = 0; v < kC; ++v) {
+        float sum = 0.0F;
+        for (long dy = std::max(y - 1, 0L); dy <= std::min(y + 1, kL - 1); ++dy) {
+          for (long du = std::max(u - 1, 0L); du <= std::min(u + 1, kC - 1); ++du) {
+            for (long dv = std::max(v - 1, 0L); dv <= std::min(v + 1, kC - 1); ++dv) {
+              sum += mass[static_cast<std::size_t>((dy * kC + du) * kC + dv)];
+            }
+          }
+        }
+        share[static_cast<std::size_t>((y * kC + u) * kC + v)] = sum;
+      }
+    }
+  }
 }
 
 // Adds one walked frame's readings to a process() call's result.
@@ -113,6 +146,11 @@ void FloorCue::pixel_values(const image::LowResFrame& frame, std::uint32_t u, st
 }
 
 float FloorCue::contrast_to(const FloorModel& model, const std::array<float, 3>& values) const {
+  if (model.textured) {
+    const float share = model.share[bin_of(values)];
+    return share > 0.0F ? params_.texture_min_share / share
+                        : std::numeric_limits<float>::infinity();
+  }
   float worst = 0.0F;
   for (std::size_t c = 0; c < 3; ++c) {
     worst = std::max(worst, std::fabs(values[c] - model.median[c]) / model.tolerance[c]);
@@ -139,19 +177,39 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   const CameraPose pose = rig_.camera_pose(pan_rad, tilt_rad);
   std::array<std::array<std::uint32_t, 256>, 3> histogram{};
   std::size_t count = 0;
+  // The texture along the region's rows: neighbouring pairs, those of two colours, and the
+  // lengths of one colour's runs [cm of floor] (textured floors).
+  std::size_t pairs = 0;
+  std::size_t edges = 0;
+  std::array<std::uint32_t, kRunBins> runs{};
+  std::size_t run_count = 0;
+  const auto end_run = [&](float length_m) {
+    if (length_m > 0.0F) {
+      const auto cm = static_cast<std::size_t>(std::lround(100.0F * length_m));
+      ++runs[std::min(cm, kRunBins - 1)];
+      ++run_count;
+    }
+  };
   const std::uint32_t rows = std::min(params_.reference_rows_max, frame.height);
   for (std::uint32_t k = 0; k < rows; ++k) {
     const std::uint32_t v = frame.height - 1 - k;
     // Rows further up see the floor farther away: stop once a whole row is beyond the region.
     bool row_beyond = true;
+    bool have_previous = false;  // the pixel just left of this one is in the region
+    Eigen::Vector3f previous_point = Eigen::Vector3f::Zero();
+    float run_m = 0.0F;
     for (std::uint32_t u = 0; u < frame.width && count < kMaxReference; ++u) {
       Eigen::Vector3f point;
       float rho = 0.0F;
       if (!floor_point(pose, static_cast<float>(u), static_cast<float>(v), point, rho)) {
+        have_previous = false;
         continue;
       }
       row_beyond = row_beyond && rho > params_.reference_max_m;
       if (rho < params_.reference_min_m || rho > params_.reference_max_m) {
+        if (have_previous) end_run(run_m);
+        have_previous = false;
+        run_m = 0.0F;
         continue;
       }
       std::array<float, 3> values{};
@@ -161,7 +219,27 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
       for (std::size_t c = 0; c < 3; ++c) {
         ++histogram[c][stored[c]];
       }
+      if (have_previous) {
+        const auto& before = reference_[count - 2];
+        ++pairs;
+        const auto differ = [&](std::size_t c) {
+          return std::fabs(static_cast<float>(stored[c]) - static_cast<float>(before[c]));
+        };
+        const bool edge = differ(0) > params_.min_tolerance_luma ||
+                          differ(1) > params_.min_tolerance_chroma ||
+                          differ(2) > params_.min_tolerance_chroma;
+        if (edge) {
+          ++edges;
+          end_run(run_m);
+          run_m = 0.0F;
+        } else {
+          run_m += (point - previous_point).norm();
+        }
+      }
+      have_previous = true;
+      previous_point = point;
     }
+    if (have_previous) end_run(run_m);
     if (row_beyond) {
       break;
     }
@@ -175,15 +253,36 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
                                            params_.min_tolerance_chroma};
   const std::array<float, 3> max_tolerance{params_.max_tolerance_luma, params_.max_tolerance_chroma,
                                            params_.max_tolerance_chroma};
+  bool uniform = true;
   for (std::size_t c = 0; c < 3; ++c) {
     float median = 0.0F;
     float sigma = 0.0F;
     robust_stats(histogram[c], count, median, sigma);
     candidate.median[c] = c == 0 ? median : median - 128.0F;
     candidate.tolerance[c] = std::max(params_.spread_factor * sigma, min_tolerance[c]);
-    if (candidate.tolerance[c] > max_tolerance[c]) {
-      return FloorLearn::kNotUniform;  // two surfaces (or one too busy to tell from others)
+    uniform = uniform && candidate.tolerance[c] <= max_tolerance[c];
+  }
+  if (!uniform) {
+    // Two surfaces (or one too busy to tell from others): a textured floor, if the region
+    // changes colour often, nothing is known of a plain one and textures are learned.
+    std::size_t p95 = 0;
+    for (std::size_t seen = 0; p95 < kRunBins; ++p95) {
+      seen += runs[p95];
+      if (20 * seen >= 19 * run_count) break;
     }
+    const float edge_share = pairs > 0 ? static_cast<float>(edges) / static_cast<float>(pairs)
+                                       : 0.0F;
+    if (!params_.textured || (model_.valid && !model_.textured) ||
+        !textured_candidate(count, edge_share, 0.01F * static_cast<float>(p95), candidate)) {
+      return FloorLearn::kNotUniform;
+    }
+  } else if (model_.valid && model_.textured) {
+    // One colour in the region (a patch of the texture, or a plain thing on it): tested
+    // against the textured model as it is, and blended into its histogram.
+    const std::array<float, 3> tolerance = candidate.tolerance;
+    (void)textured_candidate(count, 0.0F, model_.max_run_m, candidate);
+    candidate.textured = false;
+    candidate.tolerance = tolerance;
   }
   // Consistency: the region must look like floor to its own model (an obstacle covering
   // part of it fails here) and to the model already known (one covering all of it).
@@ -197,7 +296,10 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
     own += contrast_to(candidate, values) <= 1.0F ? 1U : 0U;
     known += model_.valid && contrast_to(model_, values) <= 1.0F ? 1U : 0U;
     for (std::size_t j = 0; j < kPendingSlots; ++j) {
-      pending[j] += pending_[j].valid && contrast_to(pending_[j], values) <= 1.0F ? 1U : 0U;
+      pending[j] += pending_[j].valid && pending_[j].textured == candidate.textured &&
+                            contrast_to(pending_[j], values) <= 1.0F
+                        ? 1U
+                        : 0U;
     }
   }
   const auto needed =
@@ -218,6 +320,15 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
     bool agrees_nearby = false;
     for (std::size_t j = 0; j < kPendingSlots; ++j) {
       if (!pending_[j].valid || pending[j] < needed) continue;
+      if (candidate.textured) {
+        // Textures agree both ways: the waiting region's colours are the candidate's too
+        // (a region half floor, half wall holds all of a floor's colours, not the reverse).
+        float covered = 0.0F;
+        for (std::size_t b = 0; b < kFloorBins; ++b) {
+          covered += candidate.share[b] >= params_.texture_min_share ? pending_[j].mass[b] : 0.0F;
+        }
+        if (covered < params_.consistency_min) continue;
+      }
       const float apart =
           std::fabs(std::remainder(pan_rad - pending_pan_rad_[j], core::kTwoPi<float>));
       if (apart < params_.confirm_separation_rad) {
@@ -234,6 +345,13 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
         model_.median[c] = 0.5F * (other.median[c] + candidate.median[c]);
         model_.tolerance[c] = 0.5F * (other.tolerance[c] + candidate.tolerance[c]);
       }
+      if (model_.textured) {
+        for (std::size_t b = 0; b < kFloorBins; ++b) {
+          model_.mass[b] = 0.5F * (other.mass[b] + candidate.mass[b]);
+        }
+        smooth_mass(model_.mass, model_.share);
+        model_.max_run_m = 0.5F * (other.max_run_m + candidate.max_run_m);
+      }
       pending_.fill(FloorModel{});
       return FloorLearn::kLearned;
     }
@@ -246,11 +364,41 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
     return FloorLearn::kPending;
   }
   const float w = params_.learn_rate;
+  if (model_.textured) {
+    for (std::size_t b = 0; b < kFloorBins; ++b) {
+      model_.mass[b] += w * (candidate.mass[b] - model_.mass[b]);
+    }
+    smooth_mass(model_.mass, model_.share);
+    if (candidate.textured) {
+      model_.max_run_m += w * (candidate.max_run_m - model_.max_run_m);
+    }
+    return FloorLearn::kUpdated;
+  }
   for (std::size_t c = 0; c < 3; ++c) {
     model_.median[c] += w * (candidate.median[c] - model_.median[c]);
     model_.tolerance[c] += w * (candidate.tolerance[c] - model_.tolerance[c]);
   }
   return FloorLearn::kUpdated;
+}
+
+bool FloorCue::textured_candidate(std::size_t count, float edge_share, float run_p95_m,
+                                  FloorModel& candidate) const {
+  candidate.mass.fill(0.0F);
+  const float each = 1.0F / static_cast<float>(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
+                                      static_cast<float>(reference_[i][1]) - 128.0F,
+                                      static_cast<float>(reference_[i][2]) - 128.0F};
+    candidate.mass[bin_of(values)] += each;
+  }
+  smooth_mass(candidate.mass, candidate.share);
+  candidate.textured = true;
+  // Along a walk "one colour" is what a plain floor's tolerances call one.
+  candidate.tolerance = {params_.min_tolerance_luma, params_.min_tolerance_chroma,
+                         params_.min_tolerance_chroma};
+  candidate.max_run_m = std::clamp(params_.texture_run_factor * run_p95_m,
+                                   params_.texture_run_min_m, params_.texture_run_max_m);
+  return edge_share >= params_.texture_min_edges;
 }
 
 bool FloorCue::sight_floor_point(const CameraPose& pose, float azimuth_rad, float elevation_rad,
@@ -386,6 +534,14 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
     std::uint32_t run = 0;
     std::uint32_t run_start = 0;  // step of the first non-floor pixel of the run
     std::array<float, kMaxRun> run_contrast{};
+    // A textured floor: the stretch of one colour the walk is in, from its first sample.
+    const bool textured = model_.textured;
+    std::uint32_t stretch_start = 0;
+    Eigen::Vector3f stretch_point = Eigen::Vector3f::Zero();
+    std::array<float, 3> last_values{};
+    Eigen::Vector3f free_before_stretch = Eigen::Vector3f::Zero();  // the floor seen before it
+    bool floor_before_stretch = false;
+    bool stretched = false;  // the walk ended at a stretch too long for the floor
     col.end = FloorColumn::End::kImageEdge;
     for (std::uint32_t step = 0; step < max_steps; ++step) {
       const float elevation = elevation0 + static_cast<float>(step) * step_rad;
@@ -419,6 +575,30 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
       const bool floor_right =
           looks_like_floor(frame, static_cast<std::uint32_t>(left + 1), row, contrast_right);
       contrast = std::max(contrast, contrast_right);
+      if (textured) {
+        std::array<float, 3> values{};
+        pixel_values(frame, static_cast<std::uint32_t>(left), row, values);
+        bool same = step > 0;
+        for (std::size_t c = 0; c < 3 && same; ++c) {
+          same = std::fabs(values[c] - last_values[c]) <= model_.tolerance[c];
+        }
+        last_values = values;
+        if (!same) {
+          stretch_start = step;
+          stretch_point = point;
+          free_before_stretch = free_point;
+          floor_before_stretch = have_floor;
+        } else if ((point - stretch_point).norm() > model_.max_run_m) {
+          // One colour for longer than the floor's patches: a plain thing stands there,
+          // from where the colour began.
+          run_start = stretch_start;
+          free_point = free_before_stretch;
+          have_floor = floor_before_stretch;
+          col.end = FloorColumn::End::kBoundary;
+          stretched = true;
+          break;
+        }
+      }
       if (floor_left && floor_right) {
         run = 0;
         have_floor = true;
@@ -444,7 +624,7 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
       Eigen::Vector3f base;
       float rho = 0.0F;
       if (sight_floor_point(pose, azimuth, elevation, base, rho)) {
-        const float c = median_of(run_contrast, k);
+        const float c = stretched ? params_.clear_contrast : median_of(run_contrast, k);
         const float ramp =
             std::clamp((c - 1.0F) / std::max(params_.clear_contrast - 1.0F, 1e-3F), 0.0F, 1.0F);
         const float m =

@@ -68,6 +68,7 @@ bool LookProcessor::process(ViewPart part, const GrabbedView& view, TargetFixes&
 
 void LookProcessor::end_look(const evidence::ReadingLimits& limits) {
   (void)evidence::filter_readings(readings_.features, limits);
+  (void)evidence::floor_readings(readings_.features, limits);
 }
 
 Eigen::Vector3f fix_in_world(const core::Pose2& look_pose, const stereo::TargetFix& fix,

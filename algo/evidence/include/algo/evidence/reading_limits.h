@@ -21,6 +21,11 @@ struct ReadingLimits {
   float max_range_m = 4.5F;  // and at most this far (thesis §3.4: visibility) [m]
   float min_h_m = -1.0F;     // lowest believed height, e.g. a little below the floor [m]
   float max_h_m = 1.0F;      // highest, e.g. the ceiling [m]
+  // The floor test (floor_readings): the floor plane's height [m] (below the PTU centre, so
+  // negative) and the range error, as a fraction of the range, within which a reading that
+  // meets the plane is the floor. 0 (the default): no floor test, the thesis's readings.
+  float floor_h_m = 0.0F;
+  float floor_range_fraction = 0.0F;
 
   // min_range < r ≤ max_range and min_h ≤ h ≤ max_h; false for NaN.
   [[nodiscard]] bool within(const Reading& reading) const {
@@ -59,6 +64,50 @@ inline std::size_t filter_readings(core::FixedVectorBase<Reading>& readings,
   const std::size_t removed = readings.size() - kept;
   readings.resize(kept);
   return removed;
+}
+
+// What floor_readings did.
+struct FloorReadings {
+  std::size_t floor = 0;  // readings of the floor itself, now free (m = 0)
+  std::size_t below = 0;  // readings below the floor beyond their range error, removed
+};
+
+// Stereo readings of the floor itself. The stereo (§3.4) sees strong intensity changes, and a
+// textured floor (a rug, wood grain, tile joints) is full of them: fitted as occupancy, they
+// fill the robot's height band with the floor. A reading's range is measured along its line
+// of sight from the camera (view_*; the PTU centre if unset), and that line meets the floor
+// plane at t = (floor_h − z_view)/(h − z_view) times the reading's distance from the camera.
+// When t is within the range error, 1 − f ≤ t ≤ 1 + f, the reading is the floor: the camera
+// saw the floor there, so its line of sight and the point are free, and its evidence becomes
+// 0 (the ray samples then make it free space, ray_samples.h). t < 1 − f is a reading deeper
+// than the floor by more than its error, a mismatch (nothing is seen through the floor): it
+// is removed, the order of the rest kept. A plain box's bottom edge is also at the floor and
+// also becomes free floor; the box itself stands above it. Nothing happens unless
+// limits.floor_range_fraction is in (0, 1) and limits.floor_h_m < 0.
+inline FloorReadings floor_readings(core::FixedVectorBase<Reading>& readings,
+                                    const ReadingLimits& limits) {
+  FloorReadings out;
+  const float f = limits.floor_range_fraction;
+  if (!(f > 0.0F && f < 1.0F && limits.floor_h_m < 0.0F)) return out;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    Reading reading = readings[i];
+    const float drop = reading.view_z_m - reading.h_m;  // how far the line of sight falls [m]
+    if (drop > 0.0F) {
+      const float t = (reading.view_z_m - limits.floor_h_m) / drop;
+      if (t < 1.0F - f) {
+        ++out.below;
+        continue;
+      }
+      if (t <= 1.0F + f) {
+        reading.m = 0.0F;
+        ++out.floor;
+      }
+    }
+    readings[kept++] = reading;
+  }
+  readings.resize(kept);
+  return out;
 }
 
 // The region the pads are drawn from (§4.9.1): all pan angles and exactly the limits' box,

@@ -62,13 +62,42 @@ struct FloorCueParams {
   float evidence_weak = 0.4F;
   float evidence_clear = 0.9F;
   float clear_contrast = 2.5F;
+  // Textured floors (a rug, wood, tile): a region too busy for one colour (kNotUniform) is
+  // learned as a textured floor when its colour changes often enough: at least
+  // texture_min_edges of the pairs of neighbouring reference pixels differ by more than the
+  // minimum tolerances (a region half wall, half floor changes once per row). Its model is
+  // the region's colour histogram (Ulrich & Nourbakhsh 2000): a pixel looks like this floor
+  // when the pixels of its bin and the bins next to it hold at least texture_min_share of
+  // the region. A plain object can wear one of the floor's colours, but not its texture: a
+  // walk on a textured floor ends where one colour runs on for longer than the floor's
+  // patches do (texture_run_factor times the 95th percentile of the region's runs along its
+  // rows, in metres of floor, within [texture_run_min_m, texture_run_max_m]). false: a
+  // busy region is never learned (the plain-floor cue alone).
+  bool textured = true;
+  float texture_min_edges = 0.08F;
+  float texture_min_share = 0.02F;
+  float texture_run_factor = 2.0F;
+  float texture_run_min_m = 0.1F;
+  float texture_run_max_m = 0.5F;
 };
+
+// The colour histogram of a textured floor: Y in 16 bins of 16 levels, Cb and Cr (offsets
+// from 128, clamped to ±32) in 8 bins of 8.
+inline constexpr std::size_t kFloorLumaBins = 16;
+inline constexpr std::size_t kFloorChromaBins = 8;
+inline constexpr std::size_t kFloorBins = kFloorLumaBins * kFloorChromaBins * kFloorChromaBins;
 
 // What the floor looks like: per channel (0 Y, 1 Cb, 2 Cr; vignetting undone) [grey levels].
 struct FloorModel {
   bool valid = false;
   std::array<float, 3> median{};     // Y in 0..255, Cb and Cr as offsets from 128
   std::array<float, 3> tolerance{};  // the floor test's half width per channel
+  // A textured floor (FloorCueParams::textured): the colour test is the histogram's, and
+  // median and tolerance say only what "one colour" is along a walk (the minimum tolerances).
+  bool textured = false;
+  std::array<float, kFloorBins> mass{};   // share of the region's pixels in each bin
+  std::array<float, kFloorBins> share{};  // the same summed over each bin and its neighbours
+  float max_run_m = 0.0F;  // longest run of one colour the floor shows, in metres of floor
 };
 
 enum class FloorLearn : std::uint8_t {
@@ -192,7 +221,13 @@ class FloorCue {
                       core::FixedVectorBase<evidence::Reading>* blocked);
   void pixel_values(const image::LowResFrame& frame, std::uint32_t u, std::uint32_t v,
                     std::array<float, 3>& values) const;
+  // How far `values` lie from the model, in tolerances (≤ 1 is floor); for a textured model,
+  // texture_min_share over the share of the values' bin (infinite for an empty bin).
   float contrast_to(const FloorModel& model, const std::array<float, 3>& values) const;
+  // Learns a textured candidate from the reference_ pixels (count of them), their edge share
+  // and the runs' 95th percentile [m]; false if the region is not textured.
+  bool textured_candidate(std::size_t count, float edge_share, float run_p95_m,
+                          FloorModel& candidate) const;
 
   RigModel rig_;
   FloorCueParams params_;
