@@ -69,6 +69,61 @@ TEST(ReadingLimits, FilteringRemovesTheReadingsOutsideInPlaceAndKeepsTheOrder) {
   LONGS_EQUAL(0, filter_readings(readings, limits));
 }
 
+// A reading on the line of sight from a view `view_z` above the PTU centre through the floor
+// point at horizontal distance rho (the floor 0.6 m below the PTU centre), whose range is the
+// floor point's distance divided by t: the floor lies at t times the reading's range (t = 1:
+// on the floor; t < 1: deeper than the floor).
+Reading along_sight_to_floor(float rho, float t, float view_z, float m = 0.8F) {
+  const float floor_z = -0.6F;
+  const float x = rho / t;
+  const float z = view_z + (floor_z - view_z) / t;
+  Reading r{0.3F, z, std::hypot(x, z), m};
+  r.view_z_m = view_z;
+  return r;
+}
+
+TEST(ReadingLimits, AReadingOnTheFloorWithinItsRangeErrorBecomesFreeAndADeeperOneIsRefused) {
+  ReadingLimits floor = limits;
+  floor.floor_h_m = -0.6F;
+  floor.floor_range_fraction = 0.05F;
+  static core::FixedVector<Reading, 16> readings;
+  readings.clear();
+  // From the PTU centre and from a camera 0.1 m above it: the floor exactly, the range error's
+  // two ends (just inside), just beyond them (deeper than the floor: refused; nearer, above
+  // it: kept as it is), a wall point level with the camera, one above it.
+  for (const float view_z : {0.0F, 0.1F}) {
+    (void)readings.push_back(along_sight_to_floor(2.0F, 1.0F, view_z));
+    (void)readings.push_back(along_sight_to_floor(2.0F, 0.951F, view_z));
+    (void)readings.push_back(along_sight_to_floor(2.0F, 1.049F, view_z));
+    (void)readings.push_back(along_sight_to_floor(2.0F, 0.94F, view_z));
+    (void)readings.push_back(along_sight_to_floor(2.0F, 1.06F, view_z));
+  }
+  Reading level{0.5F, 0.1F, 2.0F, 0.9F};
+  level.view_z_m = 0.1F;
+  (void)readings.push_back(level);
+  (void)readings.push_back({0.6F, 0.5F, 2.0F, 0.9F});
+  FloorReadings out;
+  CHECK_NO_ALLOCATION({ out = floor_readings(readings, floor); });
+  LONGS_EQUAL(6, out.floor);
+  LONGS_EQUAL(2, out.below);
+  LONGS_EQUAL(10, readings.size());
+  const float expected_m[10] = {0.0F, 0.0F, 0.0F, 0.8F, 0.0F, 0.0F, 0.0F, 0.8F, 0.9F, 0.9F};
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    DOUBLES_EQUAL(expected_m[k], readings[k].m, 0.0);
+  }
+  DOUBLES_EQUAL(0.1, readings[4].view_z_m, 1e-6);  // the order kept: the second view's first
+  DOUBLES_EQUAL(0.5, readings[8].alpha_rad, 1e-6);
+  // Off (the thesis's readings): nothing changes.
+  static core::FixedVector<Reading, 16> copy;
+  copy.clear();
+  (void)copy.push_back(along_sight_to_floor(2.0F, 1.0F, 0.0F));
+  (void)copy.push_back(along_sight_to_floor(2.0F, 1.2F, 0.0F));
+  const FloorReadings off = floor_readings(copy, limits);
+  LONGS_EQUAL(0, off.floor + off.below);
+  LONGS_EQUAL(2, copy.size());
+  DOUBLES_EQUAL(0.8, copy[0].m, 1e-6);
+}
+
 TEST(ReadingLimits, PadsAreDrawnExactlyWithinTheLimits) {
   const PadRegion region = pad_region(limits);
   DOUBLES_EQUAL(0.0, region.alpha_min_rad, 0.0);

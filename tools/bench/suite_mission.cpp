@@ -353,6 +353,21 @@ int run() {
                  std::strerror(errno));
     return 1;
   }
+  // BOTICELLI_MISSION_CONFIG: a configuration file of the user's, whose keys every run takes
+  // too (without `thesis_planner`: the planner knob decides that).
+  std::string extra;
+  if (const char* path = std::getenv("BOTICELLI_MISSION_CONFIG"); path != nullptr && *path) {
+    FILE* in = std::fopen(path, "r");
+    if (in == nullptr) {
+      std::fprintf(stderr, "mission: cannot read BOTICELLI_MISSION_CONFIG %s: %s\n", path,
+                   std::strerror(errno));
+      return 1;
+    }
+    char chunk[4096];
+    for (std::size_t n = 0; (n = std::fread(chunk, 1, sizeof chunk, in)) > 0;) extra.append(chunk, n);
+    std::fclose(in);
+    if (!extra.empty() && extra.back() != '\n') extra += '\n';
+  }
   for (const std::string& planner : planners) {
     const std::string conf = std::string(tmp) + "/" + planner + ".conf";
     FILE* f = std::fopen(conf.c_str(), "w");
@@ -360,7 +375,17 @@ int run() {
       std::fprintf(stderr, "mission: cannot write %s\n", conf.c_str());
       return 1;
     }
-    std::fprintf(f, "[mission]\nthesis_planner = %s\n", planner == "thesis" ? "true" : "false");
+    // TOML defines a table once: the planner's key goes into the user's [mission] if any.
+    const std::string key =
+        std::string("thesis_planner = ") + (planner == "thesis" ? "true" : "false") + "\n";
+    std::string text = extra;
+    const std::size_t table = text.find("[mission]\n");
+    if (table != std::string::npos && (table == 0 || text[table - 1] == '\n')) {
+      text.insert(table + 10, key);
+    } else {
+      text += "[mission]\n" + key;
+    }
+    std::fputs(text.c_str(), f);
     std::fclose(f);
   }
 

@@ -177,19 +177,6 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   const CameraPose pose = rig_.camera_pose(pan_rad, tilt_rad);
   std::array<std::array<std::uint32_t, 256>, 3> histogram{};
   std::size_t count = 0;
-  // The texture along the region's rows: neighbouring pairs, those of two colours, and the
-  // lengths of one colour's runs [cm of floor] (textured floors).
-  std::size_t pairs = 0;
-  std::size_t edges = 0;
-  std::array<std::uint32_t, kRunBins> runs{};
-  std::size_t run_count = 0;
-  const auto end_run = [&](float length_m) {
-    if (length_m > 0.0F) {
-      const auto cm = static_cast<std::size_t>(std::lround(100.0F * length_m));
-      ++runs[std::min(cm, kRunBins - 1)];
-      ++run_count;
-    }
-  };
   const std::uint32_t rows = std::min(params_.reference_rows_max, frame.height);
   for (std::uint32_t k = 0; k < rows; ++k) {
     const std::uint32_t v = frame.height - 1 - k;
@@ -197,7 +184,6 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
     bool row_beyond = true;
     bool have_previous = false;  // the pixel just left of this one is in the region
     Eigen::Vector3f previous_point = Eigen::Vector3f::Zero();
-    float run_m = 0.0F;
     for (std::uint32_t u = 0; u < frame.width && count < kMaxReference; ++u) {
       Eigen::Vector3f point;
       float rho = 0.0F;
@@ -207,9 +193,7 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
       }
       row_beyond = row_beyond && rho > params_.reference_max_m;
       if (rho < params_.reference_min_m || rho > params_.reference_max_m) {
-        if (have_previous) end_run(run_m);
         have_previous = false;
-        run_m = 0.0F;
         continue;
       }
       std::array<float, 3> values{};
@@ -219,27 +203,11 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
       for (std::size_t c = 0; c < 3; ++c) {
         ++histogram[c][stored[c]];
       }
-      if (have_previous) {
-        const auto& before = reference_[count - 2];
-        ++pairs;
-        const auto differ = [&](std::size_t c) {
-          return std::fabs(static_cast<float>(stored[c]) - static_cast<float>(before[c]));
-        };
-        const bool edge = differ(0) > params_.min_tolerance_luma ||
-                          differ(1) > params_.min_tolerance_chroma ||
-                          differ(2) > params_.min_tolerance_chroma;
-        if (edge) {
-          ++edges;
-          end_run(run_m);
-          run_m = 0.0F;
-        } else {
-          run_m += (point - previous_point).norm();
-        }
-      }
+      reference_step_m_[count - 1] = have_previous ? (point - previous_point).norm() : -1.0F;
+      reference_rho_m_[count - 1] = rho;
       have_previous = true;
       previous_point = point;
     }
-    if (have_previous) end_run(run_m);
     if (row_beyond) {
       break;
     }
@@ -265,22 +233,15 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   if (!uniform) {
     // Two surfaces (or one too busy to tell from others): a textured floor, if the region
     // changes colour often, nothing is known of a plain one and textures are learned.
-    std::size_t p95 = 0;
-    for (std::size_t seen = 0; p95 < kRunBins; ++p95) {
-      seen += runs[p95];
-      if (20 * seen >= 19 * run_count) break;
-    }
-    const float edge_share = pairs > 0 ? static_cast<float>(edges) / static_cast<float>(pairs)
-                                       : 0.0F;
     if (!params_.textured || (model_.valid && !model_.textured) ||
-        !textured_candidate(count, edge_share, 0.01F * static_cast<float>(p95), candidate)) {
+        !textured_candidate(count, candidate)) {
       return FloorLearn::kNotUniform;
     }
   } else if (model_.valid && model_.textured) {
     // One colour in the region (a patch of the texture, or a plain thing on it): tested
     // against the textured model as it is, and blended into its histogram.
     const std::array<float, 3> tolerance = candidate.tolerance;
-    (void)textured_candidate(count, 0.0F, model_.max_run_m, candidate);
+    (void)textured_candidate(count, candidate);
     candidate.textured = false;
     candidate.tolerance = tolerance;
   }
@@ -381,24 +342,114 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   return FloorLearn::kUpdated;
 }
 
-bool FloorCue::textured_candidate(std::size_t count, float edge_share, float run_p95_m,
-                                  FloorModel& candidate) const {
+bool FloorCue::textured_candidate(std::size_t count, FloorModel& candidate) {
   candidate.mass.fill(0.0F);
+  near_mass_.fill(0.0F);
+  far_mass_.fill(0.0F);
   const float each = 1.0F / static_cast<float>(count);
+  const float mid_m = 0.5F * (params_.reference_min_m + params_.reference_max_m);
+  std::size_t near = 0;
   for (std::size_t i = 0; i < count; ++i) {
     const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
                                       static_cast<float>(reference_[i][1]) - 128.0F,
                                       static_cast<float>(reference_[i][2]) - 128.0F};
-    candidate.mass[bin_of(values)] += each;
+    const std::size_t b = bin_of(values);
+    candidate.mass[b] += each;
+    const bool is_near = reference_rho_m_[i] < mid_m;
+    (is_near ? near_mass_ : far_mass_)[b] += 1.0F;
+    near += is_near ? 1U : 0U;
   }
   smooth_mass(candidate.mass, candidate.share);
   candidate.textured = true;
-  // Along a walk "one colour" is what a plain floor's tolerances call one.
-  candidate.tolerance = {params_.min_tolerance_luma, params_.min_tolerance_chroma,
-                         params_.min_tolerance_chroma};
-  candidate.max_run_m = std::clamp(params_.texture_run_factor * run_p95_m,
-                                   params_.texture_run_min_m, params_.texture_run_max_m);
-  return edge_share >= params_.texture_min_edges;
+  // One texture: each half's pixels lie in colours the other half holds too.
+  const auto covered = [&](const std::array<float, kFloorBins>& of, std::size_t of_n,
+                           const std::array<float, kFloorBins>& by, std::size_t by_n) {
+    for (std::size_t b = 0; b < kFloorBins; ++b) half_mass_[b] = by[b] / static_cast<float>(by_n);
+    smooth_mass(half_mass_, half_share_);
+    float inside = 0.0F;
+    for (std::size_t b = 0; b < kFloorBins; ++b) {
+      inside += half_share_[b] >= params_.texture_min_share ? of[b] : 0.0F;
+    }
+    return inside >= params_.consistency_min * static_cast<float>(of_n);
+  };
+  const std::size_t far = count - near;
+  const bool one_texture = near > 0 && far > 0 && covered(near_mass_, near, far_mass_, far) &&
+                           covered(far_mass_, far, near_mass_, near);
+  const auto differ = [&](std::size_t i, std::size_t c) {
+    return std::fabs(static_cast<float>(reference_[i][c]) - static_cast<float>(reference_[i - 1][c]));
+  };
+  // A change of colour: the luma steps between row neighbours beyond the luma minimum, and
+  // half their median (a patch's edge falls between pixels as often as on one, so the step
+  // it makes is often split in two).
+  std::array<std::uint32_t, 256> steps{};
+  std::size_t step_count = 0;
+  for (std::size_t i = 1; i < count; ++i) {
+    const float dy = differ(i, 0);
+    if (reference_step_m_[i] >= 0.0F && dy > params_.min_tolerance_luma) {
+      ++steps[static_cast<std::size_t>(dy)];
+      ++step_count;
+    }
+  }
+  float luma_change = params_.min_tolerance_luma;
+  for (std::size_t b = 0, seen = 0; b < steps.size() && step_count > 0; ++b) {
+    seen += steps[b];
+    if (2 * seen >= step_count) {
+      luma_change = std::max(luma_change, 0.5F * static_cast<float>(b));
+      break;
+    }
+  }
+  candidate.tolerance = {luma_change, params_.min_tolerance_chroma, params_.min_tolerance_chroma};
+  // Runs of one colour along the rows, by whole cm of floor up to 1 m and beyond, each
+  // weighted by its length: the percentile is of the floor the runs cover, so the patches'
+  // blurred edges (runs of a pixel or two, many of them) do not hide the large patches.
+  std::array<std::uint32_t, kRunBins> runs{};
+  std::size_t run_count = 0;
+  std::size_t pairs = 0;
+  std::size_t changes = 0;
+  float run_m = 0.0F;
+  const auto end_run = [&]() {
+    if (run_m > 0.0F) {
+      const auto cm = static_cast<std::size_t>(std::lround(100.0F * run_m));
+      runs[std::min(cm, kRunBins - 1)] += static_cast<std::uint32_t>(cm);
+      run_count += cm;
+    }
+    run_m = 0.0F;
+  };
+  // A run's colour is its first pixel's, as along a walk.
+  std::size_t first = 0;
+  const auto apart = [&](std::size_t i, std::size_t c) {
+    return std::fabs(static_cast<float>(reference_[i][c]) - static_cast<float>(reference_[first][c]));
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    if (i == 0 || reference_step_m_[i] < 0.0F) {
+      end_run();  // a row (or a stretch of one) begins
+      first = i;
+      continue;
+    }
+    ++pairs;
+    changes += differ(i, 0) > luma_change || differ(i, 1) > params_.min_tolerance_chroma ||
+                       differ(i, 2) > params_.min_tolerance_chroma
+                   ? 1U
+                   : 0U;
+    if (apart(i, 0) > luma_change || apart(i, 1) > params_.min_tolerance_chroma ||
+        apart(i, 2) > params_.min_tolerance_chroma) {
+      end_run();
+      first = i;
+    } else {
+      run_m += reference_step_m_[i];
+    }
+  }
+  end_run();
+  std::size_t p95 = 0;
+  for (std::size_t seen = 0; p95 + 1 < kRunBins; ++p95) {
+    seen += runs[p95];
+    if (20 * seen >= 19 * run_count) break;
+  }
+  candidate.max_run_m =
+      std::clamp(params_.texture_run_factor * 0.01F * static_cast<float>(p95),
+                 params_.texture_run_min_m, params_.texture_run_max_m);
+  return one_texture && pairs > 0 &&
+         static_cast<float>(changes) >= params_.texture_min_edges * static_cast<float>(pairs);
 }
 
 bool FloorCue::sight_floor_point(const CameraPose& pose, float azimuth_rad, float elevation_rad,
@@ -534,14 +585,22 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
     std::uint32_t run = 0;
     std::uint32_t run_start = 0;  // step of the first non-floor pixel of the run
     std::array<float, kMaxRun> run_contrast{};
-    // A textured floor: the stretch of one colour the walk is in, from its first sample.
+    // A textured floor: the stretch of one colour the walk is in, from its first sample, and
+    // the changes of colour in a row that led into it (an edge blurred over a few pixels):
+    // the stretch's thing begins where they began.
     const bool textured = model_.textured;
-    std::uint32_t stretch_start = 0;
     Eigen::Vector3f stretch_point = Eigen::Vector3f::Zero();
+    std::array<float, 3> stretch_values{};
     std::array<float, 3> last_values{};
-    Eigen::Vector3f free_before_stretch = Eigen::Vector3f::Zero();  // the floor seen before it
+    bool last_same = false;
+    std::uint32_t ramp_start = 0;
+    Eigen::Vector3f free_before_ramp = Eigen::Vector3f::Zero();  // the floor seen before it
+    bool floor_before_ramp = false;
+    std::uint32_t stretch_base = 0;
+    Eigen::Vector3f free_before_stretch = Eigen::Vector3f::Zero();
     bool floor_before_stretch = false;
     bool stretched = false;  // the walk ended at a stretch too long for the floor
+    Eigen::Vector3f walked_point = Eigen::Vector3f::Zero();  // the last sample's floor point
     col.end = FloorColumn::End::kImageEdge;
     for (std::uint32_t step = 0; step < max_steps; ++step) {
       const float elevation = elevation0 + static_cast<float>(step) * step_rad;
@@ -576,28 +635,39 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
           looks_like_floor(frame, static_cast<std::uint32_t>(left + 1), row, contrast_right);
       contrast = std::max(contrast, contrast_right);
       if (textured) {
+        walked_point = point;
         std::array<float, 3> values{};
         pixel_values(frame, static_cast<std::uint32_t>(left), row, values);
+        // One colour: within the change tolerances of the last sample, and within twice them
+        // of the stretch's first (a blurred, distant texture drifts; a plain face does not).
         bool same = step > 0;
         for (std::size_t c = 0; c < 3 && same; ++c) {
-          same = std::fabs(values[c] - last_values[c]) <= model_.tolerance[c];
+          same = std::fabs(values[c] - last_values[c]) <= model_.tolerance[c] &&
+                 std::fabs(values[c] - stretch_values[c]) <= 2.0F * model_.tolerance[c];
         }
         last_values = values;
         if (!same) {
-          stretch_start = step;
+          if (last_same || step == 0) {
+            ramp_start = step;
+            free_before_ramp = free_point;
+            floor_before_ramp = have_floor;
+          }
           stretch_point = point;
-          free_before_stretch = free_point;
-          floor_before_stretch = have_floor;
+          stretch_values = values;
+          stretch_base = ramp_start;
+          free_before_stretch = free_before_ramp;
+          floor_before_stretch = floor_before_ramp;
         } else if ((point - stretch_point).norm() > model_.max_run_m) {
           // One colour for longer than the floor's patches: a plain thing stands there,
-          // from where the colour began.
-          run_start = stretch_start;
+          // from where the colour began to change to it.
+          run_start = stretch_base;
           free_point = free_before_stretch;
           have_floor = floor_before_stretch;
           col.end = FloorColumn::End::kBoundary;
           stretched = true;
           break;
         }
+        last_same = same;
       }
       if (floor_left && floor_right) {
         run = 0;
@@ -613,6 +683,13 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
         col.end = FloorColumn::End::kBoundary;
         break;
       }
+    }
+    if (textured && !stretched && col.end != FloorColumn::End::kBoundary &&
+        (walked_point - stretch_point).norm() > 0.5F * model_.max_run_m) {
+      // The walk ended (max range, the image's edge) in a long stretch of one colour, which
+      // may yet be a plain thing: the floor is free up to where it began.
+      free_point = free_before_stretch;
+      have_floor = floor_before_stretch;
     }
     if (col.end == FloorColumn::End::kBoundary && run_start == 0) {
       // Not floor from the first row: the obstacle may be anywhere nearer; say nothing.

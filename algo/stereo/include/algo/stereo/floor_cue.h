@@ -65,7 +65,8 @@ struct FloorCueParams {
   // Textured floors (a rug, wood, tile): a region too busy for one colour (kNotUniform) is
   // learned as a textured floor when its colour changes often enough: at least
   // texture_min_edges of the pairs of neighbouring reference pixels differ by more than the
-  // minimum tolerances (a region half wall, half floor changes once per row). Its model is
+  // minimum tolerances (a region half wall, half floor changes once per row), and its near
+  // and far halves hold each other's colours (a textured wall across the far part does not). Its model is
   // the region's colour histogram (Ulrich & Nourbakhsh 2000): a pixel looks like this floor
   // when the pixels of its bin and the bins next to it hold at least texture_min_share of
   // the region. A plain object can wear one of the floor's colours, but not its texture: a
@@ -76,9 +77,9 @@ struct FloorCueParams {
   bool textured = true;
   float texture_min_edges = 0.08F;
   float texture_min_share = 0.02F;
-  float texture_run_factor = 2.0F;
-  float texture_run_min_m = 0.1F;
-  float texture_run_max_m = 0.5F;
+  float texture_run_factor = 3.0F;
+  float texture_run_min_m = 0.4F;
+  float texture_run_max_m = 0.6F;
 };
 
 // The colour histogram of a textured floor: Y in 16 bins of 16 levels, Cb and Cr (offsets
@@ -93,7 +94,9 @@ struct FloorModel {
   std::array<float, 3> median{};     // Y in 0..255, Cb and Cr as offsets from 128
   std::array<float, 3> tolerance{};  // the floor test's half width per channel
   // A textured floor (FloorCueParams::textured): the colour test is the histogram's, and
-  // median and tolerance say only what "one colour" is along a walk (the minimum tolerances).
+  // tolerance says what a change of colour along a walk is: the chroma minimum, and half the
+  // region's typical luma step between patches (at least the luma minimum), so that two
+  // faces of one plain thing, shaded apart, are not taken for the floor's patches.
   bool textured = false;
   std::array<float, kFloorBins> mass{};   // share of the region's pixels in each bin
   std::array<float, kFloorBins> share{};  // the same summed over each bin and its neighbours
@@ -224,10 +227,10 @@ class FloorCue {
   // How far `values` lie from the model, in tolerances (≤ 1 is floor); for a textured model,
   // texture_min_share over the share of the values' bin (infinite for an empty bin).
   float contrast_to(const FloorModel& model, const std::array<float, 3>& values) const;
-  // Learns a textured candidate from the reference_ pixels (count of them), their edge share
-  // and the runs' 95th percentile [m]; false if the region is not textured.
-  bool textured_candidate(std::size_t count, float edge_share, float run_p95_m,
-                          FloorModel& candidate) const;
+  // Learns a textured candidate from the first `count` reference_ pixels; false if the
+  // region is not textured (too few colour changes along its rows) or not one texture (its
+  // near and far halves do not hold each other's colours: a wall across its far part).
+  bool textured_candidate(std::size_t count, FloorModel& candidate);
 
   RigModel rig_;
   FloorCueParams params_;
@@ -256,6 +259,15 @@ class FloorCue {
   // Reference pixels of the region being learned (compensated values), for the robust stats.
   static constexpr std::size_t kMaxReference = std::size_t{kMaxColumns} * 64;
   std::array<std::array<std::uint8_t, 3>, kMaxReference> reference_{};
+  // Floor distance from each reference pixel to the one before it in the list when that is
+  // its left neighbour on the row [m], else negative: the texture along the rows.
+  std::array<float, kMaxReference> reference_step_m_{};
+  std::array<float, kMaxReference> reference_rho_m_{};  // each one's ρ [m]
+  // Scratch of textured_candidate: the region's near and far halves' histograms.
+  std::array<float, kFloorBins> near_mass_{};
+  std::array<float, kFloorBins> far_mass_{};
+  std::array<float, kFloorBins> half_mass_{};
+  std::array<float, kFloorBins> half_share_{};
 };
 
 }  // namespace boticelli::stereo
