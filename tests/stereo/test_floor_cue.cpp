@@ -749,19 +749,44 @@ TEST(FloorCue, ARugIsLearnedFromTwoDirectionsAndIsFreeOutToMaxRange) {
 // tones) and a grey one. A plain thing is found where one colour runs on for longer than the
 // rug's patches, at its base.
 TEST(FloorCue, PlainBoxesOnARugAreFoundAtTheirBase) {
+  FloorCueParams bases = trusting();
+  bases.texture_obstacles = true;
+  static FloorCue rug{g_rig, bases};
+  rug.reset();
+  const auto walk = [&](float pan, float tilt, std::uint32_t frame_index) {
+    render(pan, tilt, frame_index, g_frame);
+    out.obstacles.clear();
+    out.free.clear();
+    out.result = rug.process(g_frame, pan, tilt, out.obstacles, out.free);
+  };
+  load(plain_box("near", "1.4 0.5 0.25", "0.4 0.6 0.5", "0.6 0.55 0.5") +
+           plain_box("far", "2.6 -0.6 0.25", "0.4 0.8 0.5"),
+       kRug);
+  render(0.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kLearned == rug.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(rug.model().textured);
+  walk(0.0F, kLookTilt, 1);
+  CHECK(check_against_truth(rug, out, 0.0F, kLookTilt, true) >= 10);
+  CHECK(check_detected(rug, 0.0F, kLookTilt, true) >= 10);
+  // Level, the floor is seen from 1.7 m: the far box's face (2.4 m) runs out at max range
+  // (3 m) before it is longer than the rug's patches; the walks that find it find its base.
+  walk(0.0F, 0.0F, 2);
+  CHECK(check_against_truth(rug, out, 0.0F, 0.0F, true) >= 5);
+}
+
+// By default (texture_obstacles off) a plain stretch on a textured floor only ends the floor
+// seen free: the boxes above stop the walks as before, and no obstacle reading is made.
+TEST(FloorCue, OnARugAPlainStretchEndsTheFreeFloorWithoutAnObstacleByDefault) {
   load(plain_box("near", "1.4 0.5 0.25", "0.4 0.6 0.5", "0.6 0.55 0.5") +
            plain_box("far", "2.6 -0.6 0.25", "0.4 0.8 0.5"),
        kRug);
   render(0.0F, kLookTilt, 1, g_frame);
   CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(cue.model().textured);
   run(0.0F, kLookTilt, 1);
-  CHECK(check_against_truth(cue, out, 0.0F, kLookTilt, true) >= 10);
+  CHECK_EQUAL(0U, out.obstacles.size());
+  CHECK_EQUAL(0U, out.result.boundaries);
   CHECK(check_detected(cue, 0.0F, kLookTilt, true) >= 10);
-  // Level, the floor is seen from 1.7 m: the far box's face (2.4 m) runs out at max range
-  // (3 m) before it is longer than the rug's patches; the walks that find it find its base.
-  run(0.0F, 0.0F, 2);
-  CHECK(check_against_truth(cue, out, 0.0F, 0.0F, true) >= 5);
+  CHECK_EQUAL(0U, check_against_truth(cue, out, 0.0F, kLookTilt, true));  // the free floor
 }
 
 // A red patterned mat 3 cm high covers the far half of the first region on a rug: its near
@@ -833,6 +858,43 @@ TEST(FloorCue, TexturesAgreeOnlyWhenEachHoldsTheOthersColours) {
   CHECK(fresh.looks_like_floor(g_frame2, 0, g_frame2.height - 1, contrast));
   fill_patches(g_frame, {220.0F});
   CHECK_FALSE(fresh.looks_like_floor(g_frame, 0, g_frame.height - 1, contrast));
+}
+
+// Along a walk, one colour is one within the change tolerances of the last sample and within
+// twice them of the stretch's first: a blurred, distant texture drifts a little from row to
+// row and is not one plain stretch; a frame all of one of the floor's colours is.
+TEST(FloorCue, ADriftingShadeIsNotOnePlainStretchButOneShadeIs) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {24.0F, 40.0F, 56.0F, 72.0F, 88.0F, 104.0F, 120.0F, 136.0F, 152.0F,
+                         168.0F, 184.0F, 200.0F, 216.0F, 232.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  // Six grey levels a row, darker upwards, from 230 down to 30 and again: every walk sees
+  // floor colours all the way.
+  fill_patches(g_frame2, {0.0F});
+  for (std::uint32_t v = 0; v < g_frame2.height; ++v) {
+    for (std::uint32_t u = 0; u < g_frame2.width; ++u) {
+      g_frame2.luma[g_frame2.index(u, v)] =
+          230.0F - static_cast<float>((6 * (g_frame2.height - 1 - v)) % 200);
+    }
+  }
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, out.result.boundaries);
+  CHECK_EQUAL(out.result.columns, out.free.size());
+  // One shade of the floor's over the whole frame: every walk is blocked from its bottom row.
+  fill_patches(g_frame2, {136.0F});
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, out.free.size());
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    CHECK(fresh.column(i).end == FloorColumn::End::kBlockedAtBottom);
+  }
 }
 
 // Without textures (FloorCueParams::textured = false) a rug is never learned: the plain-floor

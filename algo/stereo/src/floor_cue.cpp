@@ -695,7 +695,13 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
       // Not floor from the first row: the obstacle may be anywhere nearer; say nothing.
       col.end = FloorColumn::End::kBlockedAtBottom;
     }
-    if (col.end == FloorColumn::End::kBoundary) {
+    if (col.end == FloorColumn::End::kBoundary && stretched && !params_.texture_obstacles) {
+      // The floor seen ends here; nothing is said of what stands there.
+      const float elevation = elevation0 + (static_cast<float>(run_start) - 0.5F) * step_rad;
+      Eigen::Vector3f base;
+      float rho = 0.0F;
+      if (sight_floor_point(pose, azimuth, elevation, base, rho)) col.base_rho_m = rho;
+    } else if (col.end == FloorColumn::End::kBoundary) {
       // The base: between the last floor sample and the first obstacle sample.
       const float elevation = elevation0 + (static_cast<float>(run_start) - 0.5F) * step_rad;
       Eigen::Vector3f base;
