@@ -345,7 +345,8 @@ TEST(WorldGeometry, EveryUnseenTestWorldIsClosedWithAFreeStartAndAReachableTarge
                                 "round_room_pillars",     "cluttered_low_boxes_table",
                                 "featureless_wall",       "partition_gap_west",
                                 "long_hall_far_target",   "patterned_floor",
-                                "skewed_pentagon_crates", "gallery_alcove"};
+                                "skewed_pentagon_crates", "gallery_alcove",
+                                "rug_room",               "wood_floor_boxes"};
   for (const char* name : worlds) {
     const std::string path = test_world_path(name);
     CHECK_TEXT(load_world(path.c_str(), g_world, g_error, sizeof g_error), g_error);

@@ -68,7 +68,12 @@ bool LookProcessor::process(ViewPart part, const GrabbedView& view, TargetFixes&
 
 void LookProcessor::end_look(const evidence::ReadingLimits& limits) {
   (void)evidence::filter_readings(readings_.features, limits);
-  (void)evidence::floor_readings(readings_.features, limits);
+  // On a floor the cue knows to be textured, the stereo's floor-level readings are mostly the
+  // floor's texture; on a plain floor they are the bases of walls and boxes, kept as the
+  // thesis fits them.
+  if (floor_cue_.model().valid && floor_cue_.model().textured) {
+    (void)evidence::floor_readings(readings_.features, limits);
+  }
 }
 
 Eigen::Vector3f fix_in_world(const core::Pose2& look_pose, const stereo::TargetFix& fix,

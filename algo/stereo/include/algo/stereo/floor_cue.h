@@ -82,7 +82,7 @@ struct FloorCueParams {
   // plain thing on the floor shows its edges to the stereo, and the floor beyond it is not
   // seen free.
   bool texture_obstacles = false;
-  float texture_min_edges = 0.08F;
+  float texture_min_edges = 0.02F;
   float texture_min_share = 0.02F;
   float texture_run_factor = 3.0F;
   float texture_run_min_m = 0.4F;

@@ -63,8 +63,9 @@ class LookProcessor {
   void reset();
   // One part of a view; true when the view is done. kTarget fills `fixes` (else untouched).
   bool process(ViewPart part, const GrabbedView& view, TargetFixes& fixes);
-  // The look is complete: drops the features outside the reading limits and makes those of
-  // the floor itself free (evidence::floor_readings): the Think stage's input.
+  // The look is complete: drops the features outside the reading limits and, on a floor the
+  // floor cue knows to be textured, makes those of the floor itself free
+  // (evidence::floor_readings): the Think stage's input.
   void end_look(const evidence::ReadingLimits& limits);
   // A recorded look replayed (the look regression tests): begin_look(), and the caller fills
   // the lists returned in place of process(); end_look() then as for a look taken.
