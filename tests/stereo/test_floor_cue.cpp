@@ -860,6 +860,43 @@ TEST(FloorCue, TexturesAgreeOnlyWhenEachHoldsTheOthersColours) {
   CHECK_FALSE(fresh.looks_like_floor(g_frame, 0, g_frame.height - 1, contrast));
 }
 
+// One texture: a region whose near part holds a tone its far part lacks (a mat in front of
+// the robot on a rug) is not learned, and neither is the reverse; the same patches all
+// through it are.
+TEST(FloorCue, ARegionIsOneTextureOnlyIfItsNearAndFarHalvesHoldEachOthersColours) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  // Patches of near_tones where a pixel sees the floor nearer than 0.7 m (the region's
+  // middle), of far_tones beyond.
+  const auto two_parts = [&](std::initializer_list<float> near_tones,
+                             std::initializer_list<float> far_tones) {
+    fill_patches(g_frame2, far_tones);
+    fill_patches(g_frame, near_tones);
+    for (std::uint32_t v = 0; v < g_frame.height; ++v) {
+      for (std::uint32_t u = 0; u < g_frame.width; ++u) {
+        const Eigen::Vector3f ray = RigModel::ray_ptu(
+            pose, camera, Eigen::Vector2f(static_cast<float>(u), static_cast<float>(v)));
+        const float t = (-g_rig.params().ptu_height_m - pose.centre_m.z()) / ray.z();
+        const Eigen::Vector3f p = pose.centre_m + t * ray;
+        if (!(ray.z() < 0.0F) || std::hypot(p.x(), p.y()) >= 0.7F) {
+          g_frame.luma[g_frame.index(u, v)] = g_frame2.luma[g_frame2.index(u, v)];
+        }
+      }
+    }
+    fresh.reset();
+    return fresh.learn(g_frame, 0.0F, kLookTilt);
+  };
+  CHECK(FloorLearn::kNotUniform ==
+        two_parts({40.0F, 100.0F, 160.0F, 220.0F}, {40.0F, 100.0F, 160.0F}));
+  CHECK(FloorLearn::kNotUniform ==
+        two_parts({40.0F, 100.0F, 160.0F}, {40.0F, 100.0F, 160.0F, 220.0F}));
+  CHECK(FloorLearn::kLearned ==
+        two_parts({40.0F, 100.0F, 160.0F, 220.0F}, {40.0F, 100.0F, 160.0F, 220.0F}));
+}
+
 // Along a walk, one colour is one within the change tolerances of the last sample and within
 // twice them of the stretch's first: a blurred, distant texture drifts a little from row to
 // row and is not one plain stretch; a frame all of one of the floor's colours is.
