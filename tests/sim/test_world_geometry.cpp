@@ -341,12 +341,18 @@ TEST(WorldGeometry, NoGridMoveJumpsAWallThinnerThanAMove) {
 
 TEST(WorldGeometry, EveryUnseenTestWorldIsClosedWithAFreeStartAndAReachableTarget) {
   const boticelli::stereo::RigModel rig;
-  const char* const worlds[] = {"two_rooms_far_target",   "l_corridor",
-                                "round_room_pillars",     "cluttered_low_boxes_table",
-                                "featureless_wall",       "partition_gap_west",
-                                "long_hall_far_target",   "patterned_floor",
-                                "skewed_pentagon_crates", "gallery_alcove",
-                                "rug_room",               "wood_floor_boxes"};
+  const char* const worlds[] = {"two_rooms_far_target",
+                                "l_corridor",
+                                "round_room_pillars",
+                                "cluttered_low_boxes_table",
+                                "featureless_wall",
+                                "partition_gap_west",
+                                "long_hall_far_target",
+                                "patterned_floor",
+                                "skewed_pentagon_crates",
+                                "gallery_alcove",
+                                "rug_room",
+                                "wood_floor_boxes"};
   for (const char* name : worlds) {
     const std::string path = test_world_path(name);
     CHECK_TEXT(load_world(path.c_str(), g_world, g_error, sizeof g_error), g_error);

@@ -53,7 +53,8 @@ std::string world_with(const std::string& models, const std::string& floor_patte
          "<model name=\"floor\"><link name=\"l\"><visual name=\"v\"><geometry><plane>"
          "<normal>0 0 1</normal><size>20 20</size></plane></geometry>"
          "<material><diffuse>0.55 0.5 0.45 1</diffuse></material>" +
-         floor_pattern + "</visual></link></model>\n"
+         floor_pattern +
+         "</visual></link></model>\n"
          "<model name=\"target\"><pose>-6 0 1 0 0 0</pose><link name=\"l\"><visual name=\"v\">"
          "<geometry><box><size>0.01 0.3 0.3</size></box></geometry>"
          "<boticelli:pattern>paper</boticelli:pattern>"
@@ -195,11 +196,11 @@ struct Outputs {
 // many bases were checked. Every free reading short of the first obstacle, and visible.
 // On a textured floor (`textured`), a walk whose own line passes beside the obstacle (it
 // meets it only within the half pixel either side, not where the walk looks), or along its
-// edge (grazes_edge), may go on past its base: the rug's colours let it, and only a plain stretch on the walk itself ends it. Such
-// a walk must still not end nearer than the obstacle. A rug's largest patches (the darkest
-// tone's blotches run on for half a metre) can end a walk where nothing stands: at most 8 of
-// a frame's 80 walks end so, with no obstacle within 1.5 px of the walk or short of the first
-// one (docs/mapping.md, "Textured floors").
+// edge (grazes_edge), may go on past its base: the rug's colours let it, and only a plain stretch
+// on the walk itself ends it. Such a walk must still not end nearer than the obstacle. A rug's
+// largest patches (the darkest tone's blotches run on for half a metre) can end a walk where
+// nothing stands: at most 8 of a frame's 80 walks end so, with no obstacle within 1.5 px of the
+// walk or short of the first one (docs/mapping.md, "Textured floors").
 std::size_t check_against_truth(const FloorCue& cue, const Outputs& out, float pan, float tilt,
                                 bool textured = false) {
   const std::size_t per_base = cue.params().obstacle_height_count;
@@ -905,8 +906,8 @@ TEST(FloorCue, ADriftingShadeIsNotOnePlainStretchButOneShadeIs) {
   flat.vignetting = 0.0F;
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
-  fill_patches(g_frame, {24.0F, 40.0F, 56.0F, 72.0F, 88.0F, 104.0F, 120.0F, 136.0F, 152.0F,
-                         168.0F, 184.0F, 200.0F, 216.0F, 232.0F});
+  fill_patches(g_frame, {24.0F, 40.0F, 56.0F, 72.0F, 88.0F, 104.0F, 120.0F, 136.0F, 152.0F, 168.0F,
+                         184.0F, 200.0F, 216.0F, 232.0F});
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   CHECK(fresh.model().textured);
   // Six grey levels a row, darker upwards, from 230 down to 30 and again: every walk sees

@@ -364,7 +364,8 @@ int run() {
       return 1;
     }
     char chunk[4096];
-    for (std::size_t n = 0; (n = std::fread(chunk, 1, sizeof chunk, in)) > 0;) extra.append(chunk, n);
+    for (std::size_t n = 0; (n = std::fread(chunk, 1, sizeof chunk, in)) > 0;)
+      extra.append(chunk, n);
     std::fclose(in);
     if (!extra.empty() && extra.back() != '\n') extra += '\n';
   }

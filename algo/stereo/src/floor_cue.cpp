@@ -376,7 +376,8 @@ bool FloorCue::textured_candidate(std::size_t count, FloorModel& candidate) {
   const bool one_texture = near > 0 && far > 0 && covered(near_mass_, near, far_mass_, far) &&
                            covered(far_mass_, far, near_mass_, near);
   const auto differ = [&](std::size_t i, std::size_t c) {
-    return std::fabs(static_cast<float>(reference_[i][c]) - static_cast<float>(reference_[i - 1][c]));
+    return std::fabs(static_cast<float>(reference_[i][c]) -
+                     static_cast<float>(reference_[i - 1][c]));
   };
   // A change of colour: the luma steps between row neighbours beyond the luma minimum, and
   // half their median (a patch's edge falls between pixels as often as on one, so the step
@@ -418,7 +419,8 @@ bool FloorCue::textured_candidate(std::size_t count, FloorModel& candidate) {
   // A run's colour is its first pixel's, as along a walk.
   std::size_t first = 0;
   const auto apart = [&](std::size_t i, std::size_t c) {
-    return std::fabs(static_cast<float>(reference_[i][c]) - static_cast<float>(reference_[first][c]));
+    return std::fabs(static_cast<float>(reference_[i][c]) -
+                     static_cast<float>(reference_[first][c]));
   };
   for (std::size_t i = 0; i < count; ++i) {
     if (i == 0 || reference_step_m_[i] < 0.0F) {
@@ -445,9 +447,8 @@ bool FloorCue::textured_candidate(std::size_t count, FloorModel& candidate) {
     seen += runs[p95];
     if (20 * seen >= 19 * run_count) break;
   }
-  candidate.max_run_m =
-      std::clamp(params_.texture_run_factor * 0.01F * static_cast<float>(p95),
-                 params_.texture_run_min_m, params_.texture_run_max_m);
+  candidate.max_run_m = std::clamp(params_.texture_run_factor * 0.01F * static_cast<float>(p95),
+                                   params_.texture_run_min_m, params_.texture_run_max_m);
   return one_texture && pairs > 0 &&
          static_cast<float>(changes) >= params_.texture_min_edges * static_cast<float>(pairs);
 }

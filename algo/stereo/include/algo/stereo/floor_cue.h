@@ -66,14 +66,14 @@ struct FloorCueParams {
   // learned as a textured floor when its colour changes often enough: at least
   // texture_min_edges of the pairs of neighbouring reference pixels differ by more than the
   // minimum tolerances (a region half wall, half floor changes once per row), and its near
-  // and far halves hold each other's colours (a textured wall across the far part does not). Its model is
-  // the region's colour histogram (Ulrich & Nourbakhsh 2000): a pixel looks like this floor
-  // when the pixels of its bin and the bins next to it hold at least texture_min_share of
-  // the region. A plain object can wear one of the floor's colours, but not its texture: a
-  // walk on a textured floor ends where one colour runs on for longer than the floor's
-  // patches do (texture_run_factor times the 95th percentile of the region's runs along its
-  // rows, in metres of floor, within [texture_run_min_m, texture_run_max_m]). false: a
-  // busy region is never learned (the plain-floor cue alone).
+  // and far halves hold each other's colours (a textured wall across the far part does not). Its
+  // model is the region's colour histogram (Ulrich & Nourbakhsh 2000): a pixel looks like this
+  // floor when the pixels of its bin and the bins next to it hold at least texture_min_share of the
+  // region. A plain object can wear one of the floor's colours, but not its texture: a walk on a
+  // textured floor ends where one colour runs on for longer than the floor's patches do
+  // (texture_run_factor times the 95th percentile of the region's runs along its rows, in metres of
+  // floor, within [texture_run_min_m, texture_run_max_m]). false: a busy region is never learned
+  // (the plain-floor cue alone).
   bool textured = true;
   // A plain stretch on a textured floor always ends the walk's free floor (unknown is not
   // free); with texture_obstacles it is also an obstacle base (evidence_clear). Off by
