@@ -29,6 +29,28 @@ float clearance_m(const StarPolygon& free, Point2 p) {
   return static_cast<float>(boticelli::test::reference_sweep_clearance_m(free, p));
 }
 
+// A vertex of an n-ray fan at length rho [m], and the distance from a point to a segment, in
+// double precision and sharing no code with the library.
+struct Vertex {
+  double x;
+  double y;
+};
+
+Vertex vertex_of(std::size_t n, std::size_t k, double rho) {
+  const double a =
+      2.0 * 3.14159265358979323846 * static_cast<double>(k % n) / static_cast<double>(n);
+  return {rho * std::cos(a), rho * std::sin(a)};
+}
+
+double point_segment_distance(Vertex q, Vertex a, Vertex b) {
+  const double ex = b.x - a.x;
+  const double ey = b.y - a.y;
+  const double len2 = ex * ex + ey * ey;
+  double t = len2 > 0.0 ? ((q.x - a.x) * ex + (q.y - a.y) * ey) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(q.x - (a.x + t * ex), q.y - (a.y + t * ey));
+}
+
 }  // namespace
 
 TEST_GROUP(StarPolygon){};
@@ -240,6 +262,36 @@ TEST(Shrink, ARegularPolygonShrinksWithoutPullingInAnyVertex) {
   }
 }
 
+TEST(Shrink, AroundALoneCornerThePulledInChordsTouchTheCornersDiscAndDoNotCutIt) {
+  // A circular room with one corner poking in (a reflex corner of the free region), on fans
+  // coarse enough that every chord near the corner either clears its disc or is pulled in:
+  // a pull-in turns the chord about its other vertex until it is tangent to the disc. So no
+  // chord comes nearer the corner than R (not merely within the chord check's 1 um), and one
+  // touches it (no vertex is pulled in farther than needed). The corner also sits at the seam.
+  for (const std::size_t n : {std::size_t{36}, std::size_t{90}}) {
+    for (const float corner : {1.0F, 1.5F}) {
+      for (const float radius : {0.1F, 0.2F, 0.3F}) {
+        for (const std::size_t m : {n / 4, n - 1, std::size_t{0}}) {
+          StarPolygon free(n);
+          free.fill(2.0F);
+          free.set_rho_m(m, corner);
+          StarPolygon nav;
+          CHECK_TRUE(boticelli::mapping::shrink_by_radius(free, radius, nav));
+          const Vertex c = vertex_of(n, m, static_cast<double>(corner));
+          double nearest = 1e9;
+          for (std::size_t k = 0; k < n; ++k) {
+            const Vertex a = vertex_of(n, k, static_cast<double>(nav.rho_m(k)));
+            const Vertex b = vertex_of(n, k + 1, static_cast<double>(nav.rho_m((k + 1) % n)));
+            nearest = std::fmin(nearest, point_segment_distance(c, a, b));
+          }
+          CHECK_TRUE(nearest >= static_cast<double>(radius) - 1e-8);
+          CHECK_TRUE(nearest <= static_cast<double>(radius) + 1e-7);
+        }
+      }
+    }
+  }
+}
+
 TEST_GROUP(ExcludePoints){};
 
 TEST(ExcludePoints, APointIsLeftOutsideAndOnlyItsSectorMoves) {
@@ -313,6 +365,20 @@ TEST(ExcludePoints, ADiscAroundAPointCutsEveryRayThatMeetsItAtItsNearEdgeAndNoOt
     }
   }
   CHECK_TRUE(cut >= 11);
+}
+
+TEST(ExcludePoints, ADiscCutsTheSectorHoldingItsCentreJustShortOfItsNearestPointAndNoFurther) {
+  // Both vertices of the sector holding the disc's centre are cut to its nearest distance
+  // d - r less one part in a million (clear of float rounding), not more: at 0.9 m that is
+  // 0.9 um, and the float arithmetic is good to about 0.2 um.
+  StarPolygon free(360);
+  free.fill(2.0F);
+  const Point2 q{std::cos(0.5F), std::sin(0.5F)};  // in the sector of rays 28 and 29
+  boticelli::mapping::exclude_discs(std::span<const Point2>(&q, 1), 0.1F, free);
+  const double d = std::hypot(static_cast<double>(q.x_m), static_cast<double>(q.y_m));
+  const double cut = (d - static_cast<double>(0.1F)) * (1.0 - 1e-6);
+  DOUBLES_EQUAL(cut, free.rho_m(28), 3e-7);
+  DOUBLES_EQUAL(cut, free.rho_m(29), 3e-7);
 }
 
 TEST(ExcludePoints, ADiscAroundAPointNearerThanItsRadiusCutsOnlyThePoint) {
