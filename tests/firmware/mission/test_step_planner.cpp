@@ -177,6 +177,37 @@ TEST(StepPlanner, WithinTheStandOffOfTheGoalTheRobotIsAtTheGoal) {
   CHECK(planner.end_choice(origin, origin, look_disc, crumbs) == StepOutcome::kAtGoal);
 }
 
+// The consistency check samples the step from where the robot stands: from 0.7 m out along
+// either axis, a step back towards the look's centre lies inside its 1 m polygon.
+TEST(StepPlanner, FromNearTheLooksEdgeAStepBackAlongXTowardsItsCentreIsAMove) {
+  (void)map.exploration().push_back({-0.9F, 0.0F});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  const Pose2 here{0.7F, 0.0F, 0.0F};
+  CHECK(cycle(here, origin) == StepOutcome::kMove);
+  CHECK(planner.target().x_m < here.x_m - 0.2F);
+}
+
+TEST(StepPlanner, FromNearTheLooksEdgeAStepBackAlongYTowardsItsCentreIsAMove) {
+  (void)map.exploration().push_back({0.0F, -0.9F});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  const Pose2 here{0.0F, 0.7F, 0.0F};
+  CHECK(cycle(here, origin) == StepOutcome::kMove);
+  CHECK(planner.target().y_m < here.y_m - 0.2F);
+}
+
+// Seen from where the robot stands, each heading of the look's polygon reaches as far as the
+// look allows whatever the robot's own heading: facing +x, it steps straight to its left.
+TEST(StepPlanner, AnotherStepOnTheSameLookCanHeadSquareToTheRobotsOwnHeading) {
+  (void)map.exploration().push_back({0.0F, 0.9F});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  const Pose2 here{0.0F, -0.4F, 0.0F};
+  CHECK_TRUE(planner.begin_next_on_look(here, origin, look_disc));
+  choose();
+  CHECK(planner.end_next_on_look() == StepOutcome::kMove);
+  CHECK(planner.target().y_m > here.y_m + 0.3F);
+  CHECK(std::fabs(planner.target().x_m) < 0.1F);
+}
+
 TEST(StepPlanner, AnotherStepOnTheSameLookIsRefusedWhenTheRobotStandsOutsideItsPolygon) {
   CHECK_FALSE(planner.begin_next_on_look({1.5F, 0.0F, 0.0F}, origin, look_disc));
   // A look taken elsewhere, its polygon seen from there.
@@ -299,6 +330,26 @@ TEST(FrontierStepPlanner, WithinTheStandOffOfTheTargetTheRobotIsAtTheGoal) {
   CHECK(planner.target().x_m > 0.3F);
 }
 
+TEST(FrontierStepPlanner, TheRobotIsAtTheGoalWithinTheStandOffAndItsArrivalTolerance) {
+  // Beyond the stand-off by less than the arrival tolerance: there; by twice it: not yet.
+  const float standoff = params.rewards.goal_standoff_m;
+  const float tolerance = params.step.arrival_tolerance_m;
+  const Point2 near_enough{standoff + 0.6F * tolerance, 0.0F};
+  CHECK(plan(origin, disc(0.6F), &near_enough) == StepOutcome::kAtGoal);
+  const Point2 not_yet{standoff + 2.0F * tolerance, 0.0F};
+  CHECK(plan(origin, disc(0.6F), &not_yet) != StepOutcome::kAtGoal);
+}
+
+// An occupied cell a quarter of a metre behind the robot: the cell it stands on is within
+// the path's clearance of it (not passable), but the part of a step within half the robot's
+// radius is the place it stands on, not the way ahead.
+TEST(FrontierStepPlanner, ARobotWithinAnObstaclesClearanceStillStepsAwayFromIt) {
+  (void)g_grid.add({-5, 0}, 20);
+  CHECK(plan(origin, disc(0.6F), nullptr) == StepOutcome::kMove);
+  CHECK_FALSE(planner.nav().passable({0.0F, 0.0F}));
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) > 0.3F);
+}
+
 TEST(FrontierStepPlanner, AGridWithNothingReachableTurnsRoundThenEnds) {
   g_grid.configure({});  // nothing known
   CHECK(plan(origin, disc(0.6F), nullptr) == StepOutcome::kTurnRound);
@@ -317,6 +368,20 @@ TEST_GROUP(ThesisPlannerTargetByPath) {
   void setup() override {
     planner.clear();
     free_square();
+  }
+  // plan() from a robot at `here` that looked where it stands.
+  StepOutcome plan_from(const Pose2& here, const Point2* goal) {
+    return plan_from(here, goal, look, here);
+  }
+  // The same with the look's polygon `navigable`, taken at `look_pose`.
+  StepOutcome plan_from(const Pose2& here, const Point2* goal, const StarPolygon& navigable,
+                        const Pose2& look_pose) {
+    planner.start_value(map, g_grid, goal, {here.x_m, here.y_m}, 1);
+    while (!planner.value_done()) planner.value_unit();
+    const StepOutcome begun = planner.begin_choice(here, navigable, true, goal != nullptr);
+    if (begun != StepOutcome::kChoosing) return begun;
+    while (!planner.choice_done()) planner.choose_heading();
+    return planner.end_choice(here, look_pose, navigable, crumbs);
   }
   StepOutcome plan(const Point2* goal) {
     planner.start_value(map, g_grid, goal, {0.0F, 0.0F}, 1);
@@ -378,4 +443,59 @@ TEST(ThesisPlannerTargetByPath, NoTargetNoWavefront) {
   CHECK(plan(nullptr) == StepOutcome::kMove);
   CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kNone);
   CHECK_FALSE(planner.nav().done());
+}
+
+// The final approach seen from a robot away from the origin (the look taken where it stands):
+// the step ends at the stand-off cell, heading there.
+TEST(ThesisPlannerTargetByPath, TheFinalApproachFromAnywhereEndsAtTheStandOffHeadingThere) {
+  const Pose2 here{-0.5F, -0.3F, 0.4F};
+  const Point2 target{0.8F, 0.6F};
+  CHECK(plan_from(here, &target) == StepOutcome::kMove);
+  const Point2 t = planner.target();
+  const Point2 g = planner.nav_choice().goal;
+  const Point2 at{here.x_m, here.y_m};
+  CHECK(boticelli::core::distance_m(at, t) > 0.6F + 0.05F);  // beyond the look's polygon
+  DOUBLES_EQUAL(g.x_m, t.x_m, 0.051);
+  DOUBLES_EQUAL(g.y_m, t.y_m, 0.051);
+  DOUBLES_EQUAL(std::atan2(t.y_m - at.y_m, t.x_m - at.x_m), planner.decision().heading_rad, 1e-5);
+  DOUBLES_EQUAL(boticelli::core::distance_m(at, t), planner.decision().distance_m, 1e-5);
+}
+
+// A final approach is a move beyond the look's polygon only for that cycle: a later step of
+// the value function (no path on the grid now) that leaves its look's polygon is no safe step.
+TEST(ThesisPlannerTargetByPath, AfterAFinalApproachAStepLeavingTheLooksPolygonIsNoSafeStep) {
+  const Point2 target{1.3F, 0.9F};
+  CHECK(plan(&target) == StepOutcome::kMove);
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) > 0.6F + 0.05F);
+  g_grid.configure({});  // nothing known: no path anywhere
+  planner.start_value(map, g_grid, &target, {0.0F, 0.0F}, 2);
+  while (!planner.value_done()) planner.value_unit();
+  CHECK(planner.begin_choice(origin, look, true, true) == StepOutcome::kChoosing);
+  while (!planner.choice_done()) planner.choose_heading();
+  // The look was taken 5 m away: no step from here lies in its polygon.
+  CHECK(planner.end_choice(origin, {5.0F, 0.0F, 0.0F}, look, crumbs) == StepOutcome::kNoSafeStep);
+}
+
+// The final approach goes by the grid alone: it is a move even when the look's polygon holds
+// no step at all.
+TEST(ThesisPlannerTargetByPath,
+     NearTheStandOffTheFinalApproachIsAMoveEvenIfTheLooksPolygonHoldsNoStep) {
+  const Point2 target{1.3F, 0.9F};
+  const StarPolygon cramped = disc(0.02F);
+  CHECK(plan_from(origin, &target, cramped, origin) == StepOutcome::kMove);
+  const Point2 g = planner.nav_choice().goal;
+  DOUBLES_EQUAL(g.x_m, planner.target().x_m, 0.051);
+  DOUBLES_EQUAL(g.y_m, planner.target().y_m, 0.051);
+}
+
+// The path's step is sampled from where the robot stands: 0.3 m below the look's centre, the
+// path up and to the right stays inside the look's 0.6 m polygon for more than one action.
+TEST(ThesisPlannerTargetByPath, ThePathsStepFromBesideTheLooksCentreStaysInsideItsPolygon) {
+  params.final_approach_m = 0.0F;  // the path's step alone
+  const Pose2 here{0.0F, -0.3F, 0.0F};
+  const Point2 target{1.3F, 0.9F};
+  CHECK(plan_from(here, &target, look, origin) == StepOutcome::kMove);
+  const Point2 t = planner.target();
+  CHECK(look.contains(to_robot(origin, t)));
+  CHECK(boticelli::core::distance_m({here.x_m, here.y_m}, t) > params.value.step_m);
 }

@@ -189,6 +189,42 @@ TEST(TargetTracker, ARestoredGoalIsConfirmedAtOnceAndIsTheTarget) {
   CHECK_FALSE(tracker.is_target(kTarget + Eigen::Vector3f(0.3F, 0.0F, 0.0F)));
 }
 
+TEST(TargetTracker, ARestoredGoalIsOneSightingOfWeightOneThatLaterSightingsRefine) {
+  tracker.restore(kTarget);
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  // A sighting 0.1 m off of weight (0.1 + 0.9) / 1² = 1, from another view: the estimate is
+  // the mean of the two, halfway.
+  tracker.add(kTarget + Eigen::Vector3f(0.1F, 0.0F, 0.0F), 0.9F, 7, 1.0F);
+  UNSIGNED_LONGS_EQUAL(2, tracker.sightings());
+  CHECK(tracker.confirmed());
+  check_near(kTarget + Eigen::Vector3f(0.05F, 0.0F, 0.0F), tracker.estimate_m(), 1e-5F);
+}
+
+TEST(TargetTracker, ARevocationForgetsOnlyTheSightingsWithinTheRefineRadius) {
+  TargetTrackerParams p;
+  p.revoke_after_misses = 1;
+  tracker.configure(p);
+  // Another object 0.6 m from the target: beyond the refine radius (0.25 m), so kept.
+  const Eigen::Vector3f other = kTarget + Eigen::Vector3f(0.0F, 0.6F, 0.0F);
+  tracker.add(other, 0.9F, 1);
+  tracker.add(kTarget, 0.9F, 2);
+  tracker.add(kTarget, 0.9F, 3);
+  CHECK(tracker.confirmed());
+  CHECK(tracker.missed());
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  check_near(other, tracker.candidate_m(), 1e-5F);
+}
+
+TEST(TargetTracker, ViewsExactlyTheBaselineApartConfirm) {
+  TargetTrackerParams p;
+  p.min_baseline_m = 0.5F;
+  tracker.configure(p);
+  tracker.add(kTarget, 0.9F, 1, 0.1F, {0.0F, 0.0F});
+  tracker.add(kTarget, 0.9F, 2, 0.1F, {0.5F, 0.0F});  // "at least 0.5 m apart"
+  CHECK(tracker.confirmed());
+}
+
 TEST(TargetTracker, ANonFiniteRangeErrorIsIgnored) {
   tracker.add(kTarget, 0.5F, 1, std::numeric_limits<float>::quiet_NaN());
   UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
