@@ -350,6 +350,13 @@ TEST(FrontierStepPlanner, ARobotWithinAnObstaclesClearanceStillStepsAwayFromIt) 
   CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) > 0.3F);
 }
 
+TEST(FrontierStepPlanner, AStepAlongThePathIsAtMostNavStepLongEvenInAWidePolygon) {
+  CHECK(plan(origin, disc(3.0F), nullptr) == StepOutcome::kMove);
+  const float d = boticelli::core::distance_m({0.0F, 0.0F}, planner.target());
+  CHECK(d > 0.5F);
+  CHECK(d <= params.nav_step_m + 1e-5F);
+}
+
 TEST(FrontierStepPlanner, AGridWithNothingReachableTurnsRoundThenEnds) {
   g_grid.configure({});  // nothing known
   CHECK(plan(origin, disc(0.6F), nullptr) == StepOutcome::kTurnRound);
@@ -498,4 +505,37 @@ TEST(ThesisPlannerTargetByPath, ThePathsStepFromBesideTheLooksCentreStaysInsideI
   const Point2 t = planner.target();
   CHECK(look.contains(to_robot(origin, t)));
   CHECK(boticelli::core::distance_m({here.x_m, here.y_m}, t) > params.value.step_m);
+}
+
+// The final approach checks the whole straight way on the grid: an obstacle whose clearance
+// reaches across the far part of the way to the stand-off (not the stand-off itself, nor the
+// way's near half) leaves the step to the look's polygon.
+TEST(ThesisPlannerTargetByPath, AnObstacleAcrossTheFarPartOfTheWayLeavesTheStepToThePolygon) {
+  const Point2 target{1.0F, 1.0F};
+  (void)g_grid.add({8, 8}, 20);  // the cell from (0.4, 0.4) to (0.45, 0.45)
+  CHECK(plan(&target) == StepOutcome::kMove);
+  const Point2 g = planner.nav_choice().goal;
+  const float way = boticelli::core::distance_m({0.0F, 0.0F}, g);
+  CHECK(way > 0.6F && way <= params.final_approach_m);  // a final approach but for the obstacle
+  float first_blocked = 2.0F;
+  for (int i = 1; i <= 100; ++i) {
+    const float s = static_cast<float>(i) / 100.0F;
+    if (!planner.nav().passable({s * g.x_m, s * g.y_m}))
+      first_blocked = std::fmin(first_blocked, s);
+  }
+  CHECK(first_blocked > 0.5F && first_blocked < 1.0F);
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) <= 0.6F + 1e-5F);
+}
+
+// The target itself is an obstacle on the grid: the final approach ends at its stand-off, the
+// way there being free, whatever lies beyond the stand-off.
+TEST(ThesisPlannerTargetByPath, TheFinalApproachToATargetThatIsAnObstacleEndsAtItsStandOff) {
+  const Point2 target{1.0F, 1.0F};
+  (void)g_grid.add({20, 20}, 20);  // the target's own cell
+  CHECK(plan(&target) == StepOutcome::kMove);
+  const Point2 g = planner.nav_choice().goal;
+  const Point2 t = planner.target();
+  CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) > 0.6F + 0.05F);
+  DOUBLES_EQUAL(g.x_m, t.x_m, 0.051);
+  DOUBLES_EQUAL(g.y_m, t.y_m, 0.051);
 }
