@@ -26,6 +26,7 @@ import os
 import random
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -286,11 +287,19 @@ class Scratch:
         with open(self.log, "a", encoding="utf-8") as log:
             log.write("$ " + " ".join(args) + "\n")
             log.flush()
-            try:
-                return subprocess.run(args, cwd=self.src, stdout=log, stderr=subprocess.STDOUT,
-                                      timeout=timeout).returncode
-            except subprocess.TimeoutExpired:
-                return None
+            # Its own process group, all of which a timeout ends: ctest's test processes (a
+            # mutant's endless loop) would otherwise outlive ctest and load the machine.
+            with subprocess.Popen(args, cwd=self.src, stdout=log, stderr=subprocess.STDOUT,
+                                  start_new_session=True) as child:
+                try:
+                    return child.wait(timeout=timeout)
+                except subprocess.TimeoutExpired:
+                    try:
+                        os.killpg(child.pid, signal.SIGKILL)
+                    except ProcessLookupError:
+                        pass
+                    child.wait()
+                    return None
 
     def configure(self):
         return self.run(["cmake", "--preset", "sim", "-DBOTICELLI_BUILD_BENCH=OFF"]) == 0
