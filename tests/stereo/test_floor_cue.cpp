@@ -935,6 +935,46 @@ TEST(FloorCue, ADriftingShadeIsNotOnePlainStretchButOneShadeIs) {
   }
 }
 
+// A plain floor's model from two agreeing regions lies between them in every channel, and an
+// update moves every channel by the learning rate; a textured model's histogram stays a
+// distribution (its masses sum to one) when two regions confirm it.
+TEST(FloorCue, ModelsAreBlendedInEveryChannelAndTexturesStayDistributions) {
+  FloorCueParams flat;
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  const auto plain = [](LowResFrame& frame, float y, int cb, int cr) {
+    fill_patches(frame, {y});
+    for (std::size_t i = 0; i < std::size_t{frame.width} * frame.height; ++i) {
+      frame.chroma_u[i] = static_cast<std::uint8_t>(128 + cb);
+      frame.chroma_v[i] = static_cast<std::uint8_t>(128 + cr);
+    }
+  };
+  plain(g_frame, 120.0F, 4, -4);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  plain(g_frame, 124.0F, 6, -2);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 1.8F, kLookTilt));
+  CHECK_FALSE(fresh.model().textured);
+  DOUBLES_EQUAL(122.0, fresh.model().median[0], 1e-4);
+  DOUBLES_EQUAL(5.0, fresh.model().median[1], 1e-4);
+  DOUBLES_EQUAL(-3.0, fresh.model().median[2], 1e-4);
+  plain(g_frame, 126.0F, 7, 0);
+  CHECK(FloorLearn::kUpdated == fresh.learn(g_frame, 3.4F, kLookTilt));
+  DOUBLES_EQUAL(124.0, fresh.model().median[0], 1e-4);  // half way: learn_rate 0.5
+  DOUBLES_EQUAL(6.0, fresh.model().median[1], 1e-4);
+  DOUBLES_EQUAL(-1.5, fresh.model().median[2], 1e-4);
+
+  fresh.reset();
+  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 1.8F, kLookTilt));
+  CHECK(fresh.model().textured);
+  double total = 0.0;
+  for (const float m : fresh.model().mass) total += static_cast<double>(m);
+  DOUBLES_EQUAL(1.0, total, 1e-3);
+}
+
 // Without textures (FloorCueParams::textured = false) a rug is never learned: the plain-floor
 // cue alone, which says nothing on it.
 TEST(FloorCue, WithoutTexturesARugIsNotLearned) {
