@@ -71,9 +71,9 @@ struct FloorCueParams {
   // floor when the pixels of its bin and the bins next to it hold at least texture_min_share of the
   // region. A plain object can wear one of the floor's colours, but not its texture: a walk on a
   // textured floor ends where one colour runs on for longer than the floor's patches do
-  // (texture_run_factor times the 95th percentile of the region's runs along its rows, in metres of
-  // floor, within [texture_run_min_m, texture_run_max_m]). false: a busy region is never learned
-  // (the plain-floor cue alone).
+  // (texture_run_factor times the 95th percentile, by length, of the region's runs along its rows,
+  // in metres of floor, within [texture_run_min_m, texture_run_max_m]). false: a busy region is
+  // never learned (the plain-floor cue alone).
   bool textured = true;
   // A plain stretch on a textured floor always ends the walk's free floor (unknown is not
   // free); with texture_obstacles it is also an obstacle base (evidence_clear). Off by
