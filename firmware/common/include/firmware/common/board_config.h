@@ -87,10 +87,10 @@ struct BoardConfig {
   // far better than odometry over long runs, but with perfect odometry its small corrections
   // are pure error (docs/benchmarks.md, localization).
   bool register_looks = false;
-  // Stereo readings of the floor itself (a rug's or wood's texture) are free floor, not
-  // occupancy, when their line of sight meets the floor within this range error (a fraction
-  // of the range; evidence::floor_readings); deeper ones are refused. 0: off, the thesis's
-  // readings ([mission] floor_range_error).
+  // On a floor the floor cue has learned to be textured, stereo readings of the floor itself
+  // (a rug's or wood's texture) are free floor, not occupancy, when their line of sight meets
+  // the floor within this range error (a fraction of the range; evidence::floor_readings);
+  // deeper ones are refused. 0: off, the thesis's readings ([mission] floor_range_error).
   float floor_range_error = 0.05F;
 };
 
