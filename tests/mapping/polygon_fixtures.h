@@ -66,23 +66,35 @@ inline void random_star_polygon(Random& rng, mapping::StarPolygon& out, std::siz
   }
 }
 
+// A vertex of an n-ray fan at length rho [m], and the distance from a point to a segment, in
+// double precision and sharing no code with the library (the shrink tests' oracles).
+struct RefVertex {
+  double x;
+  double y;
+};
+
+inline RefVertex ref_vertex(std::size_t n, std::size_t k, double rho) {
+  const double a =
+      2.0 * 3.14159265358979323846 * static_cast<double>(k % n) / static_cast<double>(n);
+  return {rho * std::cos(a), rho * std::sin(a)};
+}
+
+inline double ref_point_segment_m(RefVertex q, RefVertex a, RefVertex b) {
+  const double ex = b.x - a.x;
+  const double ey = b.y - a.y;
+  const double len2 = ex * ex + ey * ey;
+  double t = len2 > 0.0 ? ((q.x - a.x) * ex + (q.y - a.y) * ey) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(q.x - (a.x + t * ex), q.y - (a.y + t * ey));
+}
+
 // The shrink tests' oracle, independent of the code under test: the smallest distance [m]
 // from the segment [0, p] (robot frame) to the boundary of `region`, by brute force over
 // every edge, with the vertices computed here from ρ_k and the angle 2πk/n (the shrink and
 // mapping::sweep_clearance_m share their vertex and segment code; this shares none).
 inline double reference_sweep_clearance_m(const mapping::StarPolygon& region, core::Point2 p) {
-  struct V {
-    double x;
-    double y;
-  };
-  const auto point_segment = [](V q, V a, V b) {
-    const double ex = b.x - a.x;
-    const double ey = b.y - a.y;
-    const double len2 = ex * ex + ey * ey;
-    double t = len2 > 0.0 ? ((q.x - a.x) * ex + (q.y - a.y) * ey) / len2 : 0.0;
-    t = std::clamp(t, 0.0, 1.0);
-    return std::hypot(q.x - (a.x + t * ex), q.y - (a.y + t * ey));
-  };
+  using V = RefVertex;
+  const auto point_segment = ref_point_segment_m;
   // Sign of the turn a -> b -> c (cross product of b - a and c - a).
   const auto orient = [](V a, V b, V c) {
     const double z = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
@@ -92,10 +104,7 @@ inline double reference_sweep_clearance_m(const mapping::StarPolygon& region, co
   const V o{0.0, 0.0};
   const V q{static_cast<double>(p.x_m), static_cast<double>(p.y_m)};
   const auto vertex = [&](std::size_t k) {
-    const double a =
-        2.0 * 3.14159265358979323846 * static_cast<double>(k % n) / static_cast<double>(n);
-    const double r = static_cast<double>(region.rho_m(k % n));
-    return V{r * std::cos(a), r * std::sin(a)};
+    return ref_vertex(n, k, static_cast<double>(region.rho_m(k % n)));
   };
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < n; ++j) {

@@ -29,27 +29,9 @@ float clearance_m(const StarPolygon& free, Point2 p) {
   return static_cast<float>(boticelli::test::reference_sweep_clearance_m(free, p));
 }
 
-// A vertex of an n-ray fan at length rho [m], and the distance from a point to a segment, in
-// double precision and sharing no code with the library.
-struct Vertex {
-  double x;
-  double y;
-};
-
-Vertex vertex_of(std::size_t n, std::size_t k, double rho) {
-  const double a =
-      2.0 * 3.14159265358979323846 * static_cast<double>(k % n) / static_cast<double>(n);
-  return {rho * std::cos(a), rho * std::sin(a)};
-}
-
-double point_segment_distance(Vertex q, Vertex a, Vertex b) {
-  const double ex = b.x - a.x;
-  const double ey = b.y - a.y;
-  const double len2 = ex * ex + ey * ey;
-  double t = len2 > 0.0 ? ((q.x - a.x) * ex + (q.y - a.y) * ey) / len2 : 0.0;
-  t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(q.x - (a.x + t * ex), q.y - (a.y + t * ey));
-}
+using Vertex = boticelli::test::RefVertex;
+using boticelli::test::ref_point_segment_m;
+using boticelli::test::ref_vertex;
 
 }  // namespace
 
@@ -277,12 +259,12 @@ TEST(Shrink, AroundALoneCornerThePulledInChordsTouchTheCornersDiscAndDoNotCutIt)
           free.set_rho_m(m, corner);
           StarPolygon nav;
           CHECK_TRUE(boticelli::mapping::shrink_by_radius(free, radius, nav));
-          const Vertex c = vertex_of(n, m, static_cast<double>(corner));
+          const Vertex c = ref_vertex(n, m, static_cast<double>(corner));
           double nearest = 1e9;
           for (std::size_t k = 0; k < n; ++k) {
-            const Vertex a = vertex_of(n, k, static_cast<double>(nav.rho_m(k)));
-            const Vertex b = vertex_of(n, k + 1, static_cast<double>(nav.rho_m((k + 1) % n)));
-            nearest = std::fmin(nearest, point_segment_distance(c, a, b));
+            const Vertex a = ref_vertex(n, k, static_cast<double>(nav.rho_m(k)));
+            const Vertex b = ref_vertex(n, k + 1, static_cast<double>(nav.rho_m((k + 1) % n)));
+            nearest = std::fmin(nearest, ref_point_segment_m(c, a, b));
           }
           CHECK_TRUE(nearest >= static_cast<double>(radius) - 1e-8);
           CHECK_TRUE(nearest <= static_cast<double>(radius) + 1e-7);
