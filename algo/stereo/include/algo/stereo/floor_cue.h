@@ -77,10 +77,9 @@ struct FloorCueParams {
   bool textured = true;
   // A plain stretch on a textured floor always ends the walk's free floor (unknown is not
   // free); with texture_obstacles it is also an obstacle base (evidence_clear). Off by
-  // default: a rug's largest patches and a wood floor's long streaks along the walk are
-  // plain stretches too, and their phantom bases walled the robot in on a wood floor; a
-  // plain thing on the floor shows its edges to the stereo, and the floor beyond it is not
-  // seen free.
+  // default: a rug's largest patches are plain stretches too, and would be phantom bases
+  // where nothing stands; a plain thing on the floor shows its edges to the stereo, and the
+  // floor beyond it is not seen free.
   bool texture_obstacles = false;
   float texture_min_edges = 0.02F;
   float texture_min_share = 0.02F;
