@@ -1,4 +1,6 @@
 // Floor-appearance cue on frames of the sim renderer: obstacle bases where the geometry puts them.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -7,6 +9,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -989,4 +992,245 @@ TEST(FloorCue, WithoutTexturesARugIsNotLearned) {
   static FloorCue textured{g_rig, trusting()};
   textured.reset();
   CHECK(FloorLearn::kLearned == textured.learn(g_frame, 0.0F, kLookTilt));
+}
+
+// A synthetic frame of the rig's low resolution, each pixel's (Y, Cb − 128, Cr − 128) given
+// by colour(u, v).
+template <typename Colour>
+void paint(LowResFrame& frame, Colour colour) {
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  frame.width = camera.width_px;
+  frame.height = camera.height_px;
+  for (std::uint32_t v = 0; v < frame.height; ++v) {
+    for (std::uint32_t u = 0; u < frame.width; ++u) {
+      const std::array<float, 3> c = colour(u, v);
+      frame.luma[frame.index(u, v)] = c[0];
+      frame.chroma_u[frame.index(u, v)] = static_cast<std::uint8_t>(128.0F + c[1]);
+      frame.chroma_v[frame.index(u, v)] = static_cast<std::uint8_t>(128.0F + c[2]);
+    }
+  }
+}
+
+// Where pixel (u, v) of the low-resolution image sees the floor, in the PTU frame; false at or
+// above the horizon.
+bool floor_seen_at(const boticelli::stereo::CameraPose& pose, float u, float v,
+                   Eigen::Vector3f& point) {
+  const Eigen::Vector3f ray =
+      RigModel::ray_ptu(pose, g_rig.low_res_camera(), Eigen::Vector2f(u, v));
+  if (!(ray.z() < 0.0F)) return false;
+  const float t = (-g_rig.params().ptu_height_m - pose.centre_m.z()) / ray.z();
+  point = pose.centre_m + t * ray;
+  return true;
+}
+
+// A textured model's share of a bin is the mass of that bin and of every bin next to it in
+// all three channels (3 × 3 × 3 bins, fewer at the histogram's edges), checked bin by bin
+// against a histogram whose colours reach both ends of every channel.
+TEST(FloorCue, ATexturedFloorsShareOfABinIsTheMassOfItAndOfEveryBinNextToIt) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  constexpr std::array<std::array<float, 3>, 5> kColours{{{40.0F, -30.0F, 31.0F},
+                                                          {100.0F, -20.0F, 10.0F},
+                                                          {160.0F, 0.0F, -20.0F},
+                                                          {220.0F, 10.0F, -30.0F},
+                                                          {60.0F, 31.0F, 0.0F}}};
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t v) { return kColours[(u / 4 + v / 4) % 5]; });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  const boticelli::stereo::FloorModel& model = fresh.model();
+  CHECK(model.textured);
+  constexpr long kL = boticelli::stereo::kFloorLumaBins;
+  constexpr long kC = boticelli::stereo::kFloorChromaBins;
+  const auto at = [](long y, long u, long v) {
+    return static_cast<std::size_t>((y * kC + u) * kC + v);
+  };
+  std::size_t with_mass = 0;
+  std::size_t shared = 0;
+  for (long y = 0; y < kL; ++y) {
+    for (long u = 0; u < kC; ++u) {
+      for (long v = 0; v < kC; ++v) {
+        with_mass += model.mass[at(y, u, v)] > 0.0F ? 1U : 0U;
+        double sum = 0.0;
+        for (long dy = -1; dy <= 1; ++dy) {
+          for (long du = -1; du <= 1; ++du) {
+            for (long dv = -1; dv <= 1; ++dv) {
+              if (y + dy < 0 || y + dy >= kL || u + du < 0 || u + du >= kC || v + dv < 0 ||
+                  v + dv >= kC) {
+                continue;
+              }
+              sum += static_cast<double>(model.mass[at(y + dy, u + du, v + dv)]);
+            }
+          }
+        }
+        shared += sum > 0.0 ? 1U : 0U;
+        DOUBLES_EQUAL(sum, static_cast<double>(model.share[at(y, u, v)]), 1e-6);
+      }
+    }
+  }
+  CHECK_EQUAL(5U, with_mass);  // one bin per colour
+  CHECK(shared > 5U * 8U);     // corner bins reach 8 bins, others up to 27
+  // Each colour's bin: Y by 16 levels; Cb and Cr offsets by 8 from −32, clamped to 0..7.
+  for (const auto& colour : kColours) {
+    const auto chroma = [](float c) {
+      return std::clamp(static_cast<long>((c + 32.0F) / 8.0F), 0L, 7L);
+    };
+    const float mass =
+        model.mass[at(static_cast<long>(colour[0]) / 16, chroma(colour[1]), chroma(colour[2]))];
+    CHECK(mass > 0.1F);  // a fifth of the region each, up to its edges
+  }
+}
+
+// Vignetting is undone about the image's centre: a plain floor rendered with the configured
+// fall-off (1 − vignetting · r², r = 1 at the corners) looks the same in every corner as in
+// the middle.
+TEST(FloorCue, VignettingIsUndoneAboutTheImageCentre) {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.3F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const float cx = 0.5F * static_cast<float>(camera.width_px - 1);
+  const float cy = 0.5F * static_cast<float>(camera.height_px - 1);
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t v) {
+    const float dx = static_cast<float>(u) - cx;
+    const float dy = static_cast<float>(v) - cy;
+    const float fall = 1.0F - p.vignetting * (dx * dx + dy * dy) / (cx * cx + cy * cy);
+    return std::array<float, 3>{16.0F + (203.0F - 16.0F) * fall, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(fresh.model().textured);
+  DOUBLES_EQUAL(203.0, fresh.model().median[0], 1.0);
+  float middle = 0.0F;
+  CHECK(fresh.looks_like_floor(g_frame, camera.width_px / 2, camera.height_px / 2, middle));
+  const std::uint32_t right = camera.width_px - 1;
+  const std::uint32_t bottom = camera.height_px - 1;
+  for (const auto& [u, v] :
+       {std::pair{0U, 0U}, std::pair{right, 0U}, std::pair{0U, bottom}, std::pair{right, bottom}}) {
+    float contrast = 0.0F;
+    CHECK(fresh.looks_like_floor(g_frame, u, v, contrast));
+    DOUBLES_EQUAL(middle, contrast, 0.02);
+  }
+}
+
+// An update by a region exactly like the model leaves it as it was: the histogram and the
+// longest run move by the learning rate towards the region's, which are the same.
+TEST(FloorCue, UpdatingATexturedFloorWithARegionLikeItLeavesItAsItWas) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  const boticelli::stereo::FloorModel before = fresh.model();
+  CHECK(before.max_run_m > 0.0F);
+  CHECK(FloorLearn::kUpdated == fresh.learn(g_frame, 0.0F, kLookTilt));
+  DOUBLES_EQUAL(before.max_run_m, fresh.model().max_run_m, 1e-6);
+  for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
+    DOUBLES_EQUAL(before.mass[b], fresh.model().mass[b], 1e-6);
+    DOUBLES_EQUAL(before.share[b], fresh.model().share[b], 1e-6);
+  }
+}
+
+// The longest run of one colour a textured floor shows is texture_run_factor times the 95th
+// percentile of the region's runs weighted by their length: a region of 2 px stripes with a
+// band of one tone over a quarter of its width has its percentile within the band's runs.
+TEST(FloorCue, ATexturesLongestRunIsThe95thPercentileOfItsRunsByLength) {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.0F;
+  p.texture_run_min_m = 0.0F;  // no clamp: the percentile itself
+  p.texture_run_max_m = 10.0F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const std::uint32_t band = camera.width_px * 3 / 4;  // the band: columns band..width − 1
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t) {
+    const float y = u >= band ? 180.0F : ((u / 2) % 2 == 0 ? 60.0F : 120.0F);
+    return std::array<float, 3>{y, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  // The band's length on the floor along each row of the region where all of it lies there.
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  float longest = 0.0F;
+  for (std::uint32_t v = 0; v < camera.height_px; ++v) {
+    Eigen::Vector3f a;
+    Eigen::Vector3f b;
+    if (!floor_seen_at(pose, static_cast<float>(band), static_cast<float>(v), a) ||
+        !floor_seen_at(pose, static_cast<float>(camera.width_px - 1), static_cast<float>(v), b)) {
+      continue;
+    }
+    const float rho_a = std::hypot(a.x(), a.y());
+    const float rho_b = std::hypot(b.x(), b.y());
+    if (std::min(rho_a, rho_b) < p.reference_min_m || std::max(rho_a, rho_b) > p.reference_max_m) {
+      continue;
+    }
+    longest = std::max(longest, (b - a).norm());
+  }
+  CHECK(longest > 0.08F);  // the stripes' runs are a pixel's step, under 0.02 m
+  const float max_run = fresh.model().max_run_m;
+  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
+  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+}
+
+// A walk samples the two pixels either side of it, also at the image's right edge: a thing
+// two pixels wide along the right edge ends the last column's walk.
+TEST(FloorCue, AThingAlongTheImagesRightEdgeEndsTheLastColumnsWalk) {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.0F;
+  p.column_step = 1;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const std::uint32_t width = g_rig.low_res_camera().width_px;
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t) {
+    return std::array<float, 3>{u + 2 >= width ? 220.0F : 120.0F, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(width, fresh.column_count());
+  const FloorColumn& last = fresh.column(width - 1);
+  CHECK_EQUAL(width - 1, last.u_px);
+  CHECK(last.end == FloorColumn::End::kBoundary || last.end == FloorColumn::End::kBlockedAtBottom);
+  CHECK(fresh.column(width / 2).end == FloorColumn::End::kMaxRange);
+}
+
+// A boundary's base lies half a step (in elevation along the walk) beyond the last floor
+// sample, which is the free reading: between it and the first sample that is not floor.
+TEST(FloorCue, ABoundarysBaseIsHalfAStepBeyondTheLastFloorSample) {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  // A wall across the image from its 45th row up; floor below.
+  paint(g_frame, [&](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  const Eigen::Vector3f c = pose.centre_m;
+  const float drop = c.z() + g_rig.params().ptu_height_m;  // the camera above the floor [m]
+  // The elevation [rad] of the line of sight along the walk's azimuth to the floor at ρ.
+  const auto elevation_of = [&](float azimuth, float rho) {
+    const float along = c.x() * std::cos(azimuth) + c.y() * std::sin(azimuth);
+    const float s = -along + std::sqrt(along * along - c.x() * c.x() - c.y() * c.y() + rho * rho);
+    return -std::atan(drop / s);
+  };
+  const float step = 1.0F / camera.focal_px;
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    const FloorColumn& col = fresh.column(i);
+    if (col.end != FloorColumn::End::kBoundary || col.free_rho_m <= 0.0F) continue;
+    const float apart = elevation_of(col.azimuth_rad, col.base_rho_m) -
+                        elevation_of(col.azimuth_rad, col.free_rho_m);
+    DOUBLES_EQUAL(0.5F * step, apart, 0.05F * step);
+    ++checked;
+  }
+  CHECK(checked >= 60U);
 }

@@ -46,17 +46,11 @@ void robust_stats(const std::array<std::uint32_t, 256>& histogram, std::size_t c
   sigma = 1.4826F * static_cast<float>(d);
 }
 
-// Median of the first n (≤ kMaxRun) values (insertion sort in place).
+// Median of the first n (1 ≤ n ≤ kMaxRun) values (reordered in place).
 float median_of(std::array<float, kMaxRun>& values, std::uint32_t n) {
-  for (std::uint32_t i = 1; i < n && i < kMaxRun; ++i) {
-    const float x = values[i];
-    std::uint32_t j = i;
-    for (; j > 0 && values[j - 1] > x; --j) {
-      values[j] = values[j - 1];
-    }
-    values[j] = x;
-  }
-  return values[std::min(n, kMaxRun) / 2];
+  const auto middle = values.begin() + std::min(n, kMaxRun) / 2;
+  std::nth_element(values.begin(), middle, values.begin() + std::min(n, kMaxRun));
+  return *middle;
 }
 
 std::uint8_t to_byte(float x) {
