@@ -556,13 +556,14 @@ TEST(FloorCue, TwoAgreeingRegionsTooCloseInPanDoNotConfirmTheFloor) {
   load("");
   static FloorCue fresh{g_rig};
   fresh.reset();
-  render(0.0F, kLookTilt, 1, g_frame);
-  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
-  render(0.5F, kLookTilt, 2, g_frame);
-  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.5F, kLookTilt));
+  // Pans away from 0, so that each waiting region's own pan is what is compared.
+  render(2.0F, kLookTilt, 1, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 2.0F, kLookTilt));
+  render(2.5F, kLookTilt, 2, g_frame);
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 2.5F, kLookTilt));
   CHECK_FALSE(fresh.model().valid);
-  render(1.2F, kLookTilt, 3, g_frame);
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 1.2F, kLookTilt));
+  render(3.2F, kLookTilt, 3, g_frame);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 3.2F, kLookTilt));
   CHECK(fresh.model().valid);
 }
 
@@ -1233,4 +1234,69 @@ TEST(FloorCue, ABoundarysBaseIsHalfAStepBeyondTheLastFloorSample) {
     ++checked;
   }
   CHECK(checked >= 60U);
+}
+
+// A textured floor's luma change (its model's luma tolerance) is half the median step between
+// row neighbours that differ by more than the luma minimum: stripes of 20 and 230 step by 210.
+TEST(FloorCue, ATexturesLumaChangeIsHalfTheMedianStepBetweenNeighbours) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  paint(g_frame, [](std::uint32_t u, std::uint32_t) {
+    return std::array<float, 3>{(u / 2) % 2 == 0 ? 20.0F : 230.0F, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  DOUBLES_EQUAL(105.0, fresh.model().tolerance[0], 1e-4);
+  DOUBLES_EQUAL(flat.min_tolerance_chroma, fresh.model().tolerance[1], 1e-6);
+  DOUBLES_EQUAL(flat.min_tolerance_chroma, fresh.model().tolerance[2], 1e-6);
+}
+
+// Between weak and clear, a boundary's evidence follows its contrast linearly: a wall 1.75
+// tolerances from the floor (half way from 1 to clear_contrast = 2.5) has evidence half way
+// from evidence_weak to evidence_clear.
+TEST(FloorCue, ABoundaryHalfWayToClearContrastHasEvidenceHalfWayToClear) {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  paint(g_frame, [&](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v < 45 ? 120.0F + 1.75F * p.min_tolerance_luma : 120.0F, 0.0F,
+                                0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  DOUBLES_EQUAL(p.min_tolerance_luma, fresh.model().tolerance[0], 1e-6);
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK(out.result.boundaries >= 60U);
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    if (fresh.column(i).end != FloorColumn::End::kBoundary) continue;
+    DOUBLES_EQUAL(0.5F * (p.evidence_weak + p.evidence_clear), fresh.column(i).evidence, 1e-4);
+  }
+  for (const Reading& r : out.obstacles) {
+    DOUBLES_EQUAL(0.5F * (p.evidence_weak + p.evidence_clear), r.m, 1e-4);
+  }
+}
+
+// Tiles of two colours, one of them on at least half the floor: the median absolute deviation
+// is 0 (half the pixels have the median), so the region's median and spread say one colour,
+// though much of it is the other. It is learned as a texture, and all of it is floor.
+TEST(FloorCue, AFloorOfTwoColoursOneOnHalfOfItIsLearnedAsATexture) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  for (const auto& tones : {std::initializer_list<float>{60.0F, 200.0F},
+                            std::initializer_list<float>{60.0F, 60.0F, 200.0F}}) {
+    fresh.reset();
+    fill_patches(g_frame, tones);
+    CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+    CHECK(fresh.model().textured);
+    out.obstacles.clear();
+    out.free.clear();
+    out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+    CHECK_EQUAL(0U, out.result.boundaries);
+    CHECK_EQUAL(out.result.columns, out.free.size());
+  }
 }

@@ -244,21 +244,33 @@ FloorLearn FloorCue::learn(const image::LowResFrame& frame, float pan_rad, float
   std::size_t own = 0;
   std::size_t known = 0;
   std::array<std::size_t, kPendingSlots> pending{};
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
-                                      static_cast<float>(reference_[i][1]) - 128.0F,
-                                      static_cast<float>(reference_[i][2]) - 128.0F};
-    own += contrast_to(candidate, values) <= 1.0F ? 1U : 0U;
-    known += model_.valid && contrast_to(model_, values) <= 1.0F ? 1U : 0U;
-    for (std::size_t j = 0; j < kPendingSlots; ++j) {
-      pending[j] += pending_[j].valid && pending_[j].textured == candidate.textured &&
-                            contrast_to(pending_[j], values) <= 1.0F
-                        ? 1U
-                        : 0U;
+  const auto agree = [&]() {
+    own = known = 0;
+    pending.fill(0);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::array<float, 3> values{static_cast<float>(reference_[i][0]),
+                                        static_cast<float>(reference_[i][1]) - 128.0F,
+                                        static_cast<float>(reference_[i][2]) - 128.0F};
+      own += contrast_to(candidate, values) <= 1.0F ? 1U : 0U;
+      known += model_.valid && contrast_to(model_, values) <= 1.0F ? 1U : 0U;
+      for (std::size_t j = 0; j < kPendingSlots; ++j) {
+        pending[j] += pending_[j].valid && pending_[j].textured == candidate.textured &&
+                              contrast_to(pending_[j], values) <= 1.0F
+                          ? 1U
+                          : 0U;
+      }
     }
-  }
+  };
+  agree();
   const auto needed =
       static_cast<std::size_t>(std::ceil(params_.consistency_min * static_cast<float>(count)));
+  if (own < needed && uniform && params_.textured && !(model_.valid && !model_.textured) &&
+      textured_candidate(count, candidate)) {
+    // A median and a spread of one colour, yet much of the region lies outside its
+    // tolerances: one colour holds at least half of it and the rest differ (tiles of two
+    // colours; the spread is 0 when half the pixels have the median). A texture, if it is one.
+    agree();
+  }
   if (model_.valid && known < needed) {
     return FloorLearn::kInconsistent;
   }
