@@ -46,31 +46,62 @@ inline firmware::BoardConfig make_config() {
 
 // How far the simulated robot departs from the thesis's perfect one ([sim] realism).
 enum class SimRealism : std::uint8_t {
-  kIdeal,      // perfect odometry: the thesis's reproductions
-  kRealistic,  // the errors of an uncalibrated small base
+  kIdeal,      // perfect odometry and optics: the thesis's reproductions
+  kRealistic,  // an uncalibrated small base, a calibrated camera's residual errors
+};
+
+// The camera and rig as they truly are, against the nominal ones in the firmware's
+// configuration (the firmware never sees these): what a careful calibration still leaves.
+struct SimOptics {
+  float lens_k1_error = 0.0F;       // true k1 − configured k1
+  float lens_k2_error = 0.0F;       // true k2 − configured k2
+  float lens_p1_error = 0.0F;       // true p1 − configured p1
+  float lens_p2_error = 0.0F;       // true p2 − configured p2
+  float focal_scale = 1.0F;         // true focal length / configured
+  float principal_error_px = 0.0F;  // true principal point − configured: +x and −y [px, full res]
+  float lever_error_m = 0.0F;       // true PTU-camera lever L − configured [m]
 };
 // The setting the board starts with (tests, benches and runs without a [sim] table).
 inline constexpr SimRealism kDefaultRealism = SimRealism::kIdeal;
-
-// The base's odometry errors under a realism setting. Realistic: an uncalibrated hobby base
-// (Borenstein & Feng 1996): wheel diameters 0.5 % apart, the effective track 1 % wider than
-// the odometry assumes, each in-place turn 1 % (sd) off, and 1 % (sd) white noise per wheel
-// per 1 ms physics step (it averages out: millimetres over a mission).
-inline void apply_realism(SimRealism realism, hal::sim::BaseParams& b) {
-  const bool real = realism == SimRealism::kRealistic;
-  b.wheel_scale_left = real ? 1.0025F : 1.0F;
-  b.wheel_scale_right = real ? 0.9975F : 1.0F;
-  b.track_scale = real ? 1.01F : 1.0F;
-  b.turn_scrub = real ? 0.01F : 0.0F;
-  b.odometry_noise = real ? 0.01F : 0.0F;
-}
 
 // Everything only the simulation needs.
 struct SimSettings {
   float camera_fps = 30.0F;           // frame rate in simulated time
   hal::sim::RenderSettings render{};  // gain, noise 2 grey levels, vignetting 0.25
   hal::sim::SimParams physics{};      // PTU-D46 limits/speeds, base ramps, 1 ms steps
+  SimOptics optics{};                 // the true camera and rig against the configured ones
 };
+
+// Every error of a realism setting. Realistic:
+// - the base: an uncalibrated hobby base (Borenstein & Feng 1996): wheel diameters 0.5 %
+//   apart, the effective track 1 % wider than the odometry assumes, each in-place turn 1 %
+//   (sd) off, and 1 % (sd) white noise per wheel per 1 ms physics step (it averages out:
+//   millimetres over a mission);
+// - the camera as OpenCV's calibration leaves it (not an uncalibrated lens): focal length 1 %
+//   long, principal point 2 px off on each axis, k1 0.01, k2 0.02, p1 and p2 0.0005 off;
+// - the rig: the lever 2 mm long, 0.05° of backlash in each PTU axis (the PTU-D46's step);
+// - the sensor: chroma noise of 1.5 levels and the exposure changing by 2 % (sd) from frame
+//   to frame.
+inline void apply_realism(SimRealism realism, SimSettings& s) {
+  const bool real = realism == SimRealism::kRealistic;
+  hal::sim::BaseParams& b = s.physics.base;
+  b.wheel_scale_left = real ? 1.0025F : 1.0F;
+  b.wheel_scale_right = real ? 0.9975F : 1.0F;
+  b.track_scale = real ? 1.01F : 1.0F;
+  b.turn_scrub = real ? 0.01F : 0.0F;
+  b.odometry_noise = real ? 0.01F : 0.0F;
+  SimOptics& o = s.optics;
+  o.lens_k1_error = real ? 0.01F : 0.0F;
+  o.lens_k2_error = real ? -0.02F : 0.0F;
+  o.lens_p1_error = real ? 0.0005F : 0.0F;
+  o.lens_p2_error = real ? -0.0005F : 0.0F;
+  o.focal_scale = real ? 1.01F : 1.0F;
+  o.principal_error_px = real ? 2.0F : 0.0F;
+  o.lever_error_m = real ? 0.002F : 0.0F;
+  s.physics.ptu.backlash_rad = real ? 8.7266e-4F : 0.0F;  // 0.05°
+  s.render.chroma_noise_sigma = real ? 1.5F : 0.0F;
+  s.render.exposure_jitter = real ? 0.02F : 0.0F;
+}
 
 inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t seed) {
   SimSettings s;
@@ -83,13 +114,27 @@ inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t s
   s.physics.base.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
   // The ODrives' watchdog, as configured on the robot: 0.2 s without a setpoint stops them.
   s.physics.base.command_timeout_us = 200000;
-  apply_realism(kDefaultRealism, s.physics.base);
+  apply_realism(kDefaultRealism, s);
   return s;
 }
 
-// The rig the renderer uses: built from the same config the firmware's stereo code reads.
+// The rig the firmware's configuration describes (its stereo code reads the same).
 inline stereo::RigParams make_rig_params(const firmware::BoardConfig& c) {
   return firmware::mission::make_rig_params(c);
+}
+
+// The rig the simulator draws and moves: the configured one with the optics' errors.
+inline stereo::RigParams true_rig_params(const firmware::BoardConfig& c, const SimOptics& o) {
+  stereo::RigParams r = make_rig_params(c);
+  r.camera.k1 += o.lens_k1_error;
+  r.camera.k2 += o.lens_k2_error;
+  r.camera.p1 += o.lens_p1_error;
+  r.camera.p2 += o.lens_p2_error;
+  r.camera.focal_px *= o.focal_scale;
+  r.camera.principal_x_px += o.principal_error_px;
+  r.camera.principal_y_px -= o.principal_error_px;
+  r.lever_m += o.lever_error_m;
+  return r;
 }
 
 }  // namespace boticelli::boards::sim

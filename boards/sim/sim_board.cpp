@@ -88,7 +88,9 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
     std::snprintf(error, error_size, "configuration: %s", why);
     return false;
   }
-  rig_.emplace(make_rig_params(config_));
+  // The simulator's camera and rig are the configured ones with the optics' errors; the
+  // firmware's stereo works with the configured ones.
+  rig_.emplace(true_rig_params(config_, settings_.optics));
   if (!sim_.init(world_, *rig_, settings_.physics, why, sizeof why)) {
     std::snprintf(error, error_size, "%s: %s", path, why);
     return false;

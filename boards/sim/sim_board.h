@@ -78,6 +78,7 @@ class SimBoard final : public firmware::Board,
   const hal::sim::World& world() const { return world_; }
   hal::sim::CameraSim& camera() { return camera_; }  // depth of the last frame, its pose
   const hal::sim::Renderer& renderer() const { return renderer_; }
+  // The rig the simulator draws and moves: the configured one with [sim]'s optics errors.
   const stereo::RigModel& rig() const { return *rig_; }
   // Settings used by the next init() (tests may change noise, rates, physics).
   SimSettings& settings() { return settings_; }

@@ -19,6 +19,16 @@ struct SimConfigKeys {
   float track_scale = std::numeric_limits<float>::quiet_NaN();
   float turn_scrub = std::numeric_limits<float>::quiet_NaN();
   float odometry_noise = std::numeric_limits<float>::quiet_NaN();
+  float lens_k1_error = std::numeric_limits<float>::quiet_NaN();
+  float lens_k2_error = std::numeric_limits<float>::quiet_NaN();
+  float lens_p1_error = std::numeric_limits<float>::quiet_NaN();
+  float lens_p2_error = std::numeric_limits<float>::quiet_NaN();
+  float focal_scale = std::numeric_limits<float>::quiet_NaN();
+  float principal_error_px = std::numeric_limits<float>::quiet_NaN();
+  float lever_error_m = std::numeric_limits<float>::quiet_NaN();
+  float ptu_backlash_rad = std::numeric_limits<float>::quiet_NaN();
+  float chroma_noise = std::numeric_limits<float>::quiet_NaN();
+  float exposure_jitter = std::numeric_limits<float>::quiet_NaN();
 };
 
 // Binds the [sim] keys to `keys` (all unset).

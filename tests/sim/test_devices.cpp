@@ -627,3 +627,46 @@ TEST(SimDevices, AWiderTrueTrackMakesTurnsShortAndUnequalWheelsBendAStraightDriv
   DOUBLES_EQUAL(-0.0125 * driven_m, boticelli::core::wrap_pi(g_sim.true_pose().yaw_rad - start_yaw),
                 2e-4);
 }
+
+// Gear play: the camera trails the PTU's position by half the backlash, on the side each axis
+// last moved from; the position the PTU reports stays the commanded one.
+TEST(SimDevices, WithBacklashTheCameraTrailsEachAxisByHalfOfItOnTheSideItCameFrom) {
+  SimParams params;
+  params.ptu.backlash_rad = 0.002F;
+  start("rectangular_room", params);
+  PanTiltSim ptu(g_sim);
+  ClockSim clock(g_sim);
+  CHECK(ptu.init());
+  ptu.update();
+  const auto camera_at = [&](float pan, float tilt) {
+    return g_sim.camera_pose(g_sim.true_pose(), pan, tilt);
+  };
+  const auto same = [](const RigidTransform& a, const RigidTransform& b) {
+    return (a.rotation - b.rotation).norm() < 1e-6F &&
+           (a.translation_m - b.translation_m).norm() < 1e-6F;
+  };
+  // Before any move: no play taken up either way.
+  CHECK(same(camera_at(0.0F, 0.0F), g_sim.camera_pose()));
+  const auto settle = [&](float pan, float tilt) {
+    CHECK(ptu.move_to(pan, tilt));
+    CHECK(run_until(
+              clock, [&] { return !ptu.state().moving; }, 5.0, 1000) > 0.0);
+  };
+  settle(0.5F, -0.2F);  // pan up, tilt down
+  const float pan = g_sim.pan().position_rad;
+  const float tilt = g_sim.tilt().position_rad;
+  CHECK(same(camera_at(pan - 0.001F, tilt + 0.001F), g_sim.camera_pose()));
+  CHECK_FALSE(same(camera_at(pan, tilt), g_sim.camera_pose()));
+  settle(0.2F, 0.1F);  // pan down, tilt up
+  CHECK(same(camera_at(g_sim.pan().position_rad + 0.001F, g_sim.tilt().position_rad - 0.001F),
+             g_sim.camera_pose()));
+  // Without backlash the camera is where the axes are.
+  start("rectangular_room");
+  PanTiltSim plain(g_sim);
+  CHECK(plain.init());
+  plain.update();
+  CHECK(plain.move_to(0.5F, -0.2F));
+  CHECK(run_until(
+            clock, [&] { return !plain.state().moving; }, 5.0, 1000) > 0.0);
+  CHECK(same(camera_at(g_sim.pan().position_rad, g_sim.tilt().position_rad), g_sim.camera_pose()));
+}

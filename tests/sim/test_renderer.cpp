@@ -342,3 +342,60 @@ TEST(Renderer, RenderingAFrameDoesNotAllocate) {
   const RigidTransform pose = looking_along_x({0, -1, 0.8F});
   CHECK_NO_ALLOCATION(renderer.render(pose, 1, img.data(), 320, depth.data()));
 }
+
+// Chroma noise: Cb and Cr of a plain wall scatter by about chroma_noise_sigma, seeded like the
+// luma's. Exposure jitter: each frame's brightness is scaled by one draw of 1 + jitter · g, so
+// frames of the same view differ as a whole, and the same frame index repeats itself.
+TEST(Renderer, ChromaNoiseScattersCbAndCrAndExposureJitterScalesWholeFrames) {
+  load_text(small_world(box_model("wall", "3.5 0 1 0 0 0", "1 20 4")));
+  RenderSettings settings;
+  settings.noise_sigma_grey = 0.0F;
+  settings.vignetting = 0.0F;
+  Renderer renderer;  // local: its buffers are freed with the test
+  start_renderer(renderer, small_camera(), settings);
+  std::vector<std::uint8_t> clean(160 * 120 * 2);
+  std::vector<std::uint8_t> img(160 * 120 * 2);
+  const RigidTransform view = looking_along_x({0, 0, 1});
+  renderer.render(view, 0, clean.data(), 320, nullptr);
+  settings.chroma_noise_sigma = 3.0F;
+  renderer.set_settings(settings);
+  renderer.render(view, 0, img.data(), 320, nullptr);
+  double luma2 = 0.0;
+  double cb2 = 0.0;
+  double cr2 = 0.0;
+  for (std::size_t i = 0; i < img.size(); i += 4) {
+    const auto d = [&](std::size_t k) {
+      return static_cast<double>(img[i + k]) - static_cast<double>(clean[i + k]);
+    };
+    luma2 += d(0) * d(0) + d(2) * d(2);
+    cb2 += d(1) * d(1);
+    cr2 += d(3) * d(3);
+  }
+  const double pairs = static_cast<double>(img.size()) / 4.0;
+  DOUBLES_EQUAL(0.0, luma2, 0.0);  // luma untouched
+  DOUBLES_EQUAL(3.0, std::sqrt(cb2 / pairs), 0.3);
+  DOUBLES_EQUAL(3.0, std::sqrt(cr2 / pairs), 0.3);
+
+  settings.chroma_noise_sigma = 0.0F;
+  settings.exposure_jitter = 0.05F;
+  renderer.set_settings(settings);
+  // Each frame's luma above black is the clean frame's times one factor.
+  std::vector<double> factors;
+  for (std::uint32_t frame = 0; frame < 40; ++frame) {
+    renderer.render(view, frame, img.data(), 320, nullptr);
+    const double ratio = (pixel(img, 160, 80, 60).y - 16.0) / (pixel(clean, 160, 80, 60).y - 16.0);
+    DOUBLES_EQUAL(
+        ratio, (pixel(img, 160, 20, 100).y - 16.0) / (pixel(clean, 160, 20, 100).y - 16.0), 0.02);
+    factors.push_back(ratio);
+  }
+  double mean = 0.0;
+  for (const double f : factors) mean += f / static_cast<double>(factors.size());
+  double var = 0.0;
+  for (const double f : factors)
+    var += (f - mean) * (f - mean) / static_cast<double>(factors.size());
+  DOUBLES_EQUAL(1.0, mean, 0.03);
+  DOUBLES_EQUAL(0.05, std::sqrt(var), 0.025);
+  std::vector<std::uint8_t> again(160 * 120 * 2);
+  renderer.render(view, 39, again.data(), 320, nullptr);
+  CHECK(again == img);
+}

@@ -51,6 +51,23 @@ TEST(SimBoard, DescribesItselfAsASimulatedBoardWithTheThesisRig) {
   CHECK(c.background_units_per_slice > 0);  // work per frame independent of the host
 }
 
+// [sim]'s optics errors reach the rig the simulator draws and moves (the renderer's camera and
+// the PTU-camera lever), not the configuration the firmware reads.
+TEST(SimBoard, TheSimulatorDrawsWithTheTrueRigAndTheFirmwareIsToldTheConfiguredOne) {
+  const std::string path = world_path("thesis_room");
+  boticelli::firmware::Options options;
+  options.world_file = path.c_str();
+  board->settings().optics.focal_scale = 1.05F;
+  board->settings().optics.lens_k1_error = 0.1F;
+  board->settings().optics.lever_error_m = 0.004F;
+  CHECK_TEXT(board->init(options, g_error, sizeof g_error), g_error);
+  DOUBLES_EQUAL(600.0, board->config().focal_px, 0.0);
+  DOUBLES_EQUAL(630.0, board->rig().camera().focal_px, 1e-3);
+  DOUBLES_EQUAL(board->config().k1 + 0.1F, board->rig().camera().k1, 1e-6);
+  DOUBLES_EQUAL(0.21, board->config().lever_m, 1e-6);
+  DOUBLES_EQUAL(0.214, board->rig().params().lever_m, 1e-6);
+}
+
 TEST(SimBoard, ABadWorldFailsInitWithTheFileAndLine) {
   boticelli::firmware::Options options;
   options.world_file = "/nonexistent/room.sdf";

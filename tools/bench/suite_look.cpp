@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -336,14 +338,30 @@ struct WorldStats {
 };
 
 int run_world(const std::string& dir, const std::string& name, std::size_t poses,
-              double min_clearance_m) {
+              double min_clearance_m, boards::sim::SimRealism realism) {
   const firmware::BoardConfig config = boards::sim::make_config();
   const firmware::mission::MissionParams params = firmware::mission::make_mission_params(config);
-  const boards::sim::SimSettings settings = boards::sim::make_settings(config, 1);
-  // The mission's look pipeline: stereo, target fixes and the floor cue of each view.
+  boards::sim::SimSettings settings = boards::sim::make_settings(config, 1);
+  boards::sim::apply_realism(realism, settings);
+  // The mission's look pipeline: stereo, target fixes and the floor cue of each view, with
+  // the configured rig; the simulator draws with the true one.
   static firmware::mission::LookProcessor look(params.rig, params.stereo,
                                                params.model.close_blocked_rays);
-  const stereo::RigModel& rig = look.rig();
+  static std::optional<stereo::RigModel> true_rig;
+  true_rig.emplace(boards::sim::true_rig_params(config, settings.optics));
+  const stereo::RigModel& rig = *true_rig;
+  // Gear play: the camera trails each commanded angle by half of it, on the side the axis
+  // came from (the PTU's moves between views, as SimWorld::camera_pose() has it).
+  const float play = 0.5F * settings.physics.ptu.backlash_rad;
+  float last_pan = 0.0F;
+  float last_tilt = 0.0F;
+  float pan_direction = 0.0F;
+  float tilt_direction = 0.0F;
+  const auto trail = [&](float& last, float& direction, float to) {
+    if (to != last) direction = to > last ? 1.0F : -1.0F;
+    last = to;
+    return to - play * direction;
+  };
 
   const std::string path = dir + "/" + name + ".sdf";
   char error[256] = "";
@@ -403,10 +421,13 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       pp.first_tilt_rad = quantise(view.tilt_rad, lim.tilt_resolution_rad);
       pp.second_tilt_rad =
           quantise(view.tilt_rad - params.rig.tilt_step_rad, lim.tilt_resolution_rad);
+      const float pan_true = trail(last_pan, pan_direction, pp.pan_rad);
       const hal::sim::RigidTransform first_pose =
-          g_sim.camera_pose(pose, pp.pan_rad, pp.first_tilt_rad);
+          g_sim.camera_pose(pose, pan_true, trail(last_tilt, tilt_direction, pp.first_tilt_rad));
       const hal::sim::RigidTransform second_pose =
-          g_sim.camera_pose(pose, pp.pan_rad, pp.second_tilt_rad);
+          view.pair ? g_sim.camera_pose(pose, pan_true,
+                                        trail(last_tilt, tilt_direction, pp.second_tilt_rad))
+                    : first_pose;
       std::int64_t t0 = cpu_ns();
       g_renderer.render(first_pose, frame_index++, first_yuyv.data(), stride, nullptr);
       if (view.pair) {
@@ -575,6 +596,7 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
                              ? std::numeric_limits<double>::quiet_NaN()
                              : *std::min_element(st.nav_safety.begin(), st.nav_safety.end());
   JsonLine(kSuite, name.c_str())
+      .text("realism", realism == boards::sim::SimRealism::kRealistic ? "realistic" : "ideal")
       .integer("poses", static_cast<std::int64_t>(pose_list.size()))
       .integer("views", static_cast<std::int64_t>(views.size()))
       .num("readings", mean(st.readings))
@@ -632,6 +654,19 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
 
 int run() {
   const auto poses = static_cast<std::size_t>(env_long("BOTICELLI_LOOK_POSES", 20));
+  // BOTICELLI_LOOK_REALISM=ideal|realistic: the simulator's setting ([sim] realism); the
+  // board's default without it.
+  boards::sim::SimRealism realism = boards::sim::kDefaultRealism;
+  if (const char* r = std::getenv("BOTICELLI_LOOK_REALISM"); r != nullptr && r[0] != '\0') {
+    if (std::strcmp(r, "realistic") == 0) {
+      realism = boards::sim::SimRealism::kRealistic;
+    } else if (std::strcmp(r, "ideal") == 0) {
+      realism = boards::sim::SimRealism::kIdeal;
+    } else {
+      std::fprintf(stderr, "look: BOTICELLI_LOOK_REALISM=%s must be realistic or ideal\n", r);
+      return 1;
+    }
+  }
   const double clearance = env_double("BOTICELLI_LOOK_CLEARANCE_M", 0.35);
   int status = 0;
   const std::string dir = worlds_dir("BOTICELLI_LOOK_WORLDS_DIR", BOTICELLI_WORLDS_DIR);
@@ -645,7 +680,7 @@ int run() {
     }
   }
   for (const std::string& name : world_names(dir, "BOTICELLI_LOOK_WORLDS", kSuite)) {
-    if (run_world(dir, name, poses, clearance) != 0) status = 1;
+    if (run_world(dir, name, poses, clearance, realism) != 0) status = 1;
   }
   return status;
 }

@@ -356,7 +356,11 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
   const std::uint32_t noise_key =
       hash32(static_cast<std::uint32_t>(settings_.seed) ^
              hash32(static_cast<std::uint32_t>(settings_.seed >> 32U) + frame_index * 0x9E3779B9U));
-  const float gain = 255.0F * settings_.gain;
+  const float exposure = settings_.exposure_jitter > 0.0F
+                             ? std::max(0.0F, 1.0F + settings_.exposure_jitter *
+                                                         noise_sd(hash32(noise_key ^ 0xE7F05E1DU)))
+                             : 1.0F;
+  const float gain = 255.0F * settings_.gain * exposure;
   std::uint16_t list[kMaxSurfaces];
   for (std::uint32_t ty = 0; ty < tiles_y_; ++ty) {
     for (std::uint32_t tx = 0; tx < tiles_x_; ++tx) {
@@ -483,10 +487,17 @@ void Renderer::render(const RigidTransform& world_from_camera, std::uint32_t fra
           const float r = 0.5F * (rgb[0][0] + rgb[1][0]);
           const float g = 0.5F * (rgb[0][1] + rgb[1][1]);
           const float bl = 0.5F * (rgb[0][2] + rgb[1][2]);
+          float cb = 128.0F + (-37.797F * r - 74.203F * g + 112.0F * bl) / 255.0F;
+          float cr = 128.0F + (112.0F * r - 93.786F * g - 18.214F * bl) / 255.0F;
+          if (settings_.chroma_noise_sigma > 0.0F) {
+            const std::uint32_t pair = (v * width_ + u) * 0xC2B2AE35U;
+            cb += settings_.chroma_noise_sigma * noise_sd(noise_key ^ pair ^ 0x27D4EB2FU);
+            cr += settings_.chroma_noise_sigma * noise_sd(noise_key ^ pair ^ 0x165667B1U);
+          }
           out[0] = to_byte(y[0]);
-          out[1] = to_byte(128.0F + (-37.797F * r - 74.203F * g + 112.0F * bl) / 255.0F);
+          out[1] = to_byte(cb);
           out[2] = to_byte(y[1]);
-          out[3] = to_byte(128.0F + (112.0F * r - 93.786F * g - 18.214F * bl) / 255.0F);
+          out[3] = to_byte(cr);
         }
       }
     }

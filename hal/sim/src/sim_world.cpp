@@ -129,7 +129,9 @@ RigidTransform SimWorld::camera_pose(const core::Pose2& robot, float pan_rad,
 }
 
 RigidTransform SimWorld::camera_pose() const {
-  return camera_pose(true_pose(), pan_.position_rad, tilt_.position_rad);
+  const float play = 0.5F * params_.ptu.backlash_rad;
+  return camera_pose(true_pose(), pan_.position_rad - play * pan_.last_direction,
+                     tilt_.position_rad - play * tilt_.last_direction);
 }
 
 bool SimWorld::teleport(const core::Pose2& pose) {
@@ -216,6 +218,7 @@ void SimWorld::step_axis(PtuAxis& axis, float dt_s) const {
   const float v0 = axis.velocity_rad_s;
   axis.velocity_rad_s += dv;
   axis.position_rad += 0.5F * (v0 + axis.velocity_rad_s) * dt_s;
+  axis.last_direction = error > 0.0F ? 1.0F : -1.0F;
   const float after = axis.target_rad - axis.position_rad;
   // Arrived (or passed the target): stop on it. Tiny remainders settle at once.
   if ((after > 0.0F) != (error > 0.0F) || after == 0.0F ||

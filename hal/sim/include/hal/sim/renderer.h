@@ -13,8 +13,12 @@ namespace boticelli::hal::sim {
 
 // Image formation after the scene radiance (all deterministic for a given seed).
 struct RenderSettings {
-  float gain = 1.0F;                    // radiance 1.0 → 255 grey levels before clipping
-  float noise_sigma_grey = 2.0F;        // sensor noise, standard deviation [grey levels of Y]
+  float gain = 1.0F;                // radiance 1.0 → 255 grey levels before clipping
+  float noise_sigma_grey = 2.0F;    // sensor noise, standard deviation [grey levels of Y]
+  float chroma_noise_sigma = 0.0F;  // the same for Cb and Cr, per pixel pair [chroma levels]
+  // Auto-exposure: each frame's gain is gain · (1 + exposure_jitter · g), g a standard normal
+  // drawn per frame (the two frames of a stereo pair differ).
+  float exposure_jitter = 0.0F;
   float vignetting = 0.25F;             // relative brightness loss at the image corners [0, 1)
   bool shading = true;                  // Lambert + ambient; false = albedo only
   std::uint64_t seed = 1;               // noise seed

@@ -22,6 +22,9 @@ struct PtuParams {
   float speed_rad_s = 1.0F;      // default speed of both axes
   float max_speed_rad_s = 2.6F;  // fastest set_speed() accepted
   float accel_rad_s2 = 4.0F;     // acceleration and deceleration of both axes
+  // Gear play of both axes: the camera trails the axis's position by half of it, on the side
+  // the axis last moved from (nothing before the first move) [rad].
+  float backlash_rad = 0.0F;
 };
 
 struct BaseParams {
@@ -77,6 +80,7 @@ struct PtuAxis {
   float velocity_rad_s = 0.0F;
   float target_rad = 0.0F;
   float speed_rad_s = 1.0F;
+  float last_direction = 0.0F;  // sign of the last motion: +1, −1, 0 before any
   bool moving() const { return position_rad != target_rad || velocity_rad_s != 0.0F; }
 };
 
@@ -103,7 +107,8 @@ class SimWorld {
   const char* last_collision_model() const { return last_collision_model_; }
   bool in_contact() const { return contact_; }
   Eigen::Vector3f target_point_m() const { return world_->target_point_m; }
-  // Camera pose in the world for the PTU's current (true) pan and tilt.
+  // Camera pose in the world for the PTU's current (true) pan and tilt: its axes' positions
+  // less half the backlash on the side each last moved from.
   RigidTransform camera_pose() const;
   // Camera pose for a robot pose and PTU angles (the same kinematics, for tests).
   RigidTransform camera_pose(const core::Pose2& robot, float pan_rad, float tilt_rad) const;
