@@ -1300,3 +1300,130 @@ TEST(FloorCue, AFloorOfTwoColoursOneOnHalfOfItIsLearnedAsATexture) {
     CHECK_EQUAL(out.result.columns, out.free.size());
   }
 }
+
+// The coverage is the image's centre column's: its bottom row's floor point is the near end,
+// its top row's the far end.
+TEST(FloorCue, CoverageIsWhatTheCentreColumnsBottomAndTopRowsSeeOfTheFloor) {
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, -0.6F);
+  float near_m = 0.0F;
+  float far_m = 0.0F;
+  CHECK(cue.floor_coverage(-0.6F, near_m, far_m));
+  Eigen::Vector3f bottom;
+  Eigen::Vector3f top;
+  const auto u = static_cast<float>(camera.width_px / 2);
+  CHECK(floor_seen_at(pose, u, static_cast<float>(camera.height_px - 1), bottom));
+  CHECK(floor_seen_at(pose, u, 0.0F, top));
+  DOUBLES_EQUAL(std::hypot(bottom.x(), bottom.y()), near_m, 1e-4);
+  DOUBLES_EQUAL(std::hypot(top.x(), top.y()), far_m, 1e-3);
+}
+
+// A region that differs from the known floor by more than its tolerances (here 1.5 of them in
+// luma) is not the floor: it does not update the model.
+TEST(FloorCue, ARegionOneAndAHalfTolerancesFromTheKnownFloorIsInconsistent) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  fill_patches(g_frame, {120.0F + 1.5F * flat.min_tolerance_luma});
+  CHECK(FloorLearn::kInconsistent == fresh.learn(g_frame, 0.0F, kLookTilt));
+  DOUBLES_EQUAL(120.0, fresh.model().median[0], 1e-6);
+  fill_patches(g_frame, {120.0F + 0.5F * flat.min_tolerance_luma});
+  CHECK(FloorLearn::kUpdated == fresh.learn(g_frame, 0.0F, kLookTilt));
+}
+
+// Two textured regions of the same colours in different proportions confirm a model whose
+// histogram is their average, bin by bin.
+TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheAverageOfTheirHistograms) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue one{g_rig, flat};
+  static FloorCue other{g_rig, flat};
+  one.reset();
+  other.reset();
+  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
+  fill_patches(g_frame2, {40.0F, 40.0F, 100.0F, 160.0F, 220.0F});
+  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
+  FloorCueParams confirming = flat;
+  confirming.confirm_separation_rad = 1.0F;
+  static FloorCue both{g_rig, confirming};
+  both.reset();
+  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+  CHECK(both.model().textured);
+  double apart = 0.0;
+  for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
+    apart += std::fabs(static_cast<double>(one.model().mass[b] - other.model().mass[b]));
+    DOUBLES_EQUAL(0.5F * (one.model().mass[b] + other.model().mass[b]), both.model().mass[b], 1e-6);
+  }
+  CHECK(apart > 0.1);  // the two regions' histograms differ
+}
+
+// A plain floor's update moves its tolerances by the learning rate too: a region of the
+// model's own colour and spread leaves them as they were.
+TEST(FloorCue, AnUpdateByARegionLikeThePlainFloorKeepsItsTolerances) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  const std::array<float, 3> tolerance = fresh.model().tolerance;
+  CHECK(FloorLearn::kUpdated == fresh.learn(g_frame, 0.0F, kLookTilt));
+  for (std::size_t c = 0; c < 3; ++c) {
+    DOUBLES_EQUAL(tolerance[c], fresh.model().tolerance[c], 1e-6);
+  }
+}
+
+// Every process() call's columns are its own: a walk to max range says nothing of a base seen
+// by the same column in the frame before.
+TEST(FloorCue, AColumnKeepsNothingFromTheFrameBefore) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  paint(g_frame2, [](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
+  });
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK(out.result.boundaries >= 60U);
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, out.result.boundaries);
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    CHECK(fresh.column(i).end == FloorColumn::End::kMaxRange);
+    DOUBLES_EQUAL(0.0, fresh.column(i).base_rho_m, 0.0);
+    DOUBLES_EQUAL(0.0, fresh.column(i).evidence, 0.0);
+  }
+}
+
+// Along a walk on a textured floor, two shades exactly the luma change apart are one colour
+// (the tolerance holds its bound): rows alternating between them are one plain stretch, which
+// ends the free floor within the floor's longest run.
+TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneColourAlongAWalk) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {40.0F, 60.0F, 80.0F, 100.0F, 120.0F, 140.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  const float change = fresh.model().tolerance[0];
+  DOUBLES_EQUAL(10.0, change, 1e-6);  // half the 20-level steps between the patches
+  paint(g_frame2, [&](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v % 2 == 0 ? 96.0F : 96.0F + change, 0.0F, 0.0F};
+  });
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, out.result.obstacle_readings);
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    CHECK(fresh.column(i).end != FloorColumn::End::kMaxRange);
+  }
+}
