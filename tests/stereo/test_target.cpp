@@ -184,16 +184,31 @@ TEST(Target, AGreenTriangleOffWhitePaperOrOfAnotherShapeIsNotTheTarget) {
 
 namespace {
 
+// A colour of the low-resolution frame: luma, and Cb, Cr as offsets from 128.
+struct Colour {
+  float y;
+  int cb;
+  int cr;
+};
+constexpr Colour kTargetGreen{80.0F, -20, -40};
+constexpr Colour kWhitePaper{200.0F, 0, 0};
+
+void set_pixel(image::LowResFrame& f, std::uint32_t u, std::uint32_t v, const Colour& c) {
+  const std::size_t i = f.index(u, v);
+  f.luma[i] = c.y;
+  f.chroma_u[i] = static_cast<std::uint8_t>(128 + c.cb);
+  f.chroma_v[i] = static_cast<std::uint8_t>(128 + c.cr);
+}
+
 // A green triangle drawn pixel by pixel on white paper that fills a 160x120 frame: its
 // vertex at (80, 40), 24 rows, row k half as wide as 0.577 k px (equilateral, head-on);
 // from the fourth row on, rows alternately `ragged_px` wider and narrower each side.
-void draw_triangle(image::LowResFrame& f, float ragged_px) {
+void draw_triangle(image::LowResFrame& f, float ragged_px, const Colour& green = kTargetGreen,
+                   const Colour& paper = kWhitePaper) {
   f.width = 160;
   f.height = 120;
-  for (std::size_t i = 0; i < std::size_t{f.width} * f.height; ++i) {
-    f.luma[i] = 200.0F;
-    f.chroma_u[i] = 128;
-    f.chroma_v[i] = 128;
+  for (std::uint32_t v = 0; v < f.height; ++v) {
+    for (std::uint32_t u = 0; u < f.width; ++u) set_pixel(f, u, v, paper);
   }
   for (int k = 0; k < 24; ++k) {
     float half = 0.5F + 0.577F * static_cast<float>(k);
@@ -202,12 +217,24 @@ void draw_triangle(image::LowResFrame& f, float ragged_px) {
     const auto v = static_cast<std::uint32_t>(40 + k);
     for (auto u = static_cast<std::uint32_t>(std::lround(80.0F - half));
          u <= static_cast<std::uint32_t>(std::lround(80.0F + half)); ++u) {
-      const std::size_t i = f.index(u, v);
-      f.luma[i] = 80.0F;
-      f.chroma_u[i] = 108;
-      f.chroma_v[i] = 88;
+      set_pixel(f, u, v, green);
     }
   }
+}
+
+// The drawn triangle's pixels: those of the green colour.
+std::size_t green_pixels(const image::LowResFrame& f, const Colour& green) {
+  std::size_t n = 0;
+  for (std::uint32_t v = 0; v < f.height; ++v) {
+    for (std::uint32_t u = 0; u < f.width; ++u) {
+      const std::size_t i = f.index(u, v);
+      n +=
+          f.luma[i] == green.y && f.chroma_u[i] == 128 + green.cb && f.chroma_v[i] == 128 + green.cr
+              ? 1U
+              : 0U;
+    }
+  }
+  return n;
 }
 
 }  // namespace
@@ -272,4 +299,76 @@ TEST(Target, CornerIsTriangulatedFromBothFramesOfAPair) {
     const Eigen::Vector3f expected = (truth - first_pose.centre_m).normalized();
     CHECK(seen.dot(expected) > std::cos(1.0F / rig.low_res_camera().focal_px));
   }
+}
+
+// Foliage's green (−Cr about 0.22 of Y − black, above the ratio a blob grows by, below the
+// one it starts from) shaped as the target on white paper is no target: no pixel of it starts
+// a blob. The target's green on the same paper is found.
+TEST(Target, ATriangleOfFoliagesGreenOnWhitePaperIsNotTheTarget) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F, Colour{120.0F, -12, -23});
+  CHECK_FALSE(detector.detect(frame()).found);
+  draw_triangle(frame(), 0.0F, Colour{120.0F, -12, -40});
+  CHECK(detector.detect(frame()).found);
+}
+
+// The green thresholds hold their bounds: a triangle whose −Cb is exactly the seed's share of
+// its brightness (0.1 · 100 levels) starts a blob, and a rim of pixels with Cb exactly neutral
+// (the growth's share, 0) grows into it: the blob's area is the triangle's and the rim's.
+TEST(Target, PixelsExactlyAtTheGreenThresholdsStartAndGrowTheBlob) {
+  static image::TargetDetector detector;
+  const Colour at_seed{116.0F, -10, -40};  // Y − black = 100
+  draw_triangle(frame(), 0.0F, at_seed);
+  const std::size_t triangle = green_pixels(frame(), at_seed);
+  const image::TargetDetection seeded = detector.detect(frame());
+  CHECK(seeded.found);
+  CHECK_EQUAL(triangle, seeded.area_px);
+  // The rim: the paper pixel left and right of each row of the triangle.
+  const Colour rim{200.0F, 0, -23};  // paper-bright: it adds no width to the rows
+  for (std::uint32_t v = 40; v < 64; ++v) {
+    std::uint32_t first = 0;
+    std::uint32_t last = 0;
+    for (std::uint32_t u = 0; u < frame().width; ++u) {
+      if (frame().chroma_v[frame().index(u, v)] != 128 + at_seed.cr) continue;
+      if (first == 0) first = u;
+      last = u;
+    }
+    set_pixel(frame(), first - 1, v, rim);
+    set_pixel(frame(), last + 1, v, rim);
+  }
+  const image::TargetDetection grown = detector.detect(frame());
+  CHECK_EQUAL(triangle + 2 * 24, grown.area_px);
+}
+
+// Under tinted light the paper's mean chroma is the neutral: a triangle within 3 chroma levels
+// of such paper is no target, however green its chroma reads against true grey.
+TEST(Target, ATriangleOfTheTintedPapersOwnColourIsNotTheTarget) {
+  static image::TargetDetector detector;
+  const Colour tinted_paper{200.0F, -15, -4};
+  draw_triangle(frame(), 0.0F, Colour{30.0F, -16, -6}, tinted_paper);
+  CHECK_FALSE(detector.detect(frame()).found);
+  // The same dark triangle clearly greener than the paper is found.
+  draw_triangle(frame(), 0.0F, Colour{30.0F, -16, -12}, tinted_paper);
+  CHECK(detector.detect(frame()).found);
+}
+
+// A dark grey rim beside the triangle (its shadow on the paper) is not greener than the paper:
+// it adds nothing to the rows' widths, and the vertex stays where the green puts it.
+TEST(Target, AShadowBesideTheTriangleDoesNotMoveItsVertex) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  const image::TargetDetection clean = detector.detect(frame());
+  CHECK(clean.found);
+  for (std::uint32_t v = 41; v < 64; ++v) {
+    for (std::uint32_t u = 0; u < frame().width; ++u) {
+      if (frame().chroma_v[frame().index(u, v)] == 128 + kTargetGreen.cr) {
+        set_pixel(frame(), u - 1, v, Colour{40.0F, 0, 0});
+        break;
+      }
+    }
+  }
+  const image::TargetDetection shadowed = detector.detect(frame());
+  CHECK(shadowed.found);
+  DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 0.05);
+  DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
 }
