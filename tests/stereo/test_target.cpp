@@ -338,6 +338,15 @@ TEST(Target, PixelsExactlyAtTheGreenThresholdsStartAndGrowTheBlob) {
   }
   const image::TargetDetection grown = detector.detect(frame());
   CHECK_EQUAL(triangle + 2 * 24, grown.area_px);
+  // A rim whose −Cr is exactly the growth's share of its brightness (0.12 · 175 levels) grows
+  // into the blob too.
+  for (std::uint32_t v = 40; v < 64; ++v) {
+    for (std::uint32_t u = 0; u < frame().width; ++u) {
+      const std::size_t i = frame().index(u, v);
+      if (frame().chroma_v[i] == 128 + rim.cr) set_pixel(frame(), u, v, Colour{191.0F, 0, -21});
+    }
+  }
+  CHECK_EQUAL(triangle + 2 * 24, detector.detect(frame()).area_px);
 }
 
 // Under tinted light the paper's mean chroma is the neutral: a triangle within 3 chroma levels
@@ -371,4 +380,34 @@ TEST(Target, AShadowBesideTheTriangleDoesNotMoveItsVertex) {
   CHECK(shadowed.found);
   DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 0.05);
   DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
+}
+
+// The confidence's factors: white paper all round scales it, and straight edges, half the box
+// filled and symmetry each take it from 0.4 to 1 of that (the product of the three).
+TEST(Target, ConfidenceIsThePapersShareTimesHowStraightFilledAndSymmetricTheTriangleIs) {
+  DOUBLES_EQUAL(1.0, image::target_confidence(1.0F, 0.0F, 0.5F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(0.8, image::target_confidence(0.8F, 0.0F, 0.5F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(1.0, image::target_confidence(1.3F, 0.0F, 0.5F, 0.0F), 1e-6);  // share clamped
+  DOUBLES_EQUAL(0.7, image::target_confidence(1.0F, 0.75F, 0.5F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(0.4, image::target_confidence(1.0F, 3.0F, 0.5F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(0.7, image::target_confidence(1.0F, 0.0F, 0.65F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(0.7, image::target_confidence(1.0F, 0.0F, 0.35F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(0.4, image::target_confidence(1.0F, 0.0F, 0.9F, 0.0F), 1e-6);
+  DOUBLES_EQUAL(0.85, image::target_confidence(1.0F, 0.0F, 0.5F, 0.3F), 1e-6);
+  DOUBLES_EQUAL(0.7, image::target_confidence(1.0F, 0.0F, 0.5F, 0.9F), 1e-6);
+  // All three halfway: 0.4 + 0.6 · 0.5 · 0.5 · 0.75.
+  DOUBLES_EQUAL(0.5125, image::target_confidence(1.0F, 0.75F, 0.65F, 0.3F), 1e-6);
+}
+
+// The vertex is where the edge lines meet, at most two rows above the blob's top row: a
+// triangle with its top two rows cut off (a trapezoid, whose edges meet three rows above it)
+// is no target.
+TEST(Target, ATriangleWithItsTopCutOffIsNotTheTarget) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  CHECK(detector.detect(frame()).found);
+  for (std::uint32_t v = 40; v < 42; ++v) {
+    for (std::uint32_t u = 0; u < frame().width; ++u) set_pixel(frame(), u, v, kWhitePaper);
+  }
+  CHECK_FALSE(detector.detect(frame()).found);
 }

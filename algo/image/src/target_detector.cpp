@@ -76,6 +76,13 @@ constexpr float kChromaQuantum = 2.0F;
 
 }  // namespace
 
+float target_confidence(float white_share, float residual_px, float fill, float skew) {
+  const float straight = clamp01(1.0F - residual_px / 1.5F);
+  const float filled = clamp01(1.0F - std::fabs(fill - 0.5F) / 0.3F);
+  const float symmetric = clamp01(1.0F - skew / 0.6F);
+  return clamp01(white_share) * (0.4F + 0.6F * straight * filled * (0.5F + 0.5F * symmetric));
+}
+
 bool TargetDetector::is_green(const LowResFrame& frame, std::size_t i, bool seed) const {
   const float cr = static_cast<float>(int{frame.chroma_v[i]} - 128);
   const float cb = static_cast<float>(int{frame.chroma_u[i]} - 128);
@@ -383,12 +390,8 @@ TargetDetection TargetDetector::examine(const LowResFrame& frame, std::uint32_t 
   if (v_apex < static_cast<double>(v_min) - 2.0 || v_apex > static_cast<double>(v_min) + 1.5) {
     return out;
   }
-  const auto residual = static_cast<float>(std::max(rms_l, rms_r));
-  const float straight = clamp01(1.0F - residual / 1.5F);
-  const float filled = clamp01(1.0F - std::fabs(fill - 0.5F) / 0.3F);
-  const float symmetric = clamp01(1.0F - static_cast<float>(skew) / 0.6F);
-  out.confidence =
-      clamp01(white_share) * (0.4F + 0.6F * straight * filled * (0.5F + 0.5F * symmetric));
+  out.confidence = target_confidence(white_share, static_cast<float>(std::max(rms_l, rms_r)), fill,
+                                     static_cast<float>(skew));
   out.found = out.confidence >= params_.min_confidence;
   out.u_px = static_cast<float>(u_apex);
   out.v_px = static_cast<float>(v_apex);

@@ -48,6 +48,13 @@ struct TargetDetection {
   std::uint32_t box_v_max = 0;
 };
 
+// Confidence in [0, 1] of a candidate from its measures: the share of white paper around it
+// (a factor), and how straight its two edge lines are (the larger RMS residual, 0 px best, 1.5
+// px or more worst), how near half its bounding box it fills (0.5 best, 0.2 or 0.8 worst) and
+// how symmetric it is (skew |b_l + b_r| / (b_r − b_l) of the edges' slopes, 0 best, 0.6
+// worst): white_share · (0.4 + 0.6 · straight · filled · (0.5 + 0.5 · symmetric)).
+[[nodiscard]] float target_confidence(float white_share, float residual_px, float fill, float skew);
+
 // Finds green blobs (connected components, hysteresis on chromaticity), keeps those shaped
 // like an upward triangle seen from up to about 60° off its normal (left and right edges
 // straight and converging to a vertex at the top, the base at the bottom, about half the
