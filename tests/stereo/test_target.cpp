@@ -1,4 +1,5 @@
 // Target detection (§3.4.2) on rendered scenes: found at 0.5–4 m, never in scenes without it.
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -204,13 +205,13 @@ void set_pixel(image::LowResFrame& f, std::uint32_t u, std::uint32_t v, const Co
 // vertex at (80, 40), 24 rows, row k half as wide as 0.577 k px (equilateral, head-on);
 // from the fourth row on, rows alternately `ragged_px` wider and narrower each side.
 void draw_triangle(image::LowResFrame& f, float ragged_px, const Colour& green = kTargetGreen,
-                   const Colour& paper = kWhitePaper) {
+                   const Colour& paper = kWhitePaper, int rows = 24) {
   f.width = 160;
   f.height = 120;
   for (std::uint32_t v = 0; v < f.height; ++v) {
     for (std::uint32_t u = 0; u < f.width; ++u) set_pixel(f, u, v, paper);
   }
-  for (int k = 0; k < 24; ++k) {
+  for (int k = 0; k < rows; ++k) {
     float half = 0.5F + 0.577F * static_cast<float>(k);
     if (k >= 3) half += k % 2 == 1 ? ragged_px : -ragged_px;
     half = std::fmax(half, 0.5F);
@@ -410,4 +411,60 @@ TEST(Target, ATriangleWithItsTopCutOffIsNotTheTarget) {
     for (std::uint32_t u = 0; u < frame().width; ++u) set_pixel(frame(), u, v, kWhitePaper);
   }
   CHECK_FALSE(detector.detect(frame()).found);
+}
+
+// An equilateral triangle, vertex up at (apex_u, apex_v), `height_px` rows high, drawn with
+// each pixel mixing green and paper by the share of it the triangle covers (16 x 16 samples),
+// as the camera's 4 x 4 averaging does; `light(u, v)` scales the brightness above black of paper
+// and triangle alike.
+template <typename Light>
+void draw_smooth_triangle(image::LowResFrame& f, float apex_u, float apex_v, float height_px,
+                          Light light) {
+  f.width = 160;
+  f.height = 120;
+  const Colour& g = kTargetGreen;
+  const Colour& p = kWhitePaper;
+  for (std::uint32_t v = 0; v < f.height; ++v) {
+    for (std::uint32_t u = 0; u < f.width; ++u) {
+      int inside = 0;
+      for (int sy = 0; sy < 16; ++sy) {
+        for (int sx = 0; sx < 16; ++sx) {
+          // Pixel (u, v) covers [u − 0.5, u + 0.5] x [v − 0.5, v + 0.5].
+          const float x = static_cast<float>(u) - 0.5F + (static_cast<float>(sx) + 0.5F) / 16.0F;
+          const float y = static_cast<float>(v) - 0.5F + (static_cast<float>(sy) + 0.5F) / 16.0F;
+          const float t = y - apex_v;
+          inside += t >= 0.0F && t <= height_px && std::fabs(x - apex_u) <= 0.57735F * t ? 1 : 0;
+        }
+      }
+      const float c = static_cast<float>(inside) / 256.0F;
+      const std::size_t i = f.index(u, v);
+      f.luma[i] = 16.0F + (p.y + (g.y - p.y) * c - 16.0F) *
+                              light(static_cast<float>(u), static_cast<float>(v));
+      f.chroma_u[i] = static_cast<std::uint8_t>(std::lround(128.0F + c * static_cast<float>(g.cb)));
+      f.chroma_v[i] = static_cast<std::uint8_t>(std::lround(128.0F + c * static_cast<float>(g.cr)));
+    }
+  }
+}
+
+// Light falling off across the paper (and the triangle on it alike): the paper's brightness
+// is fitted as a plane, so the vertex is found where it is drawn, as under even light.
+TEST(Target, UnevenLightAcrossThePaperDoesNotMoveTheVertex) {
+  static image::TargetDetector detector;
+  // Brightness slopes across the frame, sideways and up-down (0.3: 30 % brighter at one edge).
+  constexpr std::array<std::array<float, 2>, 7> kSlopes{{{0.0F, 0.0F},
+                                                         {0.3F, 0.0F},
+                                                         {-0.3F, 0.0F},
+                                                         {0.6F, 0.0F},
+                                                         {0.0F, 0.3F},
+                                                         {0.0F, -0.3F},
+                                                         {0.3F, 0.3F}}};
+  for (const auto& [across, down] : kSlopes) {
+    draw_smooth_triangle(frame(), 80.3F, 39.6F, 24.0F, [&](float u, float v) {
+      return 1.0F + across * (u - 80.0F) / 80.0F + down * (v - 60.0F) / 60.0F;
+    });
+    const image::TargetDetection d = detector.detect(frame());
+    CHECK(d.found);
+    DOUBLES_EQUAL(80.3, d.u_px, 0.01);
+    DOUBLES_EQUAL(39.6, d.v_px, 0.02);
+  }
 }
