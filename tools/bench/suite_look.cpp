@@ -25,6 +25,8 @@
 #include "bench.h"
 #include "bench_worlds.h"
 #include "board_config.h"
+#include "firmware/app/config_file.h"
+#include "sim_config.h"
 #include "firmware/mission/look/look_processor.h"
 #include "firmware/mission/look/look_scan.h"
 #include "firmware/mission/params/mission_params.h"
@@ -337,12 +339,23 @@ struct WorldStats {
   std::vector<double> pose_target_error_m;
 };
 
+// BOTICELLI_LOOK_SIM_CONFIG=FILE: a configuration file whose [sim] keys go on top of the
+// realism setting (one error at a time, e.g. `[sim]` `focal_scale = 1.01`).
+boards::sim::SimConfigKeys g_sim_keys;
+bool g_sim_keys_set = false;
+char error_of_config[256] = "";
+
 int run_world(const std::string& dir, const std::string& name, std::size_t poses,
               double min_clearance_m, boards::sim::SimRealism realism) {
   const firmware::BoardConfig config = boards::sim::make_config();
   const firmware::mission::MissionParams params = firmware::mission::make_mission_params(config);
   boards::sim::SimSettings settings = boards::sim::make_settings(config, 1);
   boards::sim::apply_realism(realism, settings);
+  if (g_sim_keys_set && !boards::sim::apply_sim_config(g_sim_keys, settings, error_of_config,
+                                                       sizeof error_of_config)) {
+    std::fprintf(stderr, "look: %s\n", error_of_config);
+    return 1;
+  }
   // The mission's look pipeline: stereo, target fixes and the floor cue of each view, with
   // the configured rig; the simulator draws with the true one.
   static firmware::mission::LookProcessor look(params.rig, params.stereo,
@@ -422,6 +435,12 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       pp.second_tilt_rad =
           quantise(view.tilt_rad - params.rig.tilt_step_rad, lim.tilt_resolution_rad);
       const float pan_true = trail(last_pan, pan_direction, pp.pan_rad);
+      if (view.pair) {
+        // The scan approaches a pair's first tilt from above (LookScan, kApproach).
+        (void)trail(last_tilt, tilt_direction,
+                    firmware::mission::tilt_approach_rad(
+                        last_tilt, pp.first_tilt_rad, params.ptu_approach_rad, lim.tilt_max_rad));
+      }
       const hal::sim::RigidTransform first_pose =
           g_sim.camera_pose(pose, pan_true, trail(last_tilt, tilt_direction, pp.first_tilt_rad));
       const hal::sim::RigidTransform second_pose =
@@ -666,6 +685,23 @@ int run() {
       std::fprintf(stderr, "look: BOTICELLI_LOOK_REALISM=%s must be realistic or ideal\n", r);
       return 1;
     }
+  }
+  if (const char* f = std::getenv("BOTICELLI_LOOK_SIM_CONFIG"); f != nullptr && f[0] != '\0') {
+    static firmware::ConfigSchema schema;
+    schema.clear();
+    if (!boards::sim::add_sim_config_keys(schema, g_sim_keys) ||
+        firmware::load_config_file(f, schema, error_of_config, sizeof error_of_config) !=
+            firmware::ConfigLoad::kLoaded) {
+      std::fprintf(stderr, "look: %s\n", error_of_config);
+      return 1;
+    }
+    // The file's realism, if it names one, decides the row's label.
+    if (std::strcmp(g_sim_keys.realism.data(), "realistic") == 0) {
+      realism = boards::sim::SimRealism::kRealistic;
+    } else if (std::strcmp(g_sim_keys.realism.data(), "ideal") == 0) {
+      realism = boards::sim::SimRealism::kIdeal;
+    }
+    g_sim_keys_set = true;
   }
   const double clearance = env_double("BOTICELLI_LOOK_CLEARANCE_M", 0.35);
   int status = 0;

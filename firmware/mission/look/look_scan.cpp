@@ -1,21 +1,32 @@
 // LookScan: the PTU scan of one look (see look_scan.h).
 #include "firmware/mission/look/look_scan.h"
 
+#include <algorithm>
+
 #include "algo/image/low_res_frame.h"
 
 namespace boticelli::firmware::mission {
+
+float tilt_approach_rad(float from_rad, float to_rad, float approach_rad, float max_rad) {
+  if (approach_rad <= 0.0F || from_rad > to_rad) return to_rad;
+  return std::max(to_rad, std::min(to_rad + approach_rad, max_rad));
+}
 
 void LookScan::begin(std::uint64_t now_us, const AimedPair& aimed, bool only_aimed) {
   aimed_ = aimed;
   view_ = only_aimed && aimed.aimed ? scan_views() : 0;
   second_frame_ = false;
+  approached_ = false;
   step_ = Step::kMove;
   view_ready_ = false;
   deadline_us_ = now_us + params_.ptu_timeout_us;
 }
 
 void LookScan::resume() {
-  if (step_ != Step::kProcess) step_ = Step::kMove;
+  if (step_ != Step::kProcess) {
+    step_ = Step::kMove;
+    approached_ = false;  // the interrupted move may have stopped anywhere
+  }
 }
 
 void LookScan::view_angles(const hal::PanTiltLimits& limits) {
@@ -36,15 +47,33 @@ ScanEvent LookScan::control(std::uint64_t now_us, hal::PanTilt& ptu) {
   if (state.fault) return ScanEvent::kPtuFault;
   switch (step_) {
     case Step::kMove: {
-      view_angles(ptu.limits());
+      const hal::PanTiltLimits limits = ptu.limits();
+      view_angles(limits);
       const float tilt =
           second_frame_ ? view_tilt_rad_ - params_.rig.tilt_step_rad : view_tilt_rad_;
+      if (view_pair_ && !second_frame_ && !approached_) {
+        approached_ = true;
+        const float above =
+            tilt_approach_rad(state.tilt_rad, tilt, params_.ptu_approach_rad, limits.tilt_max_rad);
+        if (above != tilt) {
+          if (!ptu.move_to(view_pan_rad_, above)) return ScanEvent::kPtuRefused;
+          deadline_us_ = now_us + params_.ptu_timeout_us;
+          step_ = Step::kApproach;
+          return ScanEvent::kBusy;
+        }
+      }
       if (!ptu.move_to(view_pan_rad_, tilt)) return ScanEvent::kPtuRefused;
       deadline_us_ = now_us + params_.ptu_timeout_us;
       step_ = Step::kSettle;
       settle_until_us_ = 0;
       return ScanEvent::kBusy;
     }
+    case Step::kApproach:
+      if (state.moving) {
+        return now_us > deadline_us_ ? ScanEvent::kPtuTimeout : ScanEvent::kBusy;
+      }
+      step_ = Step::kMove;
+      return ScanEvent::kBusy;
     case Step::kSettle:
       if (state.moving) {
         return now_us > deadline_us_ ? ScanEvent::kPtuTimeout : ScanEvent::kBusy;
@@ -77,6 +106,7 @@ ScanEvent LookScan::control(std::uint64_t now_us, hal::PanTilt& ptu) {
     case Step::kProcess:
       if (view_ready_) return ScanEvent::kBusy;  // the background has not taken the view yet
       second_frame_ = false;
+      approached_ = false;
       if (++view_ < view_count()) {
         step_ = Step::kMove;
         return ScanEvent::kBusy;

@@ -103,6 +103,7 @@ MissionParams make_mission_params(const BoardConfig& c) {
   std::stable_sort(p.rows, p.rows + p.row_count,
                    [](const LookRow& a, const LookRow& b) { return a.tilt_rad < b.tilt_rad; });
   p.settle_us = c.camera_settle_ms * 1000U;
+  p.ptu_approach_rad = std::max(c.ptu_approach_rad, 0.0F);
   p.device_retry_us = static_cast<std::uint64_t>(static_cast<double>(c.device_retry_s) * 1e6);
   p.steps_per_look = std::max<std::uint32_t>(c.steps_per_look, 1);
 

@@ -83,6 +83,19 @@ TEST_GROUP(LookScan) {
     CHECK(control() == ScanEvent::kBusy);  // the frame kept
     CHECK_FALSE(scan.wants_frames());
   }
+  // A pair's first tilt reached from below: the move above it, the PTU there at rest.
+  void approach(float pan_rad, float above_rad) {
+    expect_move(pan_rad, above_rad);
+    CHECK(control() == ScanEvent::kBusy);
+    mock().checkExpectations();
+    ptu_at(pan_rad, above_rad, true);
+    now += 1000;
+    CHECK(control() == ScanEvent::kBusy);  // still moving
+    ptu_at(pan_rad, above_rad);
+    now += 1000;
+    CHECK(control() == ScanEvent::kBusy);  // there: on to the view's tilt
+    CHECK_FALSE(scan.wants_frames());
+  }
   // The background is done with the view; the scan goes on to the next one.
   void next_view() {
     scan.view_processed();
@@ -166,7 +179,8 @@ TEST(LookScan, TheScansViewsComeInTurnAndTheAimedPairComesLast) {
   CHECK_EQUAL(1U, scan.view().index);
   CHECK_FALSE(scan.view().aimed);
   next_view();
-  // The aimed view is a pair, at the aimed angles.
+  // The aimed view is a pair, at the aimed angles, its first tilt reached from above.
+  approach(0.4F, 0.1F + params.ptu_approach_rad);
   move_settle_grab(0.4F, 0.1F);
   CHECK_FALSE(scan.view_ready());
   move_settle_grab(0.4F, 0.1F - phi);
@@ -188,6 +202,7 @@ TEST(LookScan, AGlanceIsTheAimedPairAloneAndWithoutOneAWholeLook) {
   aimed.pan_rad = -0.3F;
   aimed.tilt_rad = 0.05F;
   scan.begin(now, aimed, true);
+  approach(-0.3F, 0.05F + params.ptu_approach_rad);  // from level, up to the pair
   move_settle_grab(-0.3F, 0.05F);
   move_settle_grab(-0.3F, 0.05F - phi);
   CHECK_TRUE(scan.view_ready());
@@ -285,4 +300,51 @@ TEST(LookScan, ResumeWhileTheBackgroundHasTheViewMovesNothing) {
   scan.view_processed();
   expect_move(0.0F, 0.0F);
   CHECK(control() == ScanEvent::kDone);
+}
+
+// Gear play: both frames of a pair must take up the PTU's backlash on the same side, so a
+// pair's first tilt is reached moving down, as its second is. From below (or from the same
+// tilt) the PTU goes above it first; from above it goes straight there; a single frame needs
+// neither.
+TEST(LookScan, APairsFirstTiltIsReachedMovingDownAsItsSecondIs) {
+  params.pan_positions = 2;
+  params.rows[0] = {-0.2F, true};
+  ptu_at(0.0F, -0.5F);  // below the row
+  scan.begin(now, {});
+  approach(-1.0F, -0.2F + params.ptu_approach_rad);
+  move_settle_grab(-1.0F, -0.2F);
+  move_settle_grab(-1.0F, -0.2F - phi);
+  next_view();
+  // The second view's first tilt is above where the first view's second frame left the PTU.
+  approach(1.0F, -0.2F + params.ptu_approach_rad);
+  move_settle_grab(1.0F, -0.2F);
+  move_settle_grab(1.0F, -0.2F - phi);
+  scan.view_processed();
+  expect_move(0.0F, 0.0F);
+  CHECK(control() == ScanEvent::kDone);
+  mock().checkExpectations();
+  // From above: straight to the pair.
+  ptu_at(0.0F, 0.3F);
+  scan.begin(now, {});
+  move_settle_grab(-1.0F, -0.2F);
+  // A single frame: straight to it from below.
+  params.rows[0] = {-0.2F, false};
+  ptu_at(0.0F, -0.5F);
+  scan.begin(now, {});
+  move_settle_grab(-1.0F, -0.2F);
+  // Without an approach: straight to the pair from below.
+  params.rows[0] = {-0.2F, true};
+  params.ptu_approach_rad = 0.0F;
+  ptu_at(0.0F, -0.5F);
+  scan.begin(now, {});
+  move_settle_grab(-1.0F, -0.2F);
+}
+
+TEST(LookScan, TheApproachGoesAboveThePairWithinTheTiltLimitOrStraightThereFromAbove) {
+  DOUBLES_EQUAL(-0.19, tilt_approach_rad(-0.5F, -0.2F, 0.01F, 0.5F), 1e-6);
+  DOUBLES_EQUAL(-0.19, tilt_approach_rad(-0.2F, -0.2F, 0.01F, 0.5F), 1e-6);  // same tilt
+  DOUBLES_EQUAL(-0.2, tilt_approach_rad(-0.1F, -0.2F, 0.01F, 0.5F), 1e-6);   // from above
+  DOUBLES_EQUAL(0.5, tilt_approach_rad(0.0F, 0.495F, 0.01F, 0.5F), 1e-6);    // at the limit
+  DOUBLES_EQUAL(0.5, tilt_approach_rad(0.0F, 0.5F, 0.01F, 0.5F), 1e-6);
+  DOUBLES_EQUAL(-0.2, tilt_approach_rad(-0.5F, -0.2F, 0.0F, 0.5F), 1e-6);  // none asked
 }

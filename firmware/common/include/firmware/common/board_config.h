@@ -71,6 +71,10 @@ struct BoardConfig {
   std::array<bool, kMaxTiltRows> look_tilt_is_pair = {true, true, false, false};
   std::uint32_t look_tilt_rows = 2;
   std::uint32_t camera_settle_ms = 60;  // after the PTU stops, before a frame counts [ms]
+  // Gear play: a stereo pair's first tilt is approached from at least this far above, so both
+  // of its frames take up the PTU's backlash on the same side and the tilt step between them
+  // is Φ (0: moves go straight to the view) [rad].
+  float ptu_approach_rad = 0.01F;
   // What the camera can be trusted for (thesis §3.4: about 0.1 m to 4.5 m).
   float max_range_m = 4.5F;
   float ceiling_height_m = 2.5F;     // readings above this height are errors [m]

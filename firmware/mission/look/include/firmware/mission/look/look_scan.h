@@ -30,6 +30,13 @@ struct AimedPair {
   float tilt_rad = 0.0F;
 };
 
+// Where the PTU goes first to reach a stereo pair's first tilt `to_rad` from `from_rad` moving
+// down, so that its gear play is taken up as for the pair's second frame: `to_rad` itself when
+// the move already goes down, else at least `approach_rad` above it within `max_rad` (the
+// tilt limit; a view at the limit is reached as it can be).
+[[nodiscard]] float tilt_approach_rad(float from_rad, float to_rad, float approach_rad,
+                                      float max_rad);
+
 // The view the background processes: both frames, where the PTU stood for each, whether it is
 // a pair, and its number in the look (the aimed pair comes after the scan's views).
 struct GrabbedView {
@@ -74,7 +81,8 @@ class LookScan {
   [[nodiscard]] std::size_t view_count() const { return scan_views() + (aimed_.aimed ? 1U : 0U); }
 
  private:
-  enum class Step : std::uint8_t { kMove, kSettle, kGrab, kProcess };
+  // kApproach: the PTU goes above a pair's first tilt first (MissionParams::ptu_approach_rad).
+  enum class Step : std::uint8_t { kMove, kApproach, kSettle, kGrab, kProcess };
   void view_angles(const hal::PanTiltLimits& limits);
 
   const MissionParams& params_;
@@ -82,6 +90,7 @@ class LookScan {
   std::size_t view_ = 0;
   Step step_ = Step::kMove;
   bool second_frame_ = false;  // grabbing the pair's second frame
+  bool approached_ = false;    // the pair's first tilt is approached from above (or need not be)
   float view_pan_rad_ = 0.0F;
   float view_tilt_rad_ = 0.0F;
   bool view_pair_ = false;

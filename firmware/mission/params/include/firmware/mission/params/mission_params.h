@@ -47,6 +47,7 @@ struct MissionParams {
   LookRow rows[BoardConfig::kMaxTiltRows]{};
   std::size_t row_count = 0;
   std::uint32_t settle_us = 60000;           // PTU at rest → frames count after this [µs]
+  float ptu_approach_rad = 0.01F;            // BoardConfig::ptu_approach_rad [rad]
   std::uint32_t frame_timeout_us = 3000000;  // no usable frame this long: camera fault [µs]
   std::uint32_t ptu_timeout_us = 8000000;    // a PTU move taking longer: PTU fault [µs]
   // A device fault is held and retried every device_retry_interval_us; with no frame grabbed
