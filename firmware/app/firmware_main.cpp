@@ -387,10 +387,16 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
 
   const char* stop_reason = "";
   TextBuffer<224> gave_up_reason;
+  bool calibration_said = false;
   for (;;) {
     executive.set_background_max_slice_us(static_cast<std::uint32_t>(background_slice_us));
     executive.run_frame();
     if (hooks != nullptr && hooks->after_frame != nullptr) hooks->after_frame(hooks->context);
+    if (!calibration_said && mission.calibration_suspect()) {
+      // The calibration self-check's finding, on the console and in the journal, once.
+      console.log(LogLevel::kWarn, "%s", mission.calibration_warning());
+      calibration_said = true;
+    }
     if (g_signal != 0) {
       stop_reason = signal_name(g_signal);
       break;
@@ -453,6 +459,11 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
                 "grid_dropped=%u blacklisted=%u",
                 mission.planner_name(), m.grid_tiles, m.grid_bytes, static_cast<double>(m.free_m2),
                 static_cast<double>(m.occupied_m2), m.grid_dropped, m.blacklisted);
+  }
+  if (mission.calibration_bases() > 0) {
+    console.log(LogLevel::kInfo, "mission calibration stereo_to_floor=%.3f bases=%u",
+                static_cast<double>(mission.calibration_ratio()),
+                static_cast<unsigned>(mission.calibration_bases()));
   }
   if (mission.guard_truncated_looks() > 0) {
     console.log(LogLevel::kWarn, "mission guard_truncated_looks=%u (a full list dropped readings)",

@@ -793,7 +793,30 @@ bool Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {
 void Mission::begin_think() {
   think_step_ = ThinkStep::kModel;
   look_.end_look(params_.limits);
+  check_calibration();
   map_.begin(params_.model, look_.readings(), look_pose_);
+}
+
+void Mission::check_calibration() {
+  // A look with enough obstacle bases seen by both the stereo and the floor cue: the running
+  // ratio is the latest such look's, weighed with the ones before by their counts.
+  float ratio = 0.0F;
+  std::size_t n = 0;
+  if (!look_.range_check().median(ratio, n) || n < kCalibrationMinBases) return;
+  const auto bases = static_cast<std::uint32_t>(n);
+  const float before = static_cast<float>(calibration_bases_);
+  calibration_ratio_ = (calibration_ratio_ * before + ratio * static_cast<float>(bases)) /
+                       (before + static_cast<float>(bases));
+  calibration_bases_ += bases;
+  if (calibration_warned_ || std::fabs(ratio - 1.0F) <= kCalibrationTolerance) return;
+  calibration_warned_ = true;
+  calibration_text_.clear();
+  calibration_text_.appendf(
+      "calibration suspect: stereo distances %.3f of the floor's at %u obstacle bases "
+      "(1 +- %.2f expected); check camera.focal_px and the lens",
+      static_cast<double>(ratio), static_cast<unsigned>(bases),
+      static_cast<double>(kCalibrationTolerance));
+  state_.add_log(state_.cycle, calibration_text_.view());
 }
 
 void Mission::localize() {

@@ -52,6 +52,9 @@ struct MissionRun {
   bool telemetry_confirmed = false;     // a TLM line reported the target confirmed
   boticelli::core::Pose2 final_pose{};  // the robot's true pose when the firmware returned
   boticelli::core::Point2 target{};     // the true target (its foot on the floor)
+  double calibration_ratio = -1.0;      // the end's `mission calibration` line, −1 if none
+  int calibration_bases = 0;
+  bool calibration_warned = false;  // the mission log said the calibration is suspect
 };
 
 // Runs firmware_main on the sim board with stdout captured; checks the trace against the
@@ -87,6 +90,13 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   if (at != std::string::npos) run.mission_line = text.substr(at, text.find('\n', at) - at);
   const std::size_t e = run.mission_line.find("target_error_m=");
   if (e != std::string::npos) run.target_error_m = std::atof(run.mission_line.c_str() + e + 15);
+  const std::size_t k = text.find("mission calibration stereo_to_floor=");
+  if (k != std::string::npos) {
+    run.calibration_ratio = std::atof(text.c_str() + k + 36);
+    const std::size_t b = text.find("bases=", k);
+    if (b != std::string::npos) run.calibration_bases = std::atoi(text.c_str() + b + 6);
+  }
+  run.calibration_warned = text.find("calibration suspect") != std::string::npos;
   std::string error;
   run.trace_text = slurp(trace_path);
   if (sim::read_trace(trace_path.c_str(), run.trace, error)) {
@@ -265,6 +275,31 @@ TEST(MissionThesisRoom, TheSameSeedGivesTheSameTraceBitForBit) {
   const MissionRun b = run_mission("thesis_room", "3");
   check_found_safely(a);
   CHECK(a.trace_text == b.trace_text);
+  // The calibration self-check: with the camera as configured the stereo's distances at the
+  // obstacles' bases are the floor's, and nothing is reported.
+  CHECK_TEXT(a.calibration_bases >= 100, a.mission_line.c_str());
+  DOUBLES_EQUAL(1.0, a.calibration_ratio, 0.03);
+  CHECK_FALSE(a.calibration_warned);
+}
+
+// A camera whose focal length is 1 % longer than configured (the simulator draws through it,
+// the firmware is told the configured one): the first look's stereo distances at the
+// obstacles' bases fall short of the floor's, and the console says so.
+TEST(MissionThesisRoom, AFocalLengthOneInAHundredOffIsReportedAfterTheFirstLook) {
+  char dir_template[] = "/tmp/boticelli-calibration-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const std::string conf = dir + "/sim.conf";
+  FILE* f = std::fopen(conf.c_str(), "w");
+  CHECK(f != nullptr);
+  std::fputs("[sim]\nfocal_scale = 1.01\n", f);
+  std::fclose(f);
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, nullptr,
+                                   {"--config", conf.c_str(), "--max-cycles", "1"});
+  std::remove(conf.c_str());
+  rmdir(dir.c_str());
+  CHECK_TEXT(r.calibration_warned, r.mission_line.c_str());
+  CHECK_TEXT(r.calibration_bases >= 30, r.mission_line.c_str());
+  CHECK(r.calibration_ratio < 0.97);
 }
 
 TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {

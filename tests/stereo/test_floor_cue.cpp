@@ -18,6 +18,8 @@
 #include "algo/evidence/reading.h"
 #include "algo/image/low_res_frame.h"
 #include "algo/stereo/floor_cue.h"
+#include "algo/stereo/range_check.h"
+#include "algo/stereo/stereo_processor.h"
 #include "algo/stereo/rig.h"
 #include "board_config.h"
 #include "hal/sim/renderer.h"
@@ -1426,4 +1428,131 @@ TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneColourAlongAWalk) {
   for (std::size_t i = 0; i < fresh.column_count(); ++i) {
     CHECK(fresh.column(i).end != FloorColumn::End::kMaxRange);
   }
+}
+
+// The calibration self-check on rendered pairs: where the floor cue finds an obstacle's base,
+// the stereo's points low on it are as far along the walk's plane, the ratio's median is 1;
+// frames drawn through a lens whose focal length is longer than configured scale the stereo's
+// distances and not the floor's, and the median shows it. Prints the medians.
+TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagreeing) {
+  // Walls and a box wearing camouflage (the shipped worlds' walls do): texture for the stereo.
+  const auto textured = [](const char* name, const char* pose, const char* size, int seed) {
+    return std::string("<model name=\"") + name + "\"><pose>" + pose +
+           " 0 0 0</pose><link name=\"l\"><visual name=\"v\"><geometry><box><size>" + size +
+           "</size></box></geometry><material><diffuse>0.7 0.7 0.65 1</diffuse></material>"
+           "<boticelli:pattern scale=\"0.1\" seed=\"" +
+           std::to_string(seed) + "\">camouflage</boticelli:pattern></visual></link></model>\n";
+  };
+  load(textured("wall", "2.4 0 0.6", "0.1 8 1.2", 3) +
+       textured("left", "0 2.2 0.6", "8 0.1 1.2", 4) +
+       textured("right", "0 -2.0 0.6", "8 0.1 1.2", 5) +
+       textured("box", "1.2 0.9 0.25", "0.4 0.4 0.5", 6));
+  static FixedVector<Reading, 4096> readings;
+  static boticelli::stereo::StereoProcessor stereo_processor{
+      g_rig, boticelli::firmware::mission::make_mission_params(board::make_config()).stereo};
+  static boticelli::stereo::RangeCheck check{g_rig};
+  // The frames drawn through the true camera (its focal length scaled, k1 moved) and with the
+  // second frame's tilt off by `phi_error`; the stereo and the floor cue use g_rig's.
+  const auto look_ratio = [&](float focal_scale, float k1_error, float phi_error) {
+    boticelli::stereo::CameraIntrinsics truth = g_rig.camera();
+    truth.focal_px *= focal_scale;
+    truth.k1 += k1_error;
+    const board::SimSettings settings = board::make_settings(board::make_config(), 3);
+    sim::Renderer renderer;  // local: its buffers are freed with the lambda's call
+    CHECK_TEXT(renderer.init(g_scene.world, g_scene.textures, truth, settings.render, g_error,
+                             sizeof g_error),
+               g_error);
+    static FloorCue fresh{g_rig, trusting()};
+    fresh.reset();
+    check.begin_look();
+    std::uint32_t frame_index = 1;
+    const auto draw = [&](float pan, float tilt, LowResFrame& into) {
+      renderer.render(camera_in_world(pan, tilt), frame_index++, g_yuyv.data(), 640U * 2U, nullptr);
+      CHECK(boticelli::image::downsample_yuyv(g_yuyv.data(), 640, 480, 640 * 2, 4, into));
+    };
+    const float phi = g_rig.params().tilt_step_rad;
+    for (const float pan : {-1.2F, -0.6F, 0.0F, 0.6F, 1.2F}) {
+      boticelli::stereo::PairPose pose{pan, kLookTilt, kLookTilt - phi};
+      draw(pan, kLookTilt, g_frame);
+      draw(pan, kLookTilt - phi - phi_error, g_frame2);
+      readings.clear();
+      (void)stereo_processor.process(g_frame, g_frame2, pose, readings);
+      (void)fresh.learn(g_frame, pan, kLookTilt);
+      out.obstacles.clear();
+      out.free.clear();
+      (void)fresh.process(g_frame, pan, kLookTilt, out.obstacles, out.free);
+      (void)check.add_view(fresh, pan, kLookTilt, stereo_processor.points().data(),
+                           stereo_processor.points().size());
+    }
+    float ratio = 0.0F;
+    std::size_t n = 0;
+    CHECK(check.median(ratio, n));
+    std::printf(
+        "\n  focal x%.3f, k1 %+.2f, phi %+.4f rad: stereo / floor distance at bases %.3f "
+        "(%zu ratios)",
+        static_cast<double>(focal_scale), static_cast<double>(k1_error),
+        static_cast<double>(phi_error), static_cast<double>(ratio), n);
+    CHECK(n >= 20U);
+    return ratio;
+  };
+  DOUBLES_EQUAL(1.0, look_ratio(1.0F, 0.0F, 0.0F), 0.02);
+  CHECK(look_ratio(1.01F, 0.0F, 0.0F) < 0.97F);                      // focal length 1 % long
+  CHECK(look_ratio(0.99F, 0.0F, 0.0F) > 1.03F);                      // 1 % short
+  CHECK(std::fabs(look_ratio(1.0F, -0.15F, 0.0F) - 1.0F) > 0.03F);   // a lens nobody calibrated
+  CHECK(std::fabs(look_ratio(1.0F, 0.0F, 0.0035F) - 1.0F) > 0.03F);  // the step 0.2° off
+}
+
+// The range check's rules on one walk: only points low on the obstacle (3 cm to 0.5 m above the
+// floor), in the walk's plane, and within [0.6, 1.6] of the base's distance count, and the
+// look's figure is their median.
+TEST(FloorCue, TheRangeCheckCountsLowPointsInTheWalksPlaneAndTakesTheirMedian) {
+  FloorCueParams flat = trusting();
+  flat.vignetting = 0.0F;
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  paint(g_frame, [](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  const FloorColumn& col = fresh.column(fresh.column_count() / 2);
+  CHECK(col.end == FloorColumn::End::kBoundary);
+  // Points along the column's plane at given shares of the base's distance along it.
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  const Eigen::Vector2f c(pose.centre_m.x(), pose.centre_m.y());
+  const Eigen::Vector2f a(std::cos(col.azimuth_rad), std::sin(col.azimuth_rad));
+  const float along = c.dot(a);
+  const float s_base =
+      -along + std::sqrt(along * along - c.squaredNorm() + col.base_rho_m * col.base_rho_m);
+  const float floor_z = -g_rig.params().ptu_height_m;
+  const Eigen::Vector2f side(-a.y(), a.x());
+  const auto at = [&](float share, float height, float aside) {
+    boticelli::stereo::StereoPoint p;
+    const Eigen::Vector2f xy = c + share * s_base * a + aside * side;
+    p.point_ptu_m = Eigen::Vector3f(xy.x(), xy.y(), floor_z + height);
+    return p;
+  };
+  const std::array<boticelli::stereo::StereoPoint, 9> points{
+      at(0.8F, 0.2F, 0.0F),   at(0.95F, 0.1F, 0.0F), at(1.0F, 0.3F, 0.0F),
+      at(1.05F, 0.45F, 0.0F), at(1.3F, 0.2F, 0.0F),  // counted: median 1.0
+      at(1.0F, 0.8F, 0.0F),                          // too high on the obstacle
+      at(1.0F, 0.01F, 0.0F),                         // on the floor
+      at(1.0F, 0.2F, 0.3F),                          // beside the walk's plane
+      at(2.0F, 0.2F, 0.0F)};                         // another object, far behind
+  boticelli::stereo::RangeCheckParams narrow;
+  narrow.lateral_m = 0.001F;  // this column's plane alone (the next is 2 px away)
+  narrow.lateral_per_m = 0.0F;
+  boticelli::stereo::RangeCheck check{g_rig, narrow};
+  check.begin_look();
+  CHECK_EQUAL(5U, check.add_view(fresh, 0.0F, kLookTilt, points.data(), points.size()));
+  float ratio = 0.0F;
+  std::size_t n = 0;
+  CHECK(check.median(ratio, n));
+  CHECK_EQUAL(5U, n);
+  DOUBLES_EQUAL(1.0, ratio, 1e-4);
+  check.begin_look();
+  CHECK_FALSE(check.median(ratio, n));
+  CHECK_EQUAL(0U, n);
 }

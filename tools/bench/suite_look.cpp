@@ -333,6 +333,9 @@ struct WorldStats {
   std::vector<double> render_ms, stereo_ms, target_ms, floor_ms, think_ms;
   std::size_t target_views = 0, target_found = 0, target_far = 0, target_false = 0;
   std::vector<double> target_error_m, target_far_error_m;
+  // The calibration self-check: each look's median ratio of stereo to floor-cue distances at
+  // obstacle bases (looks with at least 10 ratios), and the ratios' count per look.
+  std::vector<double> range_check_ratio, range_check_count;
   std::vector<double> target_across_error_m;  // fixes across pans, target in view
   // Per look, as the mission acts on it: the look's fixes in the mission's TargetTracker.
   std::size_t pose_target_views = 0, pose_target_found = 0, pose_target_confirmed = 0;
@@ -573,6 +576,14 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
     // from its readings (the first look: no prior look's free polygon).
     const std::int64_t t0 = cpu_ns();
     look.end_look(params.limits);
+    {
+      float ratio = 0.0F;
+      std::size_t n = 0;
+      if (look.range_check().median(ratio, n) && n >= 10) {
+        st.range_check_ratio.push_back(static_cast<double>(ratio));
+      }
+      st.range_check_count.push_back(static_cast<double>(n));
+    }
     g_builder.start(params.model, readings.features.span(), readings.floor_obstacles.span(),
                     readings.floor_free.span(), readings.floor_free_near.span(),
                     readings.floor_blocked.span());
@@ -667,6 +678,11 @@ int run_world(const std::string& dir, const std::string& name, std::size_t poses
       .num("target_ms", mean(st.target_ms))
       .num("floor_ms", mean(st.floor_ms))
       .num("think_ms", mean(st.think_ms))
+      .num("range_check_ratio_median", percentile(st.range_check_ratio, 0.5))
+      .num("range_check_ratio_p10", percentile(st.range_check_ratio, 0.1))
+      .num("range_check_ratio_p90", percentile(st.range_check_ratio, 0.9))
+      .integer("range_check_looks", static_cast<std::int64_t>(st.range_check_ratio.size()))
+      .num("range_check_count_mean", mean(st.range_check_count))
       .emit();
   return 0;
 }

@@ -13,11 +13,16 @@ void LookReadings::clear() {
 
 LookProcessor::LookProcessor(const stereo::RigParams& rig, const stereo::StereoParams& stereo,
                              bool keep_blocked_walks)
-    : rig_(rig), stereo_(rig_, stereo), floor_cue_(rig_), keep_blocked_(keep_blocked_walks) {}
+    : rig_(rig),
+      stereo_(rig_, stereo),
+      floor_cue_(rig_),
+      range_check_(rig_),
+      keep_blocked_(keep_blocked_walks) {}
 
 void LookProcessor::begin_look() {
   readings_.clear();
   floor_cue_.begin_look();
+  range_check_.begin_look();
   last_sighting_ = {};
 }
 
@@ -58,6 +63,10 @@ bool LookProcessor::process(ViewPart part, const GrabbedView& view, TargetFixes&
       // The floor cue: learn from the frames that see the floor close in front, then walk
       // the columns; a low pair's second frame sees nearer floor than its first.
       floor(view.first, view.pose.pan_rad, view.pose.first_tilt_rad);
+      if (view.pair) {
+        (void)range_check_.add_view(floor_cue_, view.pose.pan_rad, view.pose.first_tilt_rad,
+                                    stereo_.points().data(), stereo_.points().size());
+      }
       return !(view.pair && view.pose.second_tilt_rad < -0.3F);
     case ViewPart::kFloorSecond:
       floor(view.second, view.pose.pan_rad, view.pose.second_tilt_rad);

@@ -153,6 +153,14 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   [[nodiscard]] double register_cpu_s() const { return register_cpu_s_; }
   // Looks whose feature guard dropped readings because a fixed list was full (0 expected).
   [[nodiscard]] std::uint32_t guard_truncated_looks() const { return guard_truncated_looks_; }
+  // The calibration self-check (stereo::RangeCheck): the median ratio of stereo to floor-cue
+  // distances at obstacle bases over the looks that had enough of them, and how many ratios
+  // that is of (0: none yet).
+  [[nodiscard]] float calibration_ratio() const { return calibration_ratio_; }
+  [[nodiscard]] std::uint32_t calibration_bases() const { return calibration_bases_; }
+  // Set once a look's ratio lay beyond 1 ± kCalibrationTolerance: what the mission log says.
+  [[nodiscard]] bool calibration_suspect() const { return calibration_warned_; }
+  [[nodiscard]] const char* calibration_warning() const { return calibration_text_.c_str(); }
   // The longest single unit of each kind so far [s of host thread CPU].
   [[nodiscard]] double longest_unit_s(Unit unit) const {
     return longest_s_[static_cast<std::size_t>(unit)];
@@ -276,6 +284,15 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   bool look_missed_target_ = false;  // the aimed pair should have seen it and did not
   std::uint32_t last_pieces_ = 0;
   std::uint32_t guard_truncated_looks_ = 0;
+  // A look's range check counts from this many ratios; beyond 1 ± the tolerance the
+  // calibration is reported once (a focal length 1 % off gives about 0.94 or 1.08).
+  static constexpr std::size_t kCalibrationMinBases = 30;
+  static constexpr float kCalibrationTolerance = 0.03F;
+  void check_calibration();
+  float calibration_ratio_ = 0.0F;
+  std::uint32_t calibration_bases_ = 0;
+  bool calibration_warned_ = false;
+  TextBuffer<MissionLogEntry::kMaxTextBytes + 1> calibration_text_;
 
   // Think and plan.
   MapStage map_;

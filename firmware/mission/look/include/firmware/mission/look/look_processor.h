@@ -10,6 +10,7 @@
 #include "algo/evidence/reading.h"
 #include "algo/evidence/reading_limits.h"
 #include "algo/stereo/floor_cue.h"
+#include "algo/stereo/range_check.h"
 #include "algo/stereo/rig.h"
 #include "algo/stereo/stereo_processor.h"
 #include "firmware/mission/look/look_scan.h"
@@ -80,6 +81,9 @@ class LookProcessor {
   [[nodiscard]] const stereo::RigModel& rig() const { return rig_; }
   // Features tracked in the last pair.
   [[nodiscard]] std::uint32_t last_features() const { return last_features_; }
+  // The look's calibration self-check so far: stereo ranges against the floor cue's at the
+  // bases of obstacles (each pair's first frame).
+  [[nodiscard]] stereo::RangeCheck& range_check() { return range_check_; }
 
  private:
   void floor(const image::LowResFrame& frame, float pan_rad, float tilt_rad);
@@ -87,6 +91,7 @@ class LookProcessor {
   stereo::RigModel rig_;
   stereo::StereoProcessor stereo_;
   stereo::FloorCue floor_cue_;
+  stereo::RangeCheck range_check_;
   bool keep_blocked_;
   LookReadings readings_;
   stereo::TargetSighting last_sighting_{};  // this look's latest first frame with the target

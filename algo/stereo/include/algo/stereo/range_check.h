@@ -1,0 +1,59 @@
+// Calibration self-check: stereo ranges against the floor cue's ground-plane ranges at obstacle
+// bases.
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include "algo/stereo/floor_cue.h"
+#include "algo/stereo/rig.h"
+#include "algo/stereo/stereo_processor.h"
+
+namespace boticelli::stereo {
+
+// The stereo reads a range from the parallax left once the tilt step Φ is taken out with the
+// configured focal length, so a focal length or lens a little off scales every stereo range
+// (docs/benchmarks.md, "The realistic camera and rig"). The floor cue's ranges come from the
+// ground plane instead: the camera's height and the ray's elevation. Where a walk of the floor
+// cue ends at an obstacle's base, a stereo point low on that obstacle, in the walk's vertical
+// plane, should be as far along the plane as the base: the ratio of the two distances is 1 for
+// a calibrated camera. The median ratio over a look's pairs says whether the calibration fits
+// what the camera sees.
+struct RangeCheckParams {
+  float min_height_m = 0.03F;    // stereo points this high above the floor ...
+  float max_height_m = 0.5F;     // ... to this high are low on an obstacle [m]
+  float lateral_m = 0.02F;       // off the walk's plane by at most this ...
+  float lateral_per_m = 0.015F;  // ... plus this per metre along it (a column's width) [m/m]
+  float min_base_m = 0.5F;       // bases nearer than this or ...
+  float max_base_m = 3.0F;       // ... farther are not used [m]
+  float min_ratio = 0.6F;        // a ratio outside [min, max] is another object's point
+  float max_ratio = 1.6F;
+};
+
+class RangeCheck {
+ public:
+  static constexpr std::size_t kCapacity = 2048;  // ratios kept per look
+
+  explicit RangeCheck(const RigModel& rig, const RangeCheckParams& params = {})
+      : rig_(rig), params_(params) {}
+  [[nodiscard]] const RangeCheckParams& params() const { return params_; }
+
+  void begin_look() { count_ = 0; }
+  // One view: the floor cue's columns of the pair's first frame (seen at pan, tilt [rad]) and
+  // the pair's stereo points. Adds a ratio for every (boundary, point) that match; returns how
+  // many. Allocation-free; ratios beyond kCapacity are dropped.
+  std::size_t add_view(const FloorCue& cue, float pan_rad, float tilt_rad,
+                       const StereoPoint* points, std::size_t point_count);
+  // The look's median ratio (stereo distance / floor distance) and how many ratios it is of;
+  // false when there are none.
+  bool median(float& ratio, std::size_t& count);
+  [[nodiscard]] std::size_t count() const { return count_; }
+
+ private:
+  const RigModel& rig_;
+  RangeCheckParams params_;
+  std::array<float, kCapacity> ratios_{};
+  std::size_t count_ = 0;
+};
+
+}  // namespace boticelli::stereo
