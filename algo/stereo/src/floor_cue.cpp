@@ -633,18 +633,18 @@ FloorCueResult FloorCue::walk(const image::LowResFrame& frame, float pan_rad, fl
       const long pv = std::lround(pixel.y());
       const long left =
           std::clamp(std::lround(std::floor(pixel.x())), 0L, static_cast<long>(frame.width) - 2);
-      float contrast = 0.0F;
-      float contrast_right = 0.0F;
       const auto row = static_cast<std::uint32_t>(pv);
-      const bool floor_left =
-          looks_like_floor(frame, static_cast<std::uint32_t>(left), row, contrast);
-      const bool floor_right =
-          looks_like_floor(frame, static_cast<std::uint32_t>(left + 1), row, contrast_right);
-      contrast = std::max(contrast, contrast_right);
+      std::array<float, 3> values{};  // the left pixel's, vignetting undone
+      std::array<float, 3> values_right{};
+      pixel_values(frame, static_cast<std::uint32_t>(left), row, values);
+      pixel_values(frame, static_cast<std::uint32_t>(left + 1), row, values_right);
+      const float contrast_left = contrast_to(model_, values);
+      const float contrast_right = contrast_to(model_, values_right);
+      const bool floor_left = contrast_left <= 1.0F;
+      const bool floor_right = contrast_right <= 1.0F;
+      const float contrast = std::max(contrast_left, contrast_right);
       if (textured) {
         walked_point = point;
-        std::array<float, 3> values{};
-        pixel_values(frame, static_cast<std::uint32_t>(left), row, values);
         // One colour: within the change tolerances of the last sample, and within twice them
         // of the stretch's first (a blurred, distant texture drifts; a plain face does not).
         bool same = step > 0;
