@@ -646,6 +646,39 @@ TEST(SavedParameters, ARoundTripThroughTheStateDirectoryKeepsEveryChangedValue) 
   STRCMP_CONTAINS("cannot create", error);
 }
 
+// A parameters text longer than a parameters file may be is refused as too long, with or
+// without the writer thread, and nothing is written or counted.
+TEST(SavedParameters, ATextLongerThanAParametersFileIsRefusedAndNothingIsWritten) {
+  const std::string dir = temp_dir("config");
+  static StateStore store;
+  char error[320] = "";
+  CHECK(store.open(dir.c_str(), error, sizeof error));
+  const std::string longer(ParameterTable::kMaxFileBytes + 1, '#');
+  {
+    StateSaver saver(store);
+    CHECK(saver.submit_parameters(longer) == StateSaver::Submitted::kTooLong);
+    CHECK_EQUAL(0U, saver.parameter_saves());
+    CHECK_EQUAL(0U, saver.parameter_failures());
+  }
+#ifndef BOTICELLI_TESTS_UNDER_EMULATOR
+  {
+    StateSaver saver(store);
+    saver.start();
+    CHECK(saver.submit_parameters(longer) == StateSaver::Submitted::kTooLong);
+    saver.flush();
+    CHECK_EQUAL(0U, saver.parameter_saves());
+  }
+#endif
+  std::FILE* f = std::fopen((dir + "/parameters.conf").c_str(), "r");
+  CHECK(f == nullptr);
+  if (f != nullptr) std::fclose(f);
+  // A text of exactly the file's size is taken.
+  const std::string full(ParameterTable::kMaxFileBytes, '#');
+  StateSaver saver(store);
+  CHECK(saver.submit_parameters(full) == StateSaver::Submitted::kSaved);
+  remove_dir(dir);
+}
+
 #ifndef BOTICELLI_TESTS_UNDER_EMULATOR
 TEST(SavedParameters, TheWriterThreadSavesWhatTheConsoleHandsItWithoutBlockingIt) {
   const std::string dir = temp_dir("config");
