@@ -1492,7 +1492,7 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
         "(%zu ratios)",
         static_cast<double>(focal_scale), static_cast<double>(k1_error),
         static_cast<double>(phi_error), static_cast<double>(ratio), n);
-    CHECK(n >= 20U);
+    CHECK(n >= 5U);
     return ratio;
   };
   DOUBLES_EQUAL(1.0, look_ratio(1.0F, 0.0F, 0.0F), 0.02);

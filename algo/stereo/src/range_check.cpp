@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace boticelli::stereo {
 
@@ -12,15 +13,15 @@ std::size_t RangeCheck::add_view(const FloorCue& cue, float pan_rad, float tilt_
   const float cx = pose.centre_m.x();
   const float cy = pose.centre_m.y();
   const float floor_z = -rig_.params().ptu_height_m;
-  std::size_t added = 0;
-  for (std::size_t i = 0; i < cue.column_count(); ++i) {
+  // The walks' planes: through the optical centre, along the azimuth; the base's distance
+  // along it from the centre, s with |c + s·a| = ρ.
+  std::size_t planes = 0;
+  for (std::size_t i = 0; i < cue.column_count() && planes < planes_.size(); ++i) {
     const FloorColumn& col = cue.column(i);
     if (col.end != FloorColumn::End::kBoundary || col.base_rho_m < params_.min_base_m ||
         col.base_rho_m > params_.max_base_m) {
       continue;
     }
-    // The walk's plane: through the optical centre, along the azimuth; the base's distance
-    // along it from the centre, s with |c + s·a| = ρ.
     const float ax = std::cos(col.azimuth_rad);
     const float ay = std::sin(col.azimuth_rad);
     const float along_c = cx * ax + cy * ay;
@@ -28,22 +29,32 @@ std::size_t RangeCheck::add_view(const FloorCue& cue, float pan_rad, float tilt_
     if (!(disc > 0.0F)) continue;
     const float s_base = -along_c + std::sqrt(disc);
     if (!(s_base > 0.0F)) continue;
-    for (std::size_t k = 0; k < point_count; ++k) {
-      const Eigen::Vector3f& p = points[k].point_ptu_m;
-      const float height = p.z() - floor_z;
-      if (height < params_.min_height_m || height > params_.max_height_m) continue;
-      const float dx = p.x() - cx;
-      const float dy = p.y() - cy;
-      const float s = dx * ax + dy * ay;
+    planes_[planes++] = {ax, ay, s_base};
+  }
+  std::size_t added = 0;
+  for (std::size_t k = 0; k < point_count && count_ < kCapacity; ++k) {
+    const Eigen::Vector3f& p = points[k].point_ptu_m;
+    const float height = p.z() - floor_z;
+    if (height < params_.min_height_m || height > params_.max_height_m) continue;
+    const float dx = p.x() - cx;
+    const float dy = p.y() - cy;
+    // The walk whose plane the point is nearest, within a column's width.
+    float best_lateral = std::numeric_limits<float>::infinity();
+    float best_ratio = 0.0F;
+    for (std::size_t j = 0; j < planes; ++j) {
+      const Plane& w = planes_[j];
+      const float s = dx * w.ax + dy * w.ay;
       if (!(s > 0.0F)) continue;
-      if (std::fabs(dx * ay - dy * ax) > params_.lateral_m + params_.lateral_per_m * s) continue;
-      const float ratio = s / s_base;
-      if (ratio < params_.min_ratio || ratio > params_.max_ratio) continue;
-      if (count_ < kCapacity) {
-        ratios_[count_++] = ratio;
-        ++added;
+      const float lateral = std::fabs(dx * w.ay - dy * w.ax);
+      if (lateral > params_.lateral_m + params_.lateral_per_m * s || lateral >= best_lateral) {
+        continue;
       }
+      best_lateral = lateral;
+      best_ratio = s / w.s_base_m;
     }
+    if (best_ratio < params_.min_ratio || best_ratio > params_.max_ratio) continue;
+    ratios_[count_++] = best_ratio;
+    ++added;
   }
   return added;
 }

@@ -40,7 +40,8 @@ class RangeCheck {
 
   void begin_look() { count_ = 0; }
   // One view: the floor cue's columns of the pair's first frame (seen at pan, tilt [rad]) and
-  // the pair's stereo points. Adds a ratio for every (boundary, point) that match; returns how
+  // the pair's stereo points. Adds one ratio for every point low on an obstacle that lies in
+  // the plane of a walk ending at a base (the walk whose plane it is nearest); returns how
   // many. Allocation-free; ratios beyond kCapacity are dropped.
   std::size_t add_view(const FloorCue& cue, float pan_rad, float tilt_rad,
                        const StereoPoint* points, std::size_t point_count);
@@ -50,8 +51,15 @@ class RangeCheck {
   [[nodiscard]] std::size_t count() const { return count_; }
 
  private:
+  // The walks that end at a base: their plane's direction and the base's distance along it.
+  struct Plane {
+    float ax = 0.0F;
+    float ay = 0.0F;
+    float s_base_m = 0.0F;
+  };
   const RigModel& rig_;
   RangeCheckParams params_;
+  std::array<Plane, FloorCue::kMaxColumns> planes_{};
   std::array<float, kCapacity> ratios_{};
   std::size_t count_ = 0;
 };
