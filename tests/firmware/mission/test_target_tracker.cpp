@@ -161,6 +161,7 @@ TEST(TargetTracker, AConfirmedTargetMissedTwiceInARowIsRevokedAndItsSightingsFor
   CHECK_FALSE(tracker.missed());
   CHECK(tracker.missed());
   CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(0, tracker.misses());  // a target confirmed again starts from none
   UNSIGNED_LONGS_EQUAL(1, tracker.revocations());
   UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
   check_near(other, tracker.candidate_m(), 1e-5F);
@@ -339,4 +340,19 @@ TEST(TargetTracker, ClearForgetsEverything) {
   check_near(Eigen::Vector3f::Zero(), tracker.estimate_m(), 0.0F);
   tracker.add(kTarget, 0.8F, 3);
   CHECK_FALSE(tracker.confirmed());
+}
+
+// A revocation that forgets every sighting leaves nothing of the target: no estimate and no
+// candidate to look at again.
+TEST(TargetTracker, ARevocationThatForgetsEverySightingLeavesNoEstimateNorCandidate) {
+  TargetTrackerParams p;
+  p.revoke_after_misses = 1;
+  tracker.configure(p);
+  tracker.add(kTarget, 0.9F, 1);
+  tracker.add(kTarget, 0.9F, 2);
+  CHECK(tracker.confirmed());
+  CHECK(tracker.missed());
+  UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
+  check_near(Eigen::Vector3f::Zero(), tracker.estimate_m(), 0.0F);
+  check_near(Eigen::Vector3f::Zero(), tracker.candidate_m(), 0.0F);
 }
