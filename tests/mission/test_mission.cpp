@@ -55,6 +55,7 @@ struct MissionRun {
   double calibration_ratio = -1.0;      // the end's `mission calibration` line, −1 if none
   int calibration_bases = 0;
   bool calibration_warned = false;  // the mission log said the calibration is suspect
+  std::string output;               // everything the console wrote
 };
 
 // Runs firmware_main on the sim board with stdout captured; checks the trace against the
@@ -97,6 +98,7 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
     if (b != std::string::npos) run.calibration_bases = std::atoi(text.c_str() + b + 6);
   }
   run.calibration_warned = text.find("calibration suspect") != std::string::npos;
+  run.output = text;
   std::string error;
   run.trace_text = slurp(trace_path);
   if (sim::read_trace(trace_path.c_str(), run.trace, error)) {
@@ -303,6 +305,27 @@ TEST(MissionThesisRoom, ACalibrationOffIsReportedAfterTheFirstLook) {
     CHECK_TEXT(r.calibration_bases >= 30, what.c_str());
     CHECK_TEXT(std::fabs(r.calibration_ratio - 1.0) > 0.03, what.c_str());
   }
+}
+
+// The camera gone for 5 s in the first look (a cable pulled and pushed back): the mission holds,
+// its telemetry says so, and it goes on looking once frames come again.
+TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeAgain) {
+  char dir_template[] = "/tmp/boticelli-faults-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const std::string plan = dir + "/faults.txt";
+  FILE* f = std::fopen(plan.c_str(), "w");
+  CHECK(f != nullptr);
+  std::fputs("3 camera off 5\n", f);
+  std::fclose(f);
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, nullptr,
+                                   {"--faults", plan.c_str(), "--max-cycles", "1"});
+  std::remove(plan.c_str());
+  rmdir(dir.c_str());
+  const std::size_t hold = r.output.find("state=hold");
+  CHECK_TEXT(hold != std::string::npos, r.mission_line.c_str());
+  CHECK_TEXT(r.output.find("state=look", hold) != std::string::npos, r.mission_line.c_str());
+  UNSIGNED_LONGS_EQUAL(0, r.check.collisions);
+  STRCMP_CONTAINS("cycles=1", r.mission_line.c_str());
 }
 
 TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {
