@@ -330,6 +330,13 @@ FloorCueParams trusting() {
   return p;
 }
 
+// The walks' tests' parameters on synthetic frames, drawn without vignetting.
+FloorCueParams flat_trusting() {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.0F;
+  return p;
+}
+
 TEST_GROUP(FloorCue) {
   FloorCue cue{g_rig, trusting()};
   Outputs out;
@@ -871,8 +878,7 @@ TEST(FloorCue, TexturesAgreeOnlyWhenEachHoldsTheOthersColours) {
 // the robot on a rug) is not learned, and neither is the reverse; the same patches all
 // through it are.
 TEST(FloorCue, ARegionIsOneTextureOnlyIfItsNearAndFarHalvesHoldEachOthersColours) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
   const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
@@ -908,8 +914,7 @@ TEST(FloorCue, ARegionIsOneTextureOnlyIfItsNearAndFarHalvesHoldEachOthersColours
 // twice them of the stretch's first: a blurred, distant texture drifts a little from row to
 // row and is not one plain stretch; a frame all of one of the floor's colours is.
 TEST(FloorCue, ADriftingShadeIsNotOnePlainStretchButOneShadeIs) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   fill_patches(g_frame, {24.0F, 40.0F, 56.0F, 72.0F, 88.0F, 104.0F, 120.0F, 136.0F, 152.0F, 168.0F,
@@ -1014,6 +1019,13 @@ void paint(LowResFrame& frame, Colour colour) {
   }
 }
 
+// A plain floor of luma 120 with a wall of 220 across the image from its 45th row up.
+void paint_wall(LowResFrame& frame) {
+  paint(frame, [](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
+  });
+}
+
 // Where pixel (u, v) of the low-resolution image sees the floor, in the PTU frame; false at or
 // above the horizon.
 bool floor_seen_at(const boticelli::stereo::CameraPose& pose, float u, float v,
@@ -1030,8 +1042,7 @@ bool floor_seen_at(const boticelli::stereo::CameraPose& pose, float u, float v,
 // all three channels (3 × 3 × 3 bins, fewer at the histogram's edges), checked bin by bin
 // against a histogram whose colours reach both ends of every channel.
 TEST(FloorCue, ATexturedFloorsShareOfABinIsTheMassOfItAndOfEveryBinNextToIt) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   constexpr std::array<std::array<float, 3>, 5> kColours{{{40.0F, -30.0F, 31.0F},
@@ -1119,8 +1130,7 @@ TEST(FloorCue, VignettingIsUndoneAboutTheImageCentre) {
 // An update by a region exactly like the model leaves it as it was: the histogram and the
 // longest run move by the learning rate towards the region's, which are the same.
 TEST(FloorCue, UpdatingATexturedFloorWithARegionLikeItLeavesItAsItWas) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
@@ -1209,9 +1219,7 @@ TEST(FloorCue, ABoundarysBaseIsHalfAStepBeyondTheLastFloorSample) {
   fresh.reset();
   const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
   // A wall across the image from its 45th row up; floor below.
-  paint(g_frame, [&](std::uint32_t, std::uint32_t v) {
-    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
-  });
+  paint_wall(g_frame);
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   out.obstacles.clear();
   out.free.clear();
@@ -1241,8 +1249,7 @@ TEST(FloorCue, ABoundarysBaseIsHalfAStepBeyondTheLastFloorSample) {
 // A textured floor's luma change (its model's luma tolerance) is half the median step between
 // row neighbours that differ by more than the luma minimum: stripes of 20 and 230 step by 210.
 TEST(FloorCue, ATexturesLumaChangeIsHalfTheMedianStepBetweenNeighbours) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   paint(g_frame, [](std::uint32_t u, std::uint32_t) {
@@ -1286,8 +1293,7 @@ TEST(FloorCue, ABoundaryHalfWayToClearContrastHasEvidenceHalfWayToClear) {
 // is 0 (half the pixels have the median), so the region's median and spread say one colour,
 // though much of it is the other. It is learned as a texture, and all of it is floor.
 TEST(FloorCue, AFloorOfTwoColoursOneOnHalfOfItIsLearnedAsATexture) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   for (const auto& tones : {std::initializer_list<float>{60.0F, 200.0F},
                             std::initializer_list<float>{60.0F, 60.0F, 200.0F}}) {
@@ -1323,8 +1329,7 @@ TEST(FloorCue, CoverageIsWhatTheCentreColumnsBottomAndTopRowsSeeOfTheFloor) {
 // A region that differs from the known floor by more than its tolerances (here 1.5 of them in
 // luma) is not the floor: it does not update the model.
 TEST(FloorCue, ARegionOneAndAHalfTolerancesFromTheKnownFloorIsInconsistent) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   fill_patches(g_frame, {120.0F});
@@ -1339,8 +1344,7 @@ TEST(FloorCue, ARegionOneAndAHalfTolerancesFromTheKnownFloorIsInconsistent) {
 // Two textured regions of the same colours in different proportions confirm a model whose
 // histogram is their average, bin by bin.
 TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheAverageOfTheirHistograms) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue one{g_rig, flat};
   static FloorCue other{g_rig, flat};
   one.reset();
@@ -1367,8 +1371,7 @@ TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheAverageOfTheirHistograms) {
 // A plain floor's update moves its tolerances by the learning rate too: a region of the
 // model's own colour and spread leaves them as they were.
 TEST(FloorCue, AnUpdateByARegionLikeThePlainFloorKeepsItsTolerances) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   fill_patches(g_frame, {120.0F});
@@ -1383,15 +1386,12 @@ TEST(FloorCue, AnUpdateByARegionLikeThePlainFloorKeepsItsTolerances) {
 // Every process() call's columns are its own: a walk to max range says nothing of a base seen
 // by the same column in the frame before.
 TEST(FloorCue, AColumnKeepsNothingFromTheFrameBefore) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   fill_patches(g_frame, {120.0F});
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
-  paint(g_frame2, [](std::uint32_t, std::uint32_t v) {
-    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
-  });
+  paint_wall(g_frame2);
   out.obstacles.clear();
   out.free.clear();
   out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
@@ -1409,8 +1409,7 @@ TEST(FloorCue, AColumnKeepsNothingFromTheFrameBefore) {
 // (the tolerance holds its bound): rows alternating between them are one plain stretch, which
 // ends the free floor within the floor's longest run.
 TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneColourAlongAWalk) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
   fill_patches(g_frame, {40.0F, 60.0F, 80.0F, 100.0F, 120.0F, 140.0F});
@@ -1506,13 +1505,10 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
 // floor), in the walk's plane, and within [0.6, 1.6] of the base's distance count, and the
 // look's figure is their median.
 TEST(FloorCue, TheRangeCheckCountsLowPointsInTheWalksPlaneAndTakesTheirMedian) {
-  FloorCueParams flat = trusting();
-  flat.vignetting = 0.0F;
+  const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
   fresh.reset();
-  paint(g_frame, [](std::uint32_t, std::uint32_t v) {
-    return std::array<float, 3>{v < 45 ? 220.0F : 120.0F, 0.0F, 0.0F};
-  });
+  paint_wall(g_frame);
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   out.obstacles.clear();
   out.free.clear();
