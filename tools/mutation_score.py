@@ -4,7 +4,8 @@
 For each FILE it generates every mutant of a fixed set of operators (below), samples N of them
 with SEED, and for each sampled mutant: writes it into a scratch copy of the tree, builds the
 sim preset's test binaries that cover FILE (tools/mutation_map.txt), runs their ctest entries
-with a timeout and restores the file. A mutant is
+one at a time, cheapest first, up to the first that fails, each with a timeout, and restores the
+file. A mutant is
 
   caught          it built and a test failed
   timed out       it built and a test ran past the timeout (an endless loop; counts as caught)
@@ -308,19 +309,37 @@ class Scratch:
         return self.run(["cmake", "--build", "--preset", "sim", "-j", str(self.jobs), "--target"]
                         + binaries, timeout) == 0
 
-    def test(self, binaries, timeout_s):
-        """'pass', 'fail' or 'timeout': the binaries' ctest entries (one per test group too)."""
+    def entries(self, binaries):
+        """The binaries' ctest entries (the binary's own, or one per test group)."""
         regex = "^(" + "|".join(re.escape(b) for b in binaries) + ")(_[A-Z][A-Za-z]*)?$"
+        listing = subprocess.run(["ctest", "--preset", "sim", "-N", "-R", regex], cwd=self.src,
+                                 capture_output=True, text=True).stdout
+        return re.findall(r"Test\s+#\d+: (\S+)", listing)
+
+    def test_entry(self, name, timeout_s):
+        """'pass', 'fail' or 'timeout' for one ctest entry."""
         out = os.path.join(self.root, "ctest.out")
-        args = ["ctest", "--preset", "sim", "--no-tests=error", "--stop-on-failure", "-R", regex,
+        args = ["ctest", "--preset", "sim", "--no-tests=error", "-R", "^" + re.escape(name) + "$",
                 "--timeout", str(int(timeout_s)), "--output-log", out]
         if os.path.exists(out):
             os.remove(out)
-        rc = self.run(args, timeout=timeout_s * 4 + 60)
+        rc = self.run(args, timeout=timeout_s * 2 + 60)
         text = open(out, encoding="utf-8", errors="replace").read() if os.path.exists(out) else ""
         if rc is None or "***Timeout" in text:
             return "timeout"
         return "pass" if rc == 0 else "fail"
+
+    def test(self, entries):
+        """'pass', 'fail' or 'timeout': each (name, timeout) in turn, up to the first that fails.
+
+        The caller orders them cheapest first, so a mutant that a short test group catches does
+        not cost the long ones (a whole-mission binary's groups take 20 s to 190 s).
+        """
+        for name, timeout_s in entries:
+            status = self.test_entry(name, timeout_s)
+            if status != "pass":
+                return status
+        return "pass"
 
 
 def same_bytes(a, b):
@@ -350,12 +369,21 @@ def score_file(scratch, rel, binaries, args):
     if not scratch.build(binaries, args.build_timeout):
         result.error = "the unmutated tree does not build (see the log)"
         return result
-    t0 = time.monotonic()
-    if scratch.test(binaries, max(args.timeout, 600)) != "pass":
-        result.error = "a test fails on the unmutated tree (see the log)"
+    # The unmutated run, one entry at a time: each entry's time orders the mutants' runs
+    # (cheapest first) and sets its timeout (3x its unmutated run + 10 s, at least --timeout).
+    names = scratch.entries(binaries)
+    if not names:
+        result.error = "no ctest entry for " + ", ".join(binaries)
         return result
-    baseline_s = time.monotonic() - t0
-    timeout_s = max(args.timeout, 3.0 * baseline_s + 10.0)
+    plan = []
+    for name in names:
+        t0 = time.monotonic()
+        if scratch.test_entry(name, max(args.timeout, 1800)) != "pass":
+            result.error = f"{name} fails on the unmutated tree (see the log)"
+            return result
+        seconds = time.monotonic() - t0
+        plan.append((seconds, name, max(args.timeout, 3.0 * seconds + 10.0)))
+    plan = [(name, timeout_s) for _, name, timeout_s in sorted(plan)]
     try:
         for mu in sample:
             t = time.monotonic()
@@ -365,7 +393,7 @@ def score_file(scratch, rel, binaries, args):
                 mu.outcome = "not compiling"
                 result.not_compiling += 1
             else:
-                status = scratch.test(binaries, timeout_s)
+                status = scratch.test(plan)
                 mu.outcome = {"fail": "caught", "pass": "survived", "timeout": "timed out"}[status]
                 if status == "fail":
                     result.caught += 1
