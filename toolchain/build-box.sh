@@ -79,17 +79,20 @@ mkdir -p "$root/etc/systemd/network"
 printf '[Match]\nName=en* eth*\n\n[Network]\nDHCP=ipv4\n' >"$root/etc/systemd/network/10-user.network"
 ln -sf /lib/systemd/system/systemd-networkd.service \
   "$root/etc/systemd/system/multi-user.target.wants/systemd-networkd.service"
-# The robot's devices: vcan as can0, vivid as the webcam, gpio-sim as the header's chip
-# (58 lines like the BCM2711's), i6300esb (a PCI device qemu adds) as the hardware watchdog.
-printf 'vcan\ncan-raw\nvivid\nconfigfs\ngpio-sim\n' >"$root/etc/modules-load.d/boticelli-box.conf"
+# The robot's devices: two SJA1000 CAN controllers on one qemu CAN bus (kvaser_pci, PCI
+# devices qemu adds: can0 the robot's, can1 the ODrive emulator's), vivid as the webcam,
+# gpio-sim as the header's chip (58 lines like the BCM2711's), i6300esb (a PCI device qemu
+# adds) as the hardware watchdog.
+printf 'kvaser_pci\ncan-raw\nvivid\nconfigfs\ngpio-sim\n' >"$root/etc/modules-load.d/boticelli-box.conf"
 printf 'options vivid n_devs=1 node_types=0x1\n' >"$root/etc/modprobe.d/boticelli-box.conf"
 install -m 0755 "$repo/tests/box/box-devices.sh" "$root/usr/local/sbin/box-devices"
 cat >"$root/etc/systemd/system/box-devices.service" <<'UNIT'
-# box-devices.service: makes the box's virtual robot devices (can0, gpiochip0) at boot.
+# box-devices.service: makes the box's virtual robot devices (the ODrives' end of the CAN bus, gpiochip0) at boot.
 [Unit]
-Description=The robot computer in a box: virtual CAN and GPIO
-After=systemd-modules-load.service sys-kernel-config.mount
+Description=The robot computer in a box: the ODrives' CAN controller and GPIO
+After=systemd-modules-load.service sys-kernel-config.mount sys-subsystem-net-devices-can1.device
 Wants=sys-kernel-config.mount
+BindsTo=sys-subsystem-net-devices-can1.device
 Before=boticelli.service boticelli-can0.service
 
 [Service]
@@ -108,10 +111,6 @@ cat >"$root/etc/udev/rules.d/70-boticelli-box.rules" <<'RULES'
 KERNEL=="ttyS1", SUBSYSTEM=="tty", SYMLINK+="ttyAMA0", TAG+="systemd"
 KERNEL=="ttyS2", SUBSYSTEM=="tty", SYMLINK+="ttyUSB0", TAG+="systemd"
 RULES
-# A vcan has no bitrate: the box brings can0 up without one (the unit's only difference).
-mkdir -p "$root/etc/systemd/system/boticelli-can0.service.d"
-printf '[Service]\nExecStart=\nExecStart=/usr/sbin/ip link set can0 up\n' \
-  >"$root/etc/systemd/system/boticelli-can0.service.d/vcan.conf"
 # Journald keeps the journal on disk (the hardware-watchdog check reads the boot before).
 mkdir -p "$root/var/log/journal"
 

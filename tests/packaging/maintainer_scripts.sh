@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Checks the .deb's maintainer scripts. postinst never starts or restarts a unit (installing
+# Checks the .deb's maintainer scripts. preinst makes the groups the udev rule names; postinst never starts or restarts a unit (installing
 # or upgrading must not set the robot driving) but the firmware held after an upgrade. Then runs them against a scratch root
 # (DPKG_ROOT, with deb-systemd-helper's real bookkeeping): the first installation enables the
 # units, an upgrade keeps an administrator's disable, remove and purge leave nothing enabled.
@@ -46,6 +46,22 @@ wants=$root/etc/systemd/system/multi-user.target.wants
 enabled() { [ -L "$wants/$1" ]; }
 fail() { echo "FAIL: $*"; exit 1; }
 
+# preinst makes every group the udev rule names before the rule is unpacked: udev drops a
+# GROUP= it cannot resolve when it reads the rule (at any device event during the unpack) and
+# does not read an unchanged rules directory again on postinst's reload. Here nothing exists
+# yet (getent finds nothing) and the stand-ins write down what was made.
+mkdir -p "$root/fakebin-new"
+printf '#!/bin/sh\nexit 2\n' >"$root/fakebin-new/getent"
+for tool in adduser addgroup; do
+  printf '#!/bin/sh\necho "%s $*" >>"%s"\n' "$tool" "$root/made" >"$root/fakebin-new/$tool"
+done
+chmod +x "$root/fakebin-new/"*
+PATH="$root/fakebin-new:$PATH" sh "$pkg/preinst" install
+for group in $(sed -n 's/.*GROUP="\([^"]*\)".*/\1/p' "$pkg/60-boticelli.rules" | sort -u); do
+  grep -qE "^(addgroup --system $group|adduser --system --group .* $group)\$" "$root/made" ||
+    fail "preinst does not make the group '$group' that 60-boticelli.rules names (made: $(tr '\n' ';' <"$root/made"))"
+done
+
 sh "$pkg/postinst" configure ""
 enabled boticelli.service || fail "first installation did not enable boticelli.service"
 enabled boticelli-can0.service || fail "first installation did not enable boticelli-can0.service"
@@ -70,5 +86,6 @@ sh "$pkg/prerm" remove
 sh "$pkg/postrm" remove
 sh "$pkg/postrm" purge
 enabled boticelli-can0.service && fail "purge left boticelli-can0.service enabled"
-echo "maintainer scripts: nothing started but a held firmware after an upgrade, enable on" \
-  "first install, admin's disable kept on upgrade, purge clean"
+echo "maintainer scripts: the udev rule's groups made before the unpack, nothing started but" \
+  "a held firmware after an upgrade, enable on first install, admin's disable kept on" \
+  "upgrade, purge clean"

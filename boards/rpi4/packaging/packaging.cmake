@@ -73,7 +73,7 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 # libgpiodcxx.so.1 in libgpiod2, there is no libgpiodcxx1 package), and what the
 # maintainer scripts and units call.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libpng16-16 (>= 1.6), libtomlplusplus3 (>= 3.3.0), adduser, systemd, init-system-helpers (>= 1.54~), iproute2, udev")
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libgpiod2 (>= 1.6), libpng16-16 (>= 1.6), libtomlplusplus3 (>= 3.3.0), systemd, init-system-helpers (>= 1.54~), iproute2, udev")
 # The console from a laptop or the robot itself, and CAN bring-up checks (docs/flashing.md).
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "picocom, can-utils")
 # A stripped binary in the package, its debug information in boticelli-dbgsym (a .ddeb):
@@ -82,8 +82,10 @@ set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "picocom, can-utils")
 set(CPACK_DEBIAN_DEBUGINFO_PACKAGE ON)
 set(CPACK_OBJCOPY_EXECUTABLE ${CMAKE_OBJCOPY})
 set(CPACK_READELF_EXECUTABLE ${CMAKE_READELF})
+# preinst creates the service user and the group gpio before the udev rule is unpacked.
+set(CPACK_DEBIAN_PACKAGE_PREDEPENDS "adduser")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
-    ${BOTICELLI_PACKAGING_DIR}/postinst ${BOTICELLI_PACKAGING_DIR}/prerm
+    ${BOTICELLI_PACKAGING_DIR}/preinst ${BOTICELLI_PACKAGING_DIR}/postinst ${BOTICELLI_PACKAGING_DIR}/prerm
     ${BOTICELLI_PACKAGING_DIR}/postrm ${BOTICELLI_PACKAGING_DIR}/conffiles)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 include(CPack)
