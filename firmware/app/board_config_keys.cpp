@@ -49,7 +49,9 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(watchdog_timeout) &&
          s.add(ConfigKey::flag_key("mission", "thesis_planner", c.thesis_planner)) &&
          s.add(ConfigKey::flag_key("mission", "register_looks", c.register_looks)) &&
-         s.add(ConfigKey::number("mission", "floor_range_error", c.floor_range_error, 0.0, 0.3));
+         s.add(ConfigKey::number("mission", "floor_range_error", c.floor_range_error, 0.0, 0.3)) &&
+         s.add(
+             ConfigKey::flag_key("mission", "stereo_self_calibration", c.stereo_self_calibration));
 }
 
 }  // namespace boticelli::firmware

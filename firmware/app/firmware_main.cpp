@@ -461,9 +461,11 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
                 static_cast<double>(m.occupied_m2), m.grid_dropped, m.blacklisted);
   }
   if (mission.calibration_bases() > 0) {
-    console.log(LogLevel::kInfo, "mission calibration stereo_to_floor=%.3f bases=%u",
+    console.log(LogLevel::kInfo,
+                "mission calibration stereo_to_floor=%.3f bases=%u inverse_range_bias_per_m=%.4f",
                 static_cast<double>(mission.calibration_ratio()),
-                static_cast<unsigned>(mission.calibration_bases()));
+                static_cast<unsigned>(mission.calibration_bases()),
+                static_cast<double>(mission.stereo_inverse_range_bias()));
   }
   if (mission.guard_truncated_looks() > 0) {
     console.log(LogLevel::kWarn, "mission guard_truncated_looks=%u (a full list dropped readings)",

@@ -1432,7 +1432,9 @@ TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneColourAlongAWalk) {
 // The calibration self-check on rendered pairs: where the floor cue finds an obstacle's base,
 // the stereo's points low on it are as far along the walk's plane, the ratio's median is 1;
 // frames drawn through a lens whose focal length is longer than configured scale the stereo's
-// distances and not the floor's, and the median shows it. Prints the medians.
+// distances and not the floor's, and the median shows it. The look's inverse-range bias
+// removed from the stereo (its self-calibration), the same look agrees with the floor again,
+// for a focal length off and for a tilt step off. Prints the medians.
 TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagreeing) {
   // Walls and a box wearing camouflage (the shipped worlds' walls do): texture for the stereo.
   const auto textured = [](const char* name, const char* pose, const char* size, int seed) {
@@ -1499,6 +1501,94 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
   CHECK(look_ratio(0.99F, 0.0F, 0.0F) > 1.03F);                      // 1 % short
   CHECK(std::fabs(look_ratio(1.0F, -0.15F, 0.0F) - 1.0F) > 0.03F);   // a lens nobody calibrated
   CHECK(std::fabs(look_ratio(1.0F, 0.0F, 0.0035F) - 1.0F) > 0.03F);  // the step 0.2° off
+  // Self-calibration: the bias the look measured removed, the look is drawn and read again.
+  const auto calibrated_ratio = [&](float focal_scale, float phi_error) {
+    stereo_processor.set_inverse_range_bias(0.0F);
+    (void)look_ratio(focal_scale, 0.0F, phi_error);
+    float bias = 0.0F;
+    std::size_t n = 0;
+    CHECK(check.inverse_bias(bias, n));
+    stereo_processor.set_inverse_range_bias(bias);
+    const float ratio = look_ratio(focal_scale, 0.0F, phi_error);
+    std::printf(" after removing %.4f /m", static_cast<double>(bias));
+    stereo_processor.set_inverse_range_bias(0.0F);
+    return ratio;
+  };
+  DOUBLES_EQUAL(1.0, calibrated_ratio(1.01F, 0.0F), 0.01);
+  DOUBLES_EQUAL(1.0, calibrated_ratio(0.99F, 0.0F), 0.01);
+  DOUBLES_EQUAL(1.0, calibrated_ratio(1.0F, 0.0035F), 0.01);
+}
+
+// The inverse-range bias of the check's pairs: points low on an obstacle, each on the camera's
+// line of sight to a point of the base's vertical plane but read with 1/r̂ = 1/r + b, give b
+// back exactly (the ratio along the plane is r̂/r on a ray from the optical centre).
+TEST(FloorCue, TheRangeChecksInverseBiasIsWhatAStereoBiasAddsToEveryInverseRange) {
+  const FloorCueParams flat = flat_trusting();
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  paint_wall(g_frame);
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  const FloorColumn& col = fresh.column(fresh.column_count() / 2);
+  CHECK(col.end == FloorColumn::End::kBoundary);
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  const Eigen::Vector2f c(pose.centre_m.x(), pose.centre_m.y());
+  const Eigen::Vector2f a(std::cos(col.azimuth_rad), std::sin(col.azimuth_rad));
+  const float along = c.dot(a);
+  const float s_base =
+      -along + std::sqrt(along * along - c.squaredNorm() + col.base_rho_m * col.base_rho_m);
+  const float floor_z = -g_rig.params().ptu_height_m;
+  const auto read = [&](float height, float bias_per_m) {
+    const Eigen::Vector2f xy = c + s_base * a;
+    const Eigen::Vector3f truth(xy.x(), xy.y(), floor_z + height);
+    const Eigen::Vector3f ray = truth - pose.centre_m;
+    const float r = ray.norm();
+    boticelli::stereo::StereoPoint p;
+    p.point_ptu_m = pose.centre_m + ray * (1.0F / (1.0F / r + bias_per_m)) / r;
+    return p;
+  };
+  constexpr float kBias = 0.12F;  // about a focal length 1 % long [1/m]
+  const std::array<boticelli::stereo::StereoPoint, 5> points{read(0.05F, kBias), read(0.15F, kBias),
+                                                             read(0.25F, kBias), read(0.1F, 0.3F),
+                                                             read(0.2F, -0.05F)};
+  boticelli::stereo::RangeCheckParams narrow;
+  narrow.lateral_m = 0.001F;
+  narrow.lateral_per_m = 0.0F;
+  boticelli::stereo::RangeCheck check{g_rig, narrow};
+  check.begin_look();
+  CHECK_EQUAL(5U, check.add_view(fresh, 0.0F, kLookTilt, points.data(), points.size()));
+  float bias = 0.0F;
+  std::size_t n = 0;
+  CHECK(check.inverse_bias(bias, n));
+  CHECK_EQUAL(5U, n);
+  DOUBLES_EQUAL(kBias, bias, 1e-4);
+  float ratio = 0.0F;
+  CHECK(check.median(ratio, n));
+  CHECK(ratio < 0.9F);  // read nearer than the base
+  check.begin_look();
+  CHECK_FALSE(check.inverse_bias(bias, n));
+}
+
+// The self-calibration's step: the look's residual added to the bias in use, from enough pairs,
+// within its bound, and none as small as a calibrated rig's; nothing when it is off.
+TEST(FloorCue, TheSelfCalibrationAddsALooksResidualFromEnoughPairsWithinItsBound) {
+  boticelli::stereo::StereoParams p;
+  p.self_calibration_min_pairs = 30;
+  p.self_calibration_max_bias_per_m = 0.5F;
+  p.self_calibration_min_bias_per_m = 0.025F;
+  using boticelli::stereo::updated_inverse_bias;
+  DOUBLES_EQUAL(0.15, updated_inverse_bias(0.1F, 0.05F, 30, p), 1e-6);
+  DOUBLES_EQUAL(0.05, updated_inverse_bias(0.1F, -0.05F, 500, p), 1e-6);
+  DOUBLES_EQUAL(0.1, updated_inverse_bias(0.1F, 0.05F, 29, p), 1e-6);  // too few pairs
+  DOUBLES_EQUAL(0.5, updated_inverse_bias(0.4F, 0.3F, 30, p), 1e-6);   // held to the bound
+  DOUBLES_EQUAL(-0.5, updated_inverse_bias(-0.4F, -0.3F, 30, p), 1e-6);
+  DOUBLES_EQUAL(0.0, updated_inverse_bias(0.0F, 0.024F, 30, p), 1e-6);  // a calibrated rig's
+  DOUBLES_EQUAL(0.0, updated_inverse_bias(0.05F, -0.03F, 30, p), 1e-6);
+  DOUBLES_EQUAL(-0.025, updated_inverse_bias(0.0F, -0.025F, 30, p), 1e-6);
+  p.self_calibration = false;
+  DOUBLES_EQUAL(0.1, updated_inverse_bias(0.1F, 0.05F, 500, p), 1e-6);
 }
 
 // The range check's rules on one walk: only points low on the obstacle (3 cm to 0.5 m above the

@@ -299,6 +299,16 @@ TEST(Target, CornerIsTriangulatedFromBothFramesOfAPair) {
     const Eigen::Vector3f seen = (fix.point_ptu_m - first_pose.centre_m).normalized();
     const Eigen::Vector3f expected = (truth - first_pose.centre_m).normalized();
     CHECK(seen.dot(expected) > std::cos(1.0F / rig.low_res_camera().focal_px));
+    // With the self-calibration's inverse-range bias in use, the same fix lies on the same
+    // line of sight at 1/r = 1/r̂ − b.
+    processor.set_inverse_range_bias(0.1F);
+    const stereo::TargetFix calibrated = processor.locate_target(frame(), second, pose);
+    processor.set_inverse_range_bias(0.0F);
+    CHECK(calibrated.found);
+    const float r_read = (fix.point_ptu_m - first_pose.centre_m).norm();
+    DOUBLES_EQUAL(1.0F / (1.0F / r_read - 0.1F),
+                  (calibrated.point_ptu_m - first_pose.centre_m).norm(), 1e-3F * r_read);
+    CHECK((calibrated.point_ptu_m - first_pose.centre_m).normalized().dot(seen) > 0.99999F);
   }
 }
 

@@ -106,3 +106,25 @@ TEST(Triangulation, OnePixelOfDisparityMovesTheRangeByLessThanEq37ButMoreThanHal
     CHECK(std::fabs(change) > 0.5F * dr);
   }
 }
+
+// The inverse-range bias removed: the point stays on its line of sight from the optical centre
+// and moves to 1/r = 1/r̂ − b (farther for b > 0, nearer for b < 0); one the bias puts beyond
+// the maximum range, or behind the camera, is refused and left as it was.
+TEST(Triangulation, AnInverseRangeBiasIsRemovedAlongTheLineOfSight) {
+  const Eigen::Vector3f centre(0.05F, -0.02F, 0.1F);
+  const Eigen::Vector3f direction = Eigen::Vector3f(3.0F, 1.0F, -0.5F).normalized();
+  const Eigen::Vector3f read = centre + 2.5F * direction;  // r̂ = 2.5 m
+  for (const float bias : {0.1F, -0.1F, 0.0F}) {
+    Eigen::Vector3f p = read;
+    CHECK(remove_inverse_range_bias(centre, bias, 20.0F, p));
+    const float expected = 1.0F / (1.0F / 2.5F - bias);  // 3.333, 2.0, 2.5 m
+    DOUBLES_EQUAL(expected, (p - centre).norm(), 1e-5);
+    CHECK(((p - centre).normalized() - direction).norm() < 1e-6F);
+  }
+  Eigen::Vector3f p = read;
+  CHECK_FALSE(remove_inverse_range_bias(centre, 0.4F, 20.0F, p));   // 1/r = 0: at infinity
+  CHECK_FALSE(remove_inverse_range_bias(centre, 0.5F, 20.0F, p));   // behind the camera
+  CHECK_FALSE(remove_inverse_range_bias(centre, 0.36F, 20.0F, p));  // 25 m, beyond 20
+  CHECK((p - read).norm() == 0.0F);
+  CHECK(remove_inverse_range_bias(centre, 0.34F, 20.0F, p));  // 16.7 m
+}

@@ -53,19 +53,44 @@ std::size_t RangeCheck::add_view(const FloorCue& cue, float pan_rad, float tilt_
       best_ratio = s / w.s_base_m;
     }
     if (best_ratio < params_.min_ratio || best_ratio > params_.max_ratio) continue;
+    const float range_m = (p - pose.centre_m).norm();
+    inverse_biases_[count_] = (1.0F - best_ratio) / range_m;
     ratios_[count_++] = best_ratio;
     ++added;
   }
   return added;
 }
 
+namespace {
+
+// The median of the first `count` values (reordered); false when there are none.
+template <std::size_t N>
+bool median_of(std::array<float, N>& values, std::size_t count, float& median) {
+  if (count == 0) return false;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(count / 2);
+  std::nth_element(values.begin(), middle, values.begin() + static_cast<std::ptrdiff_t>(count));
+  median = *middle;
+  return true;
+}
+
+}  // namespace
+
+float updated_inverse_bias(float in_use_per_m, float residual_per_m, std::size_t pairs,
+                           const StereoParams& params) {
+  if (!params.self_calibration || pairs < params.self_calibration_min_pairs) return in_use_per_m;
+  const float limit = params.self_calibration_max_bias_per_m;
+  const float bias = std::clamp(in_use_per_m + residual_per_m, -limit, limit);
+  return std::fabs(bias) < params.self_calibration_min_bias_per_m ? 0.0F : bias;
+}
+
 bool RangeCheck::median(float& ratio, std::size_t& count) {
   count = count_;
-  if (count_ == 0) return false;
-  const auto middle = ratios_.begin() + static_cast<std::ptrdiff_t>(count_ / 2);
-  std::nth_element(ratios_.begin(), middle, ratios_.begin() + static_cast<std::ptrdiff_t>(count_));
-  ratio = *middle;
-  return true;
+  return median_of(ratios_, count_, ratio);
+}
+
+bool RangeCheck::inverse_bias(float& bias_per_m, std::size_t& count) {
+  count = count_;
+  return median_of(inverse_biases_, count_, bias_per_m);
 }
 
 }  // namespace boticelli::stereo

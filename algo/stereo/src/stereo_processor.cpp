@@ -99,6 +99,11 @@ std::size_t StereoProcessor::process(const image::LowResFrame& first,
     if (!triangulate(pose1, pose2, point.first_px, point.second_px, point.point_ptu_m)) {
       continue;
     }
+    if (inverse_range_bias_ != 0.0F &&
+        !remove_inverse_range_bias(pose1.centre_m, inverse_range_bias_,
+                                   params_.self_calibration_max_range_m, point.point_ptu_m)) {
+      continue;
+    }
     point.range_camera_m = (point.point_ptu_m - pose1.centre_m).norm();
     if (point.range_camera_m < params_.min_range_m) {
       continue;
@@ -139,6 +144,11 @@ TargetFix StereoProcessor::locate_target(const image::LowResFrame& first,
   }
   if (params_.target_range_from_edges) {
     refine_target_range(first, second, pose1, pose2, fix);
+  }
+  if (inverse_range_bias_ != 0.0F &&
+      !remove_inverse_range_bias(pose1.centre_m, inverse_range_bias_,
+                                 params_.self_calibration_max_range_m, fix.point_ptu_m)) {
+    return fix;
   }
   fix.range_error_m = evidence::range_error_m((fix.point_ptu_m - pose1.centre_m).norm(),
                                               (pose2.centre_m - pose1.centre_m).norm(),

@@ -53,6 +53,17 @@ bool triangulate_fast(const CameraPose& first, const CameraPose& second,
   return true;
 }
 
+bool remove_inverse_range_bias(const Eigen::Vector3f& centre_m, float bias_per_m, float max_range_m,
+                               Eigen::Vector3f& point_m) {
+  const Eigen::Vector3f ray = point_m - centre_m;
+  const float range_m = ray.norm();
+  if (!(range_m > 0.0F)) return false;
+  const float inverse = 1.0F / range_m - bias_per_m;  // 1/r = 1/r̂ − b
+  if (!(inverse > 1.0F / max_range_m)) return false;
+  point_m = centre_m + ray * (1.0F / (inverse * range_m));
+  return true;
+}
+
 evidence::Reading reading_from_point(const Eigen::Vector3f& point_ptu_m, float evidence_m,
                                      const Eigen::Vector3f& view_ptu_m) {
   evidence::Reading reading =

@@ -76,6 +76,7 @@ bool LookProcessor::process(ViewPart part, const GrabbedView& view, TargetFixes&
 }
 
 void LookProcessor::end_look(const evidence::ReadingLimits& limits) {
+  self_calibrate();
   (void)evidence::filter_readings(readings_.features, limits);
   // On a floor the cue knows to be textured, the stereo's floor-level readings are mostly the
   // floor's texture; on a plain floor they are the bases of walls and boxes, kept as the
@@ -83,6 +84,14 @@ void LookProcessor::end_look(const evidence::ReadingLimits& limits) {
   if (floor_cue_.model().valid && floor_cue_.model().textured) {
     (void)evidence::floor_readings(readings_.features, limits);
   }
+}
+
+void LookProcessor::self_calibrate() {
+  float residual = 0.0F;
+  std::size_t n = 0;
+  if (!range_check_.inverse_bias(residual, n)) return;
+  stereo_.set_inverse_range_bias(
+      stereo::updated_inverse_bias(stereo_.inverse_range_bias(), residual, n, stereo_.params()));
 }
 
 Eigen::Vector3f fix_in_world(const core::Pose2& look_pose, const stereo::TargetFix& fix,

@@ -34,6 +34,7 @@ MissionParams make_mission_params(const BoardConfig& c) {
   p.limits = evidence::make_reading_limits(c.ptu_height_m, c.ceiling_height_m, c.max_range_m);
   p.limits.floor_h_m = -c.ptu_height_m;
   p.limits.floor_range_fraction = c.floor_range_error;
+  p.stereo.self_calibration = c.stereo_self_calibration;
 
   // Think: the model's box is the readings' box (so nothing the stereo keeps falls outside).
   mapping::LocalModelParams& m = p.model;

@@ -30,6 +30,14 @@ struct RangeCheckParams {
   float max_ratio = 1.6F;
 };
 
+// The stereo's self-calibration step (StereoParams::self_calibration): the inverse-range bias
+// in use [1/m] plus a look's residual median (RangeCheck::inverse_bias, of points that had the
+// bias in use removed) from `pairs` pairs, held to ±self_calibration_max_bias_per_m, and 0
+// when that is within ±self_calibration_min_bias_per_m (the stereo's own); the bias in use
+// unchanged when it is off or the look has fewer than self_calibration_min_pairs.
+float updated_inverse_bias(float in_use_per_m, float residual_per_m, std::size_t pairs,
+                           const StereoParams& params);
+
 class RangeCheck {
  public:
   static constexpr std::size_t kCapacity = 2048;  // ratios kept per look
@@ -48,6 +56,12 @@ class RangeCheck {
   // The look's median ratio (stereo distance / floor distance) and how many ratios it is of;
   // false when there are none.
   bool median(float& ratio, std::size_t& count);
+  // The look's median inverse-range bias b [1/m]: the stereo's 1/r̂ less the floor's 1/r along
+  // the same line of sight, (1 − ratio)/r̂ for each ratio (a point on the camera's ray at
+  // ratio × the base's distance along the walk's plane is at ratio × its true range). A
+  // focal length or tilt step a little off adds about the same b to every inverse range
+  // (StereoProcessor::set_inverse_range_bias); false when there is no ratio.
+  bool inverse_bias(float& bias_per_m, std::size_t& count);
   [[nodiscard]] std::size_t count() const { return count_; }
 
  private:
@@ -61,6 +75,7 @@ class RangeCheck {
   RangeCheckParams params_;
   std::array<Plane, FloorCue::kMaxColumns> planes_{};
   std::array<float, kCapacity> ratios_{};
+  std::array<float, kCapacity> inverse_biases_{};  // (1 − ratio) / r̂ of the same pairs [1/m]
   std::size_t count_ = 0;
 };
 

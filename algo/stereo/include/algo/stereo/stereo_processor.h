@@ -46,6 +46,22 @@ struct StereoParams {
   // many pixels (at the point's range) of each other, a mismatch between the two rows the
   // vertex was found at.
   float target_across_max_gap_px = 1.5F;
+  // Self-calibration from the floor (RangeCheck::inverse_bias): after each look whose check
+  // has at least self_calibration_min_pairs pairs, the look's median inverse-range bias is
+  // added to the one in use (set_inverse_range_bias), which the tilt pairs' points and target
+  // fixes then have removed (remove_inverse_range_bias); |b| is held to
+  // self_calibration_max_bias_per_m. Off: the ranges as the configured rig gives them.
+  bool self_calibration = true;
+  std::size_t self_calibration_min_pairs = 30;
+  float self_calibration_max_bias_per_m = 0.5F;  // [1/m]: 1/r̂ off by this at most
+  // A bias below this is the stereo's own (a calibrated rig's looks give ±0.01 m⁻¹, the
+  // check's ratio within 1 ± 0.02) and is not removed: 0.025 m⁻¹ is a focal length about
+  // 0.5 % off on the 0.21 m lever. The far ranges that matter in a long room are where a
+  // small inverse bias moves points most (a calibrated rig corrected by −0.0095 m⁻¹ lost the
+  // corridor at seed 1).
+  float self_calibration_min_bias_per_m = 0.025F;  // [1/m]
+  // A point the bias puts beyond this is dropped (its parallax is the bias's) [m].
+  float self_calibration_max_range_m = 20.0F;
 };
 
 // Where the PTU was for the two frames [rad]: same pan; the second frame after tilting
@@ -96,6 +112,10 @@ class StereoProcessor {
   explicit StereoProcessor(const RigModel& rig, const StereoParams& params = {});
   [[nodiscard]] const RigModel& rig() const { return rig_; }
   [[nodiscard]] const StereoParams& params() const { return params_; }
+  // The inverse-range bias b [1/m] removed from every tilt pair's point and target fix from
+  // now on (remove_inverse_range_bias; 0: none, the ranges as triangulated).
+  void set_inverse_range_bias(float bias_per_m) { inverse_range_bias_ = bias_per_m; }
+  [[nodiscard]] float inverse_range_bias() const { return inverse_range_bias_; }
 
   // Averages the two YUYV frames (full resolution, as the rig's camera) by the rig's
   // downsample factor into first_frame()/second_frame(), then process()es them.
@@ -154,6 +174,7 @@ class StereoProcessor {
   core::FixedVector<image::Feature, kMaxPoints> features_;
   core::FixedVector<StereoPoint, kMaxPoints> points_;
   std::array<float, 512> edge_rho_{};  // the target's edge distances [m]
+  float inverse_range_bias_ = 0.0F;    // [1/m]
 };
 
 }  // namespace boticelli::stereo

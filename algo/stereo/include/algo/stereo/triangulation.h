@@ -25,6 +25,16 @@ bool triangulate_fast(const CameraPose& first, const CameraPose& second,
                       const Eigen::Vector2f& normalized1, const Eigen::Vector2f& normalized2,
                       Eigen::Vector3f& point_camera1_m);
 
+// A tilt pair's range is the parallax left once the tilt step Φ is taken out with the
+// configured focal length: a focal length f·s or a step Φ·k a little off leaves a parallax of
+// about (s − 1)·f·Φ (or (k − 1)·f·Φ) on every point, which adds the same b to every inverse
+// range, 1/r̂ = 1/r + b (b ≈ (s − 1)/L for a lever arm L: 0.048 m⁻¹ for 1 % and L = 0.21 m,
+// 3 m read as 2.6 m). This moves point_m along its line of sight from centre_m to the range r
+// of 1/r = 1/r̂ − b. False (point_m untouched) when that is beyond max_range_m or behind the
+// camera (1/r̂ ≤ b + 1/max_range_m): what the bias says is farther than anything measured.
+bool remove_inverse_range_bias(const Eigen::Vector3f& centre_m, float bias_per_m, float max_range_m,
+                               Eigen::Vector3f& point_m);
+
 // A PTU-frame point as a Reading about the PTU centre (§4.5.2): α = atan2(y, x) in [0, 2π),
 // h = z, r = |p|; m is the evidence (Eq 3.8); seen from view_ptu_m (the camera's optical
 // centre, PTU frame; Reading::view_*).

@@ -96,6 +96,11 @@ struct BoardConfig {
   // the floor within this range error (a fraction of the range; evidence::floor_readings);
   // deeper ones are refused. 0: off, the thesis's readings ([mission] floor_range_error).
   float floor_range_error = 0.05F;
+  // The stereo calibrates itself from the floor: each look's calibration self-check (stereo
+  // against floor-cue distances at obstacle bases) gives the inverse-range bias a focal length
+  // or tilt step a little off adds, and the next looks' tilt pairs have it removed
+  // (StereoParams::self_calibration; [mission] stereo_self_calibration).
+  bool stereo_self_calibration = true;
 };
 
 }  // namespace boticelli::firmware

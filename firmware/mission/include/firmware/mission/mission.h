@@ -158,6 +158,10 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // that is of (0: none yet).
   [[nodiscard]] float calibration_ratio() const { return calibration_ratio_; }
   [[nodiscard]] std::uint32_t calibration_bases() const { return calibration_bases_; }
+  // The stereo's self-calibration in use: the inverse-range bias removed [1/m].
+  [[nodiscard]] float stereo_inverse_range_bias() const {
+    return look_.stereo().inverse_range_bias();
+  }
   // Set once a look's ratio lay beyond 1 ± kCalibrationTolerance: what the mission log says.
   [[nodiscard]] bool calibration_suspect() const { return calibration_warned_; }
   [[nodiscard]] const char* calibration_warning() const { return calibration_text_.c_str(); }

@@ -60,13 +60,16 @@ class LookProcessor {
   // A new look: its lists emptied, the floor cue's frames from the last look (seen from
   // elsewhere) forgotten, no sighting carried over to pair across pans.
   void begin_look();
-  // A new mission: begin_look() and nothing learnt about the floor either.
+  // A new mission: begin_look() and nothing learnt about the floor either. The stereo's
+  // self-calibration is the rig's and is kept.
   void reset();
   // One part of a view; true when the view is done. kTarget fills `fixes` (else untouched).
   bool process(ViewPart part, const GrabbedView& view, TargetFixes& fixes);
-  // The look is complete: drops the features outside the reading limits and, on a floor the
-  // floor cue knows to be textured, makes those of the floor itself free
-  // (evidence::floor_readings): the Think stage's input.
+  // The look is complete: the stereo's self-calibration takes the look's range check
+  // (StereoParams::self_calibration: the next looks' tilt pairs have the bias removed), then
+  // drops the features outside the reading limits and, on a floor the floor cue knows to be
+  // textured, makes those of the floor itself free (evidence::floor_readings): the Think
+  // stage's input.
   void end_look(const evidence::ReadingLimits& limits);
   // A recorded look replayed (the look regression tests): begin_look(), and the caller fills
   // the lists returned in place of process(); end_look() then as for a look taken.
@@ -87,6 +90,7 @@ class LookProcessor {
 
  private:
   void floor(const image::LowResFrame& frame, float pan_rad, float tilt_rad);
+  void self_calibrate();
 
   stereo::RigModel rig_;
   stereo::StereoProcessor stereo_;
