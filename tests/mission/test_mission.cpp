@@ -307,8 +307,29 @@ TEST(MissionThesisRoom, ACalibrationOffIsReportedAfterTheFirstLook) {
   }
 }
 
+namespace {
+// The operator pauses the mission at 31 s of simulated time and resumes it at 33 s: later
+// than the device retry time (30 s) after the mission began.
+struct PauseScript {
+  int console_fd = -1;
+  int typed = 0;
+};
+void on_frame_pause(void* context) {
+  auto* p = static_cast<PauseScript*>(context);
+  const std::uint64_t now = g_board.sim().now_us();
+  const char* text = p->typed == 0 && now >= 31000000U   ? "pause\r"
+                     : p->typed == 1 && now >= 33000000U ? "resume\r"
+                                                         : nullptr;
+  if (text == nullptr) return;
+  CHECK(write(p->console_fd, text, std::strlen(text)) == static_cast<ssize_t>(std::strlen(text)));
+  ++p->typed;
+}
+}  // namespace
+
 // The camera gone for 5 s in the first look (a cable pulled and pushed back): the mission holds,
-// its telemetry says so, and it goes on looking once frames come again.
+// its telemetry says so, and it goes on looking once frames come again. A pause and resume by
+// the operator afterwards is a hold of its own: the device hold is over, so it does not count
+// the time since the camera's fault and give up.
 TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeAgain) {
   char dir_template[] = "/tmp/boticelli-faults-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
@@ -317,13 +338,26 @@ TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeA
   CHECK(f != nullptr);
   std::fputs("3 camera off 5\n", f);
   std::fclose(f);
-  const MissionRun r = run_mission("thesis_room", "1", 0.0F, nullptr,
-                                   {"--faults", plan.c_str(), "--max-cycles", "1"});
+  int console[2] = {-1, -1};
+  CHECK(pipe(console) == 0);
+  PauseScript pause;
+  pause.console_fd = console[1];
+  boticelli::firmware::MainHooks hooks;
+  hooks.after_frame = on_frame_pause;
+  hooks.context = &pause;
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks,
+                                   {"--faults", plan.c_str(), "--max-cycles", "1"}, console[0]);
+  close(console[0]);
+  close(console[1]);
   std::remove(plan.c_str());
   rmdir(dir.c_str());
   const std::size_t hold = r.output.find("state=hold");
   CHECK_TEXT(hold != std::string::npos, r.mission_line.c_str());
-  CHECK_TEXT(r.output.find("state=look", hold) != std::string::npos, r.mission_line.c_str());
+  const std::size_t looking = r.output.find("state=look", hold);
+  CHECK_TEXT(looking != std::string::npos, r.mission_line.c_str());
+  CHECK_EQUAL(2, pause.typed);
+  CHECK_TEXT(r.output.find("state=hold", looking) != std::string::npos, "held by the pause");
+  CHECK_TEXT(r.mission_line.find("result=aborted") == std::string::npos, r.mission_line.c_str());
   UNSIGNED_LONGS_EQUAL(0, r.check.collisions);
   STRCMP_CONTAINS("cycles=1", r.mission_line.c_str());
 }
