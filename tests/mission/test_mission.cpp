@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -706,6 +707,10 @@ struct KilledAndResumed {
   int child_status = 0;
   double estimate_off_m = -1.0, estimate_off_rad = -1.0;
   double saved_off_m = -1.0, saved_off_rad = -1.0;
+  // The turn the resumed pose was carried on by [rad] (its first anchored estimate less the
+  // saved heading), and what the mission log says of it [deg] (NaN without the line).
+  double moved_rad = 0.0;
+  double logged_moved_deg = std::numeric_limits<double>::quiet_NaN();
   std::string log;
 };
 KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir) {
@@ -760,6 +765,21 @@ KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir) {
                                static_cast<double>(saved.pose.y_m) - ty);
   out.saved_off_rad = std::fabs(
       std::remainder(static_cast<double>(saved.pose.yaw_rad) - tyaw, 2.0 * std::numbers::pi));
+  out.moved_rad =
+      std::remainder(f[12] - static_cast<double>(saved.pose.yaw_rad), 2.0 * std::numbers::pi);
+  // The resumed run's state: its mission log says how far the wheels carried the pose.
+  static boticelli::firmware::MissionState after;
+  if (store.load(after, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded) {
+    for (const boticelli::firmware::MissionLogEntry& e : after.log) {
+      const char* at = std::strstr(e.text.data(), "resumed pose moved on by the wheels: ");
+      double metres = 0.0;
+      double degrees = 0.0;
+      if (at != nullptr && std::sscanf(at, "resumed pose moved on by the wheels: %lf m, %lf deg",
+                                       &metres, &degrees) == 2) {
+        out.logged_moved_deg = degrees;
+      }
+    }
+  }
   return out;
 }
 
@@ -802,5 +822,7 @@ TEST(MissionResume, KilledMidTurnItResumesWithinOneDegreeOfTheRobotsHeading) {
              (std::to_string(r.estimate_off_m) + " m off: " + r.log).c_str());
   CHECK_TEXT(r.estimate_off_rad <= 1.0 * std::numbers::pi / 180.0,
              std::to_string(r.estimate_off_rad).c_str());
+  // The mission log tells the operator the turn in degrees, as the pose took it.
+  DOUBLES_EQUAL(r.moved_rad * 180.0 / std::numbers::pi, r.logged_moved_deg, 0.1);
 }
 #endif  // BOTICELLI_TESTS_UNDER_EMULATOR
