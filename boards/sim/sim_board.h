@@ -76,6 +76,10 @@ class SimBoard final : public firmware::Board,
   // ---- sim-only: ground truth and scripting (valid after a successful init) ----
   hal::sim::SimWorld& sim() { return sim_; }  // true pose, collisions, target, e-stop script
   const hal::sim::World& world() const { return world_; }
+  // The target taken away (its paper removed from the wall): from the next frame on the
+  // renderer draws its face as the surface's own. The world's target point stays, the truth
+  // the trace is checked against; the next init() loads the world as its file has it.
+  void remove_target() { world_.surfaces[world_.target_surface].target_face = hal::sim::kNoFace; }
   hal::sim::CameraSim& camera() { return camera_; }  // depth of the last frame, its pose
   const hal::sim::Renderer& renderer() const { return renderer_; }
   // The rig the simulator draws and moves: the configured one with [sim]'s optics errors.

@@ -126,6 +126,14 @@ void trace_odometry(const std::string& text, bool last, double odo[3], int first
   }
 }
 
+// Removes a mission's state directory: its two state copies and the sim world's truth file.
+void remove_state_dir(const std::string& dir) {
+  for (const char* name : {"/mission.state.a", "/mission.state.b", "/sim-world.truth"}) {
+    std::remove((dir + name).c_str());
+  }
+  rmdir(dir.c_str());
+}
+
 void check_found_safely(const MissionRun& r) {
   CHECK_EQUAL_TEXT(0, r.exit_code, r.mission_line.c_str());
   STRCMP_CONTAINS("MISSION result=found", r.mission_line.c_str());
@@ -363,6 +371,66 @@ TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeA
   STRCMP_CONTAINS("cycles=1", r.mission_line.c_str());
 }
 
+namespace {
+// Takes the target away once the robot is within 1.2 m of it (on its way to the stand-off,
+// 0.75 m, after the target was confirmed from two places).
+struct TakeTarget {
+  bool removed = false;
+};
+void on_frame_take_target(void* context) {
+  auto* t = static_cast<TakeTarget*>(context);
+  if (t->removed) return;
+  const boticelli::core::Pose2 p = g_board.robot_pose();
+  const Eigen::Vector3f target = g_board.target_m();
+  if (std::hypot(p.x_m - target.x(), p.y_m - target.y()) < 1.2F) {
+    g_board.remove_target();
+    t->removed = true;
+  }
+}
+}  // namespace
+
+// A confirmed target that is gone when the robot reaches its stand-off is not found: the
+// glance from the stand-off misses it (one miss, the aimed pair's), the next look's aimed pair
+// misses it again and revokes it, and the mission goes on without it.
+TEST(MissionThesisRoom, AConfirmedTargetGoneWhenTheRobotArrivesIsMissedThenRevokedNotFound) {
+  char dir_template[] = "/tmp/boticelli-gone-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  TakeTarget take;
+  boticelli::firmware::MainHooks hooks;
+  hooks.after_frame = on_frame_take_target;
+  hooks.context = &take;
+  const MissionRun r =
+      run_mission("thesis_room", "1", 0.0F, &hooks, {"--state", dir.c_str(), "--max-cycles", "20"});
+  static boticelli::firmware::MissionState state;
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  const bool loaded =
+      store.open(dir.c_str(), error, sizeof error) &&
+      store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  remove_state_dir(dir);
+  CHECK_TEXT(loaded, error);
+  CHECK(take.removed);
+  CHECK_TEXT(r.telemetry_confirmed, r.mission_line.c_str());
+  CHECK_TEXT(r.mission_line.find("result=found") == std::string::npos, r.mission_line.c_str());
+  UNSIGNED_LONGS_EQUAL(0, r.check.collisions);
+  // The mission log: the stand-off's miss, then the revocation.
+  std::string first_standoff;
+  bool revoked = false;
+  std::string entries;
+  for (const boticelli::firmware::MissionLogEntry& e : state.log) {
+    const std::string text = e.text.data();
+    entries += text + " | ";
+    if (first_standoff.empty() && text.find("stand-off") != std::string::npos &&
+        text.find("at the target's stand-off") == std::string::npos) {
+      first_standoff = text;
+    }
+    revoked = revoked || text.find("revoked") != std::string::npos;
+  }
+  STRCMP_CONTAINS_TEXT("target not seen from its stand-off", first_standoff.c_str(),
+                       entries.c_str());
+  CHECK_TEXT(revoked, entries.c_str());
+}
+
 TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {
   for (const char* world : {"box_in_cylindrical_room", "box_in_rectangular_room", "cluttered_room",
                             "corridor", "cylindrical_room", "cylindrical_room_offcentre",
@@ -597,10 +665,7 @@ TEST(MissionResume, WhileDrivingThePoseIsSavedAtLeastEverySecond) {
   // A frame of slack: the save is due once a second has passed since the last.
   CHECK_TEXT(watch.worst_gap_moving_us <= 1010000U,
              std::to_string(watch.worst_gap_moving_us).c_str());
-  std::remove((watch.dir + "/mission.state.a").c_str());
-  std::remove((watch.dir + "/mission.state.b").c_str());
-  std::remove((watch.dir + "/sim-world.truth").c_str());
-  rmdir(watch.dir.c_str());
+  remove_state_dir(watch.dir);
 }
 
 // Stopped after three cycles and started again with --resume: the robot is put back where it
@@ -783,12 +848,6 @@ KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir) {
   return out;
 }
 
-void remove_state_dir(const std::string& dir) {
-  for (const char* name : {"/mission.state.a", "/mission.state.b", "/sim-world.truth"}) {
-    std::remove((dir + name).c_str());
-  }
-  rmdir(dir.c_str());
-}
 }  // namespace
 
 // Killed mid-drive at full speed: the last pose saved is up to a second old, and the wheels
