@@ -159,6 +159,10 @@ bx 'sudo install -m 0755 /tmp/boticelli-box-devices /usr/local/bin/ &&
 # ---------------------------------------------------------------------------------------
 # Helpers of the checks.
 unit_prop() { bx systemctl show -P "$1" boticelli.service || echo "(no answer)"; }
+# The firmware process PID's real-time set-up line in the journal (empty if it has none).
+startup_line() { # PID
+  bx sudo journalctl -u boticelli "_PID=$1" --no-pager -o cat 2>&1 | grep -m1 'realtime: ' || true
+}
 main_pid() { unit_prop MainPID; }
 active_state() { unit_prop ActiveState; }
 # Frames the firmware sends the ODrives that make the wheels turn, over SECONDS (candump -L:
@@ -301,7 +305,7 @@ fi
 # overruns' warnings can fill the last ten lines -f starts with within a second.)
 pid=$(main_pid)
 follow=$(bx timeout 5 sudo journalctl -u boticelli -f --no-pager 2>&1 || true)
-startup=$(bx sudo journalctl -u boticelli "_PID=$pid" --no-pager -o cat 2>&1 | grep -m1 'realtime: ' || true)
+startup=$(startup_line "$pid")
 if ! grep -q "boticelli\[$pid\]: " <<<"$follow"; then
   fail journal_follow_shows_startup "no line of the firmware (pid $pid) in 5 s of journalctl -u boticelli -f: $(tail -n 3 <<<"$follow" | tr '\n' ' ')"
 elif [ -z "$startup" ]; then
@@ -533,7 +537,7 @@ pid=$(main_pid)
 if bx sudo systemctl restart boticelli 2>"$work/restart.err" && wait_running 30 "$pid"; then
   new_pid=$(main_pid)
   last20=$(bx sudo journalctl -u boticelli -n 20 --no-pager 2>&1 || true)
-  startup=$(bx sudo journalctl -u boticelli "_PID=$new_pid" --no-pager -o cat 2>&1 | grep -m1 'realtime: ' || true)
+  startup=$(startup_line "$new_pid")
   if ! grep -q "boticelli\[$new_pid\]: " <<<"$last20"; then
     fail restart_as_documented "restarted (pid $new_pid), but journalctl -u boticelli -n 20 has none of its lines: $(tail -n 3 <<<"$last20" | tr '\n' ' ')"
   elif [ -z "$startup" ]; then

@@ -126,6 +126,23 @@ void trace_odometry(const std::string& text, bool last, double odo[3], int first
   }
 }
 
+// The thesis room at seed 1 with an operator: `after_frame` runs after every frame with
+// `script`, whose console_fd is the write end of the console's stdin (set here).
+template <class Script>
+MissionRun run_mission_typing(Script& script, void (*after_frame)(void*),
+                              const std::vector<const char*>& extra) {
+  int console[2] = {-1, -1};
+  CHECK(pipe(console) == 0);
+  script.console_fd = console[1];
+  boticelli::firmware::MainHooks hooks;
+  hooks.after_frame = after_frame;
+  hooks.context = &script;
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks, extra, console[0]);
+  close(console[0]);
+  close(console[1]);
+  return r;
+}
+
 // Removes a mission's state directory: its two state copies and the sim world's truth file.
 void remove_state_dir(const std::string& dir) {
   for (const char* name : {"/mission.state.a", "/mission.state.b", "/sim-world.truth"}) {
@@ -347,17 +364,9 @@ TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeA
   CHECK(f != nullptr);
   std::fputs("3 camera off 5\n", f);
   std::fclose(f);
-  int console[2] = {-1, -1};
-  CHECK(pipe(console) == 0);
   PauseScript pause;
-  pause.console_fd = console[1];
-  boticelli::firmware::MainHooks hooks;
-  hooks.after_frame = on_frame_pause;
-  hooks.context = &pause;
-  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks,
-                                   {"--faults", plan.c_str(), "--max-cycles", "1"}, console[0]);
-  close(console[0]);
-  close(console[1]);
+  const MissionRun r =
+      run_mission_typing(pause, on_frame_pause, {"--faults", plan.c_str(), "--max-cycles", "1"});
   std::remove(plan.c_str());
   rmdir(dir.c_str());
   const std::size_t hold = r.output.find("state=hold");
@@ -564,16 +573,8 @@ void on_frame_estop(void* context) {
 }
 
 TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndResume) {
-  int console[2] = {-1, -1};
-  CHECK(pipe(console) == 0);
   EstopScript e;
-  e.console_fd = console[1];
-  boticelli::firmware::MainHooks hooks;
-  hooks.after_frame = on_frame_estop;
-  hooks.context = &e;
-  const MissionRun r = run_mission("thesis_room", "1", 0.0F, &hooks, {}, console[0]);
-  close(console[0]);
-  close(console[1]);
+  const MissionRun r = run_mission_typing(e, on_frame_estop, {});
   CHECK_EQUAL(EstopScript::kResumed, e.phase);
   CHECK_TEXT(e.frames_to_stop >= 1 && e.frames_to_stop <= 1, "the base stops within one frame");
   // Not a millimetre while pressed, in the 5 s after the release (no reset) and in the 2 s

@@ -1519,44 +1519,65 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
   DOUBLES_EQUAL(1.0, calibrated_ratio(1.0F, 0.0035F), 0.01);
 }
 
+// One walk of a learned flat floor up to a painted wall, the column in the middle of the frame
+// (the cue is left with the frame processed into `out`, for RangeCheck::add_view): the optical
+// centre's position on the floor c, the walk's direction a, the base's distance along it from
+// c, and the floor's height, PTU frame.
+struct WalkToAWall {
+  boticelli::stereo::CameraPose pose;
+  Eigen::Vector2f c = Eigen::Vector2f::Zero();
+  Eigen::Vector2f a = Eigen::Vector2f::Zero();
+  float s_base_m = 0.0F;
+  float floor_z_m = 0.0F;
+};
+WalkToAWall walk_to_a_wall(FloorCue& cue, Outputs& out) {
+  cue.reset();
+  paint_wall(g_frame);
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = cue.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  const FloorColumn& col = cue.column(cue.column_count() / 2);
+  CHECK(col.end == FloorColumn::End::kBoundary);
+  WalkToAWall w;
+  w.pose = g_rig.camera_pose(0.0F, kLookTilt);
+  w.c = Eigen::Vector2f(w.pose.centre_m.x(), w.pose.centre_m.y());
+  w.a = Eigen::Vector2f(std::cos(col.azimuth_rad), std::sin(col.azimuth_rad));
+  const float along = w.c.dot(w.a);
+  w.s_base_m =
+      -along + std::sqrt(along * along - w.c.squaredNorm() + col.base_rho_m * col.base_rho_m);
+  w.floor_z_m = -g_rig.params().ptu_height_m;
+  return w;
+}
+
+// The range check taking the plane of the walk_to_a_wall column alone (the next is 2 px away).
+boticelli::stereo::RangeCheckParams one_plane() {
+  boticelli::stereo::RangeCheckParams p;
+  p.lateral_m = 0.001F;
+  p.lateral_per_m = 0.0F;
+  return p;
+}
+
 // The inverse-range bias of the check's pairs: points low on an obstacle, each on the camera's
 // line of sight to a point of the base's vertical plane but read with 1/r̂ = 1/r + b, give b
 // back exactly (the ratio along the plane is r̂/r on a ray from the optical centre).
 TEST(FloorCue, TheRangeChecksInverseBiasIsWhatAStereoBiasAddsToEveryInverseRange) {
-  const FloorCueParams flat = flat_trusting();
-  static FloorCue fresh{g_rig, flat};
-  fresh.reset();
-  paint_wall(g_frame);
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
-  out.obstacles.clear();
-  out.free.clear();
-  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
-  const FloorColumn& col = fresh.column(fresh.column_count() / 2);
-  CHECK(col.end == FloorColumn::End::kBoundary);
-  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
-  const Eigen::Vector2f c(pose.centre_m.x(), pose.centre_m.y());
-  const Eigen::Vector2f a(std::cos(col.azimuth_rad), std::sin(col.azimuth_rad));
-  const float along = c.dot(a);
-  const float s_base =
-      -along + std::sqrt(along * along - c.squaredNorm() + col.base_rho_m * col.base_rho_m);
-  const float floor_z = -g_rig.params().ptu_height_m;
+  static FloorCue fresh{g_rig, flat_trusting()};
+  const WalkToAWall w = walk_to_a_wall(fresh, out);
   const auto read = [&](float height, float bias_per_m) {
-    const Eigen::Vector2f xy = c + s_base * a;
-    const Eigen::Vector3f truth(xy.x(), xy.y(), floor_z + height);
-    const Eigen::Vector3f ray = truth - pose.centre_m;
+    const Eigen::Vector2f xy = w.c + w.s_base_m * w.a;
+    const Eigen::Vector3f truth(xy.x(), xy.y(), w.floor_z_m + height);
+    const Eigen::Vector3f ray = truth - w.pose.centre_m;
     const float r = ray.norm();
     boticelli::stereo::StereoPoint p;
-    p.point_ptu_m = pose.centre_m + ray * (1.0F / (1.0F / r + bias_per_m)) / r;
+    p.point_ptu_m = w.pose.centre_m + ray * (1.0F / (1.0F / r + bias_per_m)) / r;
     return p;
   };
   constexpr float kBias = 0.12F;  // about a focal length 1 % long [1/m]
   const std::array<boticelli::stereo::StereoPoint, 5> points{read(0.05F, kBias), read(0.15F, kBias),
                                                              read(0.25F, kBias), read(0.1F, 0.3F),
                                                              read(0.2F, -0.05F)};
-  boticelli::stereo::RangeCheckParams narrow;
-  narrow.lateral_m = 0.001F;
-  narrow.lateral_per_m = 0.0F;
-  boticelli::stereo::RangeCheck check{g_rig, narrow};
+  boticelli::stereo::RangeCheck check{g_rig, one_plane()};
   check.begin_look();
   CHECK_EQUAL(5U, check.add_view(fresh, 0.0F, kLookTilt, points.data(), points.size()));
   float bias = 0.0F;
@@ -1595,29 +1616,14 @@ TEST(FloorCue, TheSelfCalibrationAddsALooksResidualFromEnoughPairsWithinItsBound
 // floor), in the walk's plane, and within [0.6, 1.6] of the base's distance count, and the
 // look's figure is their median.
 TEST(FloorCue, TheRangeCheckCountsLowPointsInTheWalksPlaneAndTakesTheirMedian) {
-  const FloorCueParams flat = flat_trusting();
-  static FloorCue fresh{g_rig, flat};
-  fresh.reset();
-  paint_wall(g_frame);
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
-  out.obstacles.clear();
-  out.free.clear();
-  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
-  const FloorColumn& col = fresh.column(fresh.column_count() / 2);
-  CHECK(col.end == FloorColumn::End::kBoundary);
+  static FloorCue fresh{g_rig, flat_trusting()};
+  const WalkToAWall w = walk_to_a_wall(fresh, out);
   // Points along the column's plane at given shares of the base's distance along it.
-  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
-  const Eigen::Vector2f c(pose.centre_m.x(), pose.centre_m.y());
-  const Eigen::Vector2f a(std::cos(col.azimuth_rad), std::sin(col.azimuth_rad));
-  const float along = c.dot(a);
-  const float s_base =
-      -along + std::sqrt(along * along - c.squaredNorm() + col.base_rho_m * col.base_rho_m);
-  const float floor_z = -g_rig.params().ptu_height_m;
-  const Eigen::Vector2f side(-a.y(), a.x());
+  const Eigen::Vector2f side(-w.a.y(), w.a.x());
   const auto at = [&](float share, float height, float aside) {
     boticelli::stereo::StereoPoint p;
-    const Eigen::Vector2f xy = c + share * s_base * a + aside * side;
-    p.point_ptu_m = Eigen::Vector3f(xy.x(), xy.y(), floor_z + height);
+    const Eigen::Vector2f xy = w.c + share * w.s_base_m * w.a + aside * side;
+    p.point_ptu_m = Eigen::Vector3f(xy.x(), xy.y(), w.floor_z_m + height);
     return p;
   };
   const std::array<boticelli::stereo::StereoPoint, 9> points{
@@ -1627,10 +1633,7 @@ TEST(FloorCue, TheRangeCheckCountsLowPointsInTheWalksPlaneAndTakesTheirMedian) {
       at(1.0F, 0.01F, 0.0F),                         // on the floor
       at(1.0F, 0.2F, 0.3F),                          // beside the walk's plane
       at(2.0F, 0.2F, 0.0F)};                         // another object, far behind
-  boticelli::stereo::RangeCheckParams narrow;
-  narrow.lateral_m = 0.001F;  // this column's plane alone (the next is 2 px away)
-  narrow.lateral_per_m = 0.0F;
-  boticelli::stereo::RangeCheck check{g_rig, narrow};
+  boticelli::stereo::RangeCheck check{g_rig, one_plane()};
   check.begin_look();
   CHECK_EQUAL(5U, check.add_view(fresh, 0.0F, kLookTilt, points.data(), points.size()));
   float ratio = 0.0F;
