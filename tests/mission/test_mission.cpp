@@ -28,6 +28,7 @@
 #include "hal/sim/world.h"
 #include "hal/sim/world_geometry.h"
 #include "mission_runner.h"
+#include "png_image.h"
 #include "sim_board.h"
 
 #include "alloc_guard.h"
@@ -293,6 +294,15 @@ TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothing) {
     std::snprintf(name, sizeof name, "/cycle-%06d.png", i);
     const std::string png = slurp(dir + name);
     CHECK_TEXT(png.size() > 1000 && png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0, name);
+    // The last picture shows what the mission passed it: the world's true walls (magenta,
+    // the sim's truth) and the world memory's free and occupied cells (the grid).
+    if (i == cycles) {
+      boticelli::test::RgbImage last;
+      CHECK_TEXT(boticelli::test::read_png(dir + name, last), name);
+      CHECK_TEXT(last.count({255, 0, 255}) > 200, "the true walls drawn");
+      CHECK_TEXT(last.count({232, 232, 232}) > 200, "the grid's free cells drawn");
+      CHECK_TEXT(last.count({70, 70, 70}) > 20, "the grid's occupied cells drawn");
+    }
     std::remove((dir + name).c_str());
   }
   CHECK_TEXT(rmdir(dir.c_str()) == 0, "nothing else in the snapshot folder");

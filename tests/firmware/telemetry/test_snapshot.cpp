@@ -14,11 +14,10 @@
 #include <string>
 #include <vector>
 
-#include <png.h>
-
 #include "firmware/telemetry/snapshot.h"
 
 #include "alloc_guard.h"
+#include "png_image.h"
 #include "CppUTest/TestHarness.h"
 
 using boticelli::core::Point2;
@@ -93,29 +92,11 @@ SnapshotFrame synthetic_frame(std::uint32_t cycle) {
   return f;
 }
 
-struct Image {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgb;
-  std::array<int, 3> at(SnapshotPixel p) const {
-    const std::size_t i = (static_cast<std::size_t>(p.y) * static_cast<std::size_t>(width) +
-                           static_cast<std::size_t>(p.x)) *
-                          3U;
-    return {rgb[i], rgb[i + 1], rgb[i + 2]};
-  }
-};
+using Image = boticelli::test::RgbImage;
+using boticelli::test::read_png;
 
-bool read_png(const std::string& path, Image& out) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  if (png_image_begin_read_from_file(&image, path.c_str()) == 0) return false;
-  image.format = PNG_FORMAT_RGB;
-  out.width = static_cast<int>(image.width);
-  out.height = static_cast<int>(image.height);
-  out.rgb.resize(PNG_IMAGE_SIZE(image));
-  const bool ok = png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr) != 0;
-  png_image_free(&image);
-  return ok;
+std::array<int, 3> at(const Image& image, SnapshotPixel p) {
+  return image.at(p.x, p.y);
 }
 
 std::vector<std::string> list_dir(const std::string& dir) {
@@ -186,33 +167,33 @@ TEST(SnapshotWriter, TheRobotObstacleGoalAndTruthWallHaveTheirColoursInThePictur
   Image image;
   CHECK_TRUE(read_png(dir + "/cycle-000003.png", image));
   // Panel 3 (navigation): robot disc, obstacle point, exploration point, goal, polygon fills.
-  CHECK((Colour{255, 140, 0}) == image.at(pixel(2, {0.05F, -0.1F})));
-  CHECK((Colour{220, 0, 0}) == image.at(pixel(2, {2.0F, -1.0F})));
-  CHECK((Colour{0, 90, 255}) == image.at(pixel(2, {-1.0F, 1.8F})));
-  CHECK((Colour{0, 200, 200}) == image.at(pixel(2, {1.0F, 2.0F})));
-  CHECK((Colour{170, 220, 170}) == image.at(pixel(2, {1.0F, -0.5F})));
-  CHECK((Colour{225, 240, 225}) == image.at(pixel(2, {-1.2F, 0.5F})));
+  CHECK((Colour{255, 140, 0}) == at(image, pixel(2, {0.05F, -0.1F})));
+  CHECK((Colour{220, 0, 0}) == at(image, pixel(2, {2.0F, -1.0F})));
+  CHECK((Colour{0, 90, 255}) == at(image, pixel(2, {-1.0F, 1.8F})));
+  CHECK((Colour{0, 200, 200}) == at(image, pixel(2, {1.0F, 2.0F})));
+  CHECK((Colour{170, 220, 170}) == at(image, pixel(2, {1.0F, -0.5F})));
+  CHECK((Colour{225, 240, 225}) == at(image, pixel(2, {-1.2F, 0.5F})));
   // Under the polygons the world memory: free pale, occupied dark, unknown white, and the
   // plan's goal on it a cross.
-  CHECK((Colour{232, 232, 232}) == image.at(pixel(2, {2.4F, 0.0F})));
-  CHECK((Colour{70, 70, 70}) == image.at(pixel(2, {2.7F, 0.0F})));
-  CHECK((Colour{255, 255, 255}) == image.at(pixel(2, {2.95F, -1.8F})));
-  CHECK((Colour{150, 0, 200}) == image.at(pixel(2, {-0.5F, 2.2F})));
+  CHECK((Colour{232, 232, 232}) == at(image, pixel(2, {2.4F, 0.0F})));
+  CHECK((Colour{70, 70, 70}) == at(image, pixel(2, {2.7F, 0.0F})));
+  CHECK((Colour{255, 255, 255}) == at(image, pixel(2, {2.95F, -1.8F})));
+  CHECK((Colour{150, 0, 200}) == at(image, pixel(2, {-0.5F, 2.2F})));
   // The true wall, thin, in every panel (here the left wall at y = 0.7 m).
   for (int panel = 0; panel < 4; ++panel) {
-    CHECK((Colour{255, 0, 255}) == image.at(pixel(panel, {-1.5F, 0.7F})));
-    CHECK((Colour{255, 0, 255}) != image.at(pixel(panel, {-1.5F - 2.0F / 80.0F, 0.7F})));
+    CHECK((Colour{255, 0, 255}) == at(image, pixel(panel, {-1.5F, 0.7F})));
+    CHECK((Colour{255, 0, 255}) != at(image, pixel(panel, {-1.5F - 2.0F / 80.0F, 0.7F})));
   }
   // Panel 1: brightness = evidence.
-  CHECK((Colour{255, 255, 255}) == image.at(pixel(0, {0.5F, 2.5F})));
-  CHECK((Colour{64, 64, 64}) == image.at(pixel(0, {0.0F, 2.5F})));
-  CHECK((Colour{0, 0, 0}) == image.at(pixel(0, {1.0F, -0.7F})));
+  CHECK((Colour{255, 255, 255}) == at(image, pixel(0, {0.5F, 2.5F})));
+  CHECK((Colour{64, 64, 64}) == at(image, pixel(0, {0.0F, 2.5F})));
+  CHECK((Colour{0, 0, 0}) == at(image, pixel(0, {1.0F, -0.7F})));
   // Panel 2: free is white, occupied is thresholded red.
-  CHECK((Colour{255, 255, 255}) == image.at(pixel(1, {1.0F, -0.7F})));
-  CHECK((Colour{110, 30, 30}) == image.at(pixel(1, {2.8F, 0.0F})));
+  CHECK((Colour{255, 255, 255}) == at(image, pixel(1, {1.0F, -0.7F})));
+  CHECK((Colour{110, 30, 30}) == at(image, pixel(1, {2.8F, 0.0F})));
   // Panel 4: V highest (red end of the map) at the goal, lowest (blue end) far from it.
-  const Colour high = image.at(pixel(3, {1.0F, 2.0F}));
-  const Colour low = image.at(pixel(3, {-1.95F, -1.95F}));
+  const Colour high = at(image, pixel(3, {1.0F, 2.0F}));
+  const Colour low = at(image, pixel(3, {-1.95F, -1.95F}));
   CHECK(high[0] > 180 && high[2] < 60);
   CHECK(low[2] > 120 && low[0] < 60);
 }
