@@ -506,6 +506,10 @@ TEST(MissionRooms, WithNothingLeftToExploreTheRobotTurnsRoundAndLooksOnceMoreBef
     if (moved < 0.02 && turned > std::numbers::pi - 0.2) turns.push_back(i);
   }
   CHECK_TEXT(!turns.empty(), r.mission_line.c_str());
+  // Every cycle is one look, those after a turn round included (and the last, which ends in
+  // its plan).
+  const std::size_t c = r.mission_line.find("cycles=");
+  LONGS_EQUAL_TEXT(std::atoi(r.mission_line.c_str() + c + 7), looks.size(), r.mission_line.c_str());
   // The last look is within 0.5 m of the last turn's place.
   const sim::TraceRow& turn = looks[turns.back()];
   CHECK(std::hypot(looks.back().x_m - turn.x_m, looks.back().y_m - turn.y_m) < 0.5);

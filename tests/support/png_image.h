@@ -15,9 +15,9 @@ struct RgbImage {
   std::vector<std::uint8_t> rgb;  // row after row, 3 bytes a pixel
 
   std::array<int, 3> at(int x, int y) const {
-    const std::size_t i =
-        (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) *
-        3U;
+    const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                           static_cast<std::size_t>(x)) *
+                          3U;
     return {rgb[i], rgb[i + 1], rgb[i + 2]};
   }
   // How many pixels have exactly this colour.
