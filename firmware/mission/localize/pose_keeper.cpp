@@ -17,6 +17,7 @@ void PoseKeeper::anchor(const core::Pose2& mission_pose) {
   frame_from_odometry_ = core::compose(mission_pose, core::inverse(odometry()));
   anchored_from_odometry_ = frame_from_odometry_;
   covariance_.setZero();
+  calibrator_.restart();
 }
 
 void PoseKeeper::moved(const core::Pose2& from, const core::Pose2& to) {
@@ -34,6 +35,9 @@ void PoseKeeper::moved(const core::Pose2& from, const core::Pose2& to) {
   q(0, 0) = q(1, 1) = sp * sp;
   q(2, 2) = sh * sh;
   covariance_ = f * covariance_ * f.transpose() + q;
+  const hal::Odometry o = base_.odometry();
+  calibrator_.moved(core::wrap_pi(to.yaw_rad - from.yaw_rad), o.wheels_known, o.wheel_left_m,
+                    o.wheel_right_m);
 }
 
 core::Pose2 PoseKeeper::correct(const core::Pose2& before,
@@ -56,8 +60,13 @@ core::Pose2 PoseKeeper::correct(const core::Pose2& before,
   const Eigen::Matrix3f prior = (covariance_ + 1e-8F * Eigen::Matrix3f::Identity()).inverse();
   const Eigen::Matrix3f posterior = (prior + info).inverse();
   const Eigen::Vector3f c = posterior * (info * delta);
-  if (!c.allFinite()) return before;
+  if (!c.allFinite()) {
+    calibrator_.restart();
+    return before;
+  }
   covariance_ = posterior;
+  const hal::Odometry o = base_.odometry();
+  calibrator_.registered(o.wheels_known, o.wheel_left_m, o.wheel_right_m, delta.z(), c.z());
   const core::Pose2 after{before.x_m + c.x(), before.y_m + c.y(),
                           core::wrap_pi(before.yaw_rad + c.z())};
   frame_from_odometry_ =

@@ -159,3 +159,33 @@ TEST(PoseKeeper, WithoutMotionOrAlongAnUnconstrainedDirectionTheOdometryStands) 
   wall.matched = false;
   check_pose(keeper.pose(), keeper.correct(keeper.pose(), wall));
 }
+
+TEST(PoseKeeper, EachMoveAndEachMatchedRegistrationReachTheBaseCalibratorWithTheWheelCounters) {
+  base.odometry_value.wheels_known = true;
+  keeper.anchor({});
+  const Pose2 start = keeper.pose();
+  (void)keeper.correct(start, registration(start, start, 200.0F));  // the first interval begins
+  // A left turn of 1 rad by a 0.4 m track, then 0.5 m straight.
+  base.odometry_value.wheel_left_m = -0.2 + 0.5;
+  base.odometry_value.wheel_right_m = 0.2 + 0.5;
+  set_odometry(base, 0.5 * std::cos(1.0), 0.5 * std::sin(1.0), 1.0);
+  keeper.moved(start, keeper.pose());
+  LONGS_EQUAL(0, keeper.calibrator().estimate().intervals);
+  const Pose2 before = keeper.pose();
+  boticelli::worldmap::Registration r = registration(before, before, 200.0F);
+  r.matched = false;
+  (void)keeper.correct(before, r);  // not matched: the interval goes on
+  LONGS_EQUAL(0, keeper.calibrator().estimate().intervals);
+  (void)keeper.correct(before, registration(before, before, 200.0F));
+  const boticelli::firmware::mission::BaseCalibration e = keeper.calibrator().estimate();
+  LONGS_EQUAL(1, e.intervals);
+  DOUBLES_EQUAL(1.0, e.turned_rad, 1e-4);
+  DOUBLES_EQUAL(0.5, e.driven_m, 1e-4);
+  // Anchored again (a resumed mission): the move before the next registration is not used.
+  keeper.anchor(keeper.pose());
+  base.odometry_value.wheel_left_m += 0.5;
+  base.odometry_value.wheel_right_m += 0.5;
+  keeper.moved(before, keeper.pose());
+  (void)keeper.correct(keeper.pose(), registration(keeper.pose(), keeper.pose(), 200.0F));
+  LONGS_EQUAL(1, keeper.calibrator().estimate().intervals);
+}

@@ -7,6 +7,7 @@
 
 #include "algo/core/geometry.h"
 #include "algo/worldmap/scan_matcher.h"
+#include "firmware/mission/localize/base_calibrator.h"
 #include "hal/base.h"
 
 namespace boticelli::firmware::mission {
@@ -52,6 +53,9 @@ class PoseKeeper {
   // The world pose of the mission frame's origin, given the world pose of the odometry
   // frame's origin (sim ground truth only).
   [[nodiscard]] core::Pose2 frame_origin_in_world(const core::Pose2& odometry_origin) const;
+  // The base's systematic errors as the registrations so far show them (moves and
+  // registrations are fed to it here).
+  [[nodiscard]] const BaseCalibrator& calibrator() const { return calibrator_; }
 
  private:
   [[nodiscard]] core::Pose2 odometry() const;
@@ -61,6 +65,7 @@ class PoseKeeper {
   core::Pose2 frame_from_odometry_{};     // mission frame from odometry frame, corrected
   core::Pose2 anchored_from_odometry_{};  // ... as anchored (the frame itself)
   Eigen::Matrix3f covariance_ = Eigen::Matrix3f::Zero();
+  BaseCalibrator calibrator_;
 };
 
 }  // namespace boticelli::firmware::mission
