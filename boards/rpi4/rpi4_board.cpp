@@ -15,7 +15,9 @@ hal_linux::BaseOdriveCanConfig base_config(const firmware::BoardConfig& c, const
   b.left_node_id = d.odrive_left_node_id;
   b.right_node_id = d.odrive_right_node_id;
   b.geometry.wheel_radius_m = c.wheel_radius_m;
-  b.geometry.track_width_m = c.track_width_m;
+  b.geometry.track_width_m = c.odometry_track_m();
+  b.geometry.left_scale = c.odometry_left_scale();
+  b.geometry.right_scale = c.odometry_right_scale();
   b.max_wheel_turns_s = d.odrive_max_wheel_turns_s;
   b.brake_timeout_ms = d.odrive_brake_timeout_ms;
   return b;

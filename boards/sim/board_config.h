@@ -110,6 +110,9 @@ inline SimSettings make_settings(const firmware::BoardConfig& c, std::uint64_t s
   s.physics.base.robot_radius_m = c.robot_radius_m;
   s.physics.base.robot_height_m = c.robot_height_m;
   s.physics.base.track_width_m = c.track_width_m;
+  s.physics.base.odometry_track_scale = c.odometry_track_scale;
+  s.physics.base.odometry_left_scale = c.odometry_left_scale();
+  s.physics.base.odometry_right_scale = c.odometry_right_scale();
   s.physics.base.max_speed_m_s = c.max_speed_m_s;
   s.physics.base.max_turn_rate_rad_s = c.max_turn_rate_rad_s;
   // The ODrives' watchdog, as configured on the robot: 0.2 s without a setpoint stops them.

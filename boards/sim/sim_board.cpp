@@ -81,6 +81,9 @@ bool SimBoard::init(const firmware::Options& options, char* error, std::size_t e
   settings_.physics.base.robot_radius_m = geometry.physics.base.robot_radius_m;
   settings_.physics.base.robot_height_m = geometry.physics.base.robot_height_m;
   settings_.physics.base.track_width_m = geometry.physics.base.track_width_m;
+  settings_.physics.base.odometry_track_scale = geometry.physics.base.odometry_track_scale;
+  settings_.physics.base.odometry_left_scale = geometry.physics.base.odometry_left_scale;
+  settings_.physics.base.odometry_right_scale = geometry.physics.base.odometry_right_scale;
   settings_.physics.base.max_speed_m_s = geometry.physics.base.max_speed_m_s;
   settings_.physics.base.max_turn_rate_rad_s = geometry.physics.base.max_turn_rate_rad_s;
   // The simulator's realism as the configuration file set it (unset keys keep the settings).

@@ -263,3 +263,30 @@ TEST(DiffDrive, TheFirstSampleOnlySetsTheReference) {
   odo.update({0.0F, 0.0F});  // a jump (ODrive rebooted) is not counted as motion
   DOUBLES_EQUAL(2.0 * std::numbers::pi * 0.1, odo.x_m(), 1e-5);
 }
+
+// A calibrated base: the right wheel 1% larger than the left (E_d = 1.01, mean radius 0.1 m)
+// and an effective track of 0.505 m. A straight drive turns the smaller wheel more, and the
+// odometry of those turns goes straight; a turn in place turns by ω·t on the effective track.
+TEST(DiffDrive, ACalibratedBaseDrivesAndCountsByEachWheelsEffectiveRadiusAndTheEffectiveTrack) {
+  DiffDriveGeometry c = g;
+  c.track_width_m = 0.505F;
+  c.left_scale = 2.0F / 2.01F;
+  c.right_scale = 2.0F * 1.01F / 2.01F;
+  const WheelTurns w = boticelli::codec::body_to_wheels(1.0F, 0.0F, c);
+  DOUBLES_EQUAL(1.0 / (2.0 * std::numbers::pi * 0.1 * (2.0 / 2.01)), w.left, 1e-4);
+  DOUBLES_EQUAL(-1.0 / (2.0 * std::numbers::pi * 0.1 * (2.02 / 2.01)), w.right, 1e-4);
+  float v = 0;
+  float omega = 0;
+  boticelli::codec::wheels_to_body(boticelli::codec::body_to_wheels(0.3F, -0.7F, c), c, v, omega);
+  DOUBLES_EQUAL(0.3, v, 1e-5);
+  DOUBLES_EQUAL(-0.7, omega, 1e-5);
+  DiffDriveOdometry odo(c);
+  odo.update({0.0F, 0.0F});
+  odo.update({w.left * 2.0F, w.right * 2.0F});  // 2 s straight at 1 m/s
+  DOUBLES_EQUAL(2.0, odo.x_m(), 1e-4);
+  DOUBLES_EQUAL(0.0, odo.yaw_rad(), 1e-5);
+  const WheelTurns spin = boticelli::codec::body_to_wheels(0.0F, 1.0F, c);
+  odo.update({w.left * 2.0F + spin.left, w.right * 2.0F + spin.right});  // 1 s at 1 rad/s
+  DOUBLES_EQUAL(1.0, odo.yaw_rad(), 1e-4);
+  DOUBLES_EQUAL(2.0, odo.x_m(), 1e-4);
+}

@@ -628,6 +628,39 @@ TEST(SimDevices, AWiderTrueTrackMakesTurnsShortAndUnequalWheelsBendAStraightDriv
                 2e-4);
 }
 
+// The same errors with the odometry calibrated for them (E_b = 1.01, E_d = 0.9975/1.0025):
+// a turn and a straight drive are where the odometry says, and the base turns at the rate
+// commanded.
+TEST(SimDevices, ACalibratedOdometryFollowsABaseWithAWiderTrackAndUnequalWheels) {
+  SimParams params;
+  params.base.track_scale = 1.01F;
+  params.base.wheel_scale_left = 1.0025F;
+  params.base.wheel_scale_right = 0.9975F;
+  params.base.odometry_track_scale = 1.01F;
+  params.base.odometry_left_scale = 1.0025F;
+  params.base.odometry_right_scale = 0.9975F;
+  start("rectangular_room", params);
+  BaseSim base(g_sim);
+  ClockSim clock(g_sim);
+  make_ready(base, clock);
+  const boticelli::core::Pose2 start_pose = g_sim.true_pose();
+  base.set_velocity(0.0F, 0.5F);
+  clock.sleep_until_us(clock.now_us() + 2000000);
+  DOUBLES_EQUAL(0.5, base.odometry().omega_rad_s, 1e-4);
+  base.set_velocity(0.2F, 0.0F);
+  clock.sleep_until_us(clock.now_us() + 4000000);
+  base.set_velocity(0.0F, 0.0F);
+  clock.sleep_until_us(clock.now_us() + 1000000);
+  const boticelli::hal::Odometry o = base.odometry();
+  const boticelli::core::Pose2 moved =
+      boticelli::core::compose(boticelli::core::inverse(start_pose), g_sim.true_pose());
+  CHECK(o.yaw_rad > 0.9);
+  CHECK(o.x_m * o.x_m + o.y_m * o.y_m > 0.5);
+  DOUBLES_EQUAL(o.yaw_rad, moved.yaw_rad, 1e-4);
+  DOUBLES_EQUAL(o.x_m, moved.x_m, 1e-3);
+  DOUBLES_EQUAL(o.y_m, moved.y_m, 1e-3);
+}
+
 // Gear play: the camera trails the PTU's position by half the backlash, on the side each axis
 // last moved from; the position the PTU reports stays the commanded one.
 TEST(SimDevices, WithBacklashTheCameraTrailsEachAxisByHalfOfItOnTheSideItCameFrom) {

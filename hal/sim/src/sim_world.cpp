@@ -318,14 +318,14 @@ void SimWorld::step_base(float dt_s) {
       contact_ = contact;
       // Wheel odometry from the encoders at the nominal diameters and track (white noise
       // optional).
-      double ol = frozen_left ? 0.0 : el;
-      double orr = frozen_right ? 0.0 : er;
+      double ol = frozen_left ? 0.0 : el * static_cast<double>(b.odometry_left_scale);
+      double orr = frozen_right ? 0.0 : er * static_cast<double>(b.odometry_right_scale);
       if (b.odometry_noise > 0.0F) {
         ol *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
         orr *= 1.0 + static_cast<double>(b.odometry_noise * gaussian());
       }
       const double ods = 0.5 * (ol + orr);
-      const double odyaw = (orr - ol) / track;
+      const double odyaw = (orr - ol) / (track * static_cast<double>(b.odometry_track_scale));
       const double omid = odometry_.yaw_rad + 0.5 * odyaw;
       const double ochord =
           std::fabs(odyaw) > 1e-9 ? ods * std::sin(0.5 * odyaw) / (0.5 * odyaw) : ods;
@@ -334,10 +334,10 @@ void SimWorld::step_base(float dt_s) {
       odometry_.yaw_rad = std::remainder(odometry_.yaw_rad + odyaw, 6.283185307179586);
     }
   }
-  const float ml = frozen_left ? 0.0F : wheel_left_m_s_;
-  const float mr = frozen_right ? 0.0F : wheel_right_m_s_;
+  const float ml = frozen_left ? 0.0F : wheel_left_m_s_ * b.odometry_left_scale;
+  const float mr = frozen_right ? 0.0F : wheel_right_m_s_ * b.odometry_right_scale;
   odometry_.v_m_s = 0.5F * (ml + mr);
-  odometry_.omega_rad_s = (mr - ml) / b.track_width_m;
+  odometry_.omega_rad_s = (mr - ml) / (b.track_width_m * b.odometry_track_scale);
   odometry_.timestamp_us = now_us_;
   odometry_.wheels_known = true;
   odometry_.wheel_left_m = wheel_count_left_m_;
@@ -517,8 +517,10 @@ void SimWorld::base_set_velocity(float v_m_s, float omega_rad_s) {
   const BaseParams& b = params_.base;
   const float v = std::clamp(v_m_s, -b.max_speed_m_s, b.max_speed_m_s);
   const float w = std::clamp(omega_rad_s, -b.max_turn_rate_rad_s, b.max_turn_rate_rad_s);
-  const float left = v - 0.5F * w * b.track_width_m;
-  const float right = v + 0.5F * w * b.track_width_m;
+  // Encoder speeds [m/s at the nominal radius] for the calibrated wheels and track.
+  const float track = b.track_width_m * b.odometry_track_scale;
+  const float left = (v - 0.5F * w * track) / b.odometry_left_scale;
+  const float right = (v + 0.5F * w * track) / b.odometry_right_scale;
   FaultType type = FaultType::kOff;
   const bool delayed = faults_.failing(FaultDevice::kCan, type) && type == FaultType::kDelayed;
   if (!delayed && pending_count_ == 0) {

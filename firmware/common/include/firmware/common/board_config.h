@@ -36,6 +36,19 @@ struct BoardConfig {
   float robot_height_m = 0.8F;       // height of that cylinder [m]
   float wheel_radius_m = 0.08F;      // [m]
   float track_width_m = 0.40F;       // distance between the wheels [m]
+  // The odometry's calibration (UMBmark, Borenstein & Feng 1996): the effective track is
+  // track_width_m times this, and the right wheel's effective diameter is this ratio times
+  // the left's (their mean stays 2 × wheel_radius_m). `base-calibration` on the console
+  // estimates both from a mission's registrations.
+  float odometry_track_scale = 1.0F;     // [1]
+  float odometry_diameter_ratio = 1.0F;  // right / left [1]
+  // The calibrated odometry: the effective track [m] and each wheel's effective radius over
+  // wheel_radius_m (2/(1 + E_d) and 2·E_d/(1 + E_d)).
+  [[nodiscard]] float odometry_track_m() const { return track_width_m * odometry_track_scale; }
+  [[nodiscard]] float odometry_left_scale() const { return 2.0F / (1.0F + odometry_diameter_ratio); }
+  [[nodiscard]] float odometry_right_scale() const {
+    return 2.0F * odometry_diameter_ratio / (1.0F + odometry_diameter_ratio);
+  }
   float max_speed_m_s = 0.3F;        // forward speed limit [m/s]
   float max_turn_rate_rad_s = 0.8F;  // yaw rate limit [rad/s]
   // Executive and console.

@@ -59,6 +59,12 @@ struct BaseParams {
   float track_scale = 1.0F;          // true effective track width / the odometry's
   float turn_scrub = 0.0F;           // sd of the share of each in-place turn lost or gained [1]
   float odometry_noise = 0.0F;       // relative sd of each wheel's step distance (0 = off)
+  // The odometry's calibration, as the firmware configures its HAL (BoardConfig
+  // odometry_*): wheel setpoints and odometry use each wheel's effective radius over the
+  // nominal one and this share of the track. 1, 1, 1 is the nominal base.
+  float odometry_left_scale = 1.0F;
+  float odometry_right_scale = 1.0F;
+  float odometry_track_scale = 1.0F;
   std::uint32_t startup_us = 50000;  // start-up until closed-loop control [µs]
   float contact_margin_m = 0.01F;    // the bumper closes within this gap [m]
   float floor_clearance_m = 0.01F;   // obstacles lower than this are driven over [m]

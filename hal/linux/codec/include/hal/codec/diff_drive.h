@@ -6,12 +6,16 @@
 namespace boticelli::codec {
 
 struct DiffDriveGeometry {
-  float wheel_radius_m = 0.0F;  // both wheels
-  float track_width_m = 0.0F;   // distance between the wheel contact points
+  float wheel_radius_m = 0.0F;  // both wheels, nominal
+  float track_width_m = 0.0F;   // effective distance between the wheel contact points
   // +1 or −1: the sign of a motor's turns for the wheel rolling the robot forward (mirrored
   // motors usually make one side −1).
   float left_direction = 1.0F;
   float right_direction = -1.0F;
+  // Each wheel's effective radius over the nominal one (the odometry's calibration: 1, 1 for
+  // equal wheels).
+  float left_scale = 1.0F;
+  float right_scale = 1.0F;
 };
 
 struct WheelTurns {
@@ -19,7 +23,7 @@ struct WheelTurns {
   float right = 0.0F;
 };
 
-// v_l = v − ω·b/2, v_r = v + ω·b/2; motor turns/s = direction · v_wheel / (2π r).
+// v_l = v − ω·b/2, v_r = v + ω·b/2; motor turns/s = direction · v_wheel / (2π r · scale).
 WheelTurns body_to_wheels(float v_m_s, float omega_rad_s, const DiffDriveGeometry& g);
 // Inverse: v = (v_r + v_l)/2, ω = (v_r − v_l)/b.
 void wheels_to_body(const WheelTurns& motor_turns_s, const DiffDriveGeometry& g, float& v_m_s,
