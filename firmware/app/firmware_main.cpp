@@ -467,6 +467,17 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
                 static_cast<unsigned>(mission.calibration_bases()),
                 static_cast<double>(mission.stereo_inverse_range_bias()));
   }
+  if (const OdometryCalibration c = mission.odometry_calibration(); c.intervals > 0) {
+    // The base's odometry calibration the registrations show (`base-calibration`).
+    console.log(LogLevel::kInfo,
+                "mission base_calibration valid=%d intervals=%u turned_deg=%.0f driven_m=%.2f "
+                "odometry_track_scale=%.4f sd=%.4f odometry_diameter_ratio=%.4f sd=%.4f",
+                c.valid ? 1 : 0, c.intervals,
+                static_cast<double>(c.turned_rad) * 180.0 / 3.14159265358979323846,
+                static_cast<double>(c.driven_m), static_cast<double>(c.track_scale),
+                static_cast<double>(c.track_scale_sd), static_cast<double>(c.diameter_ratio),
+                static_cast<double>(c.diameter_ratio_sd));
+  }
   if (mission.guard_truncated_looks() > 0) {
     console.log(LogLevel::kWarn, "mission guard_truncated_looks=%u (a full list dropped readings)",
                 static_cast<unsigned>(mission.guard_truncated_looks()));

@@ -24,6 +24,9 @@ const Console::Command Console::kCommands[] = {
     {"pose", "", "robot pose in the world frame", &Console::cmd_pose},
     {"model", "", "the occupancy ALN in the text format", &Console::cmd_model},
     {"map", "", "world memory (grid) summary, frontiers, goal, polygon, target", &Console::cmd_map},
+    {"base-calibration", "",
+     "the odometry's track scale and wheel diameter ratio the looks' registrations show",
+     &Console::cmd_base_calibration},
     {"pause", "", "pause the background work (mission)", &Console::cmd_pause},
     {"resume", "", "after pause or clear-estop: the background work and the base go on",
      &Console::cmd_resume},
@@ -429,6 +432,24 @@ void Console::cmd_map(const Words& w) {
                    static_cast<double>(m.goal_y_m), static_cast<double>(m.goal_path_m));
   }
   append_target(reply_, view_.target());
+  reply_.append("\r\nOK\r\n");
+  emit(reply_.view());
+}
+
+void Console::cmd_base_calibration(const Words& w) {
+  if (!no_args(w)) return reply_error("base-calibration takes no arguments");
+  const OdometryCalibration c = view_.odometry_calibration();
+  reply_.appendf("base-calibration intervals=%u turned_deg=%.0f driven_m=%.2f", c.intervals,
+                 static_cast<double>(c.turned_rad) * 180.0 / 3.14159265358979323846,
+                 static_cast<double>(c.driven_m));
+  if (c.valid) {
+    reply_.appendf(" odometry_track_scale=%.4f sd=%.4f odometry_diameter_ratio=%.4f sd=%.4f",
+                   static_cast<double>(c.track_scale), static_cast<double>(c.track_scale_sd),
+                   static_cast<double>(c.diameter_ratio),
+                   static_cast<double>(c.diameter_ratio_sd));
+  } else {
+    reply_.append(" not enough yet (4 intervals, 360 deg turned and 2 m driven, with register_looks)");
+  }
   reply_.append("\r\nOK\r\n");
   emit(reply_.view());
 }

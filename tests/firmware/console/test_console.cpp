@@ -54,6 +54,8 @@ class FakeView final : public MissionView {
   MapCounts map_counts() const override { return counts; }
   MapCounts counts{12, 34, 5};
   TargetEstimate target() const override { return target_value; }
+  OdometryCalibration odometry_calibration() const override { return calibration; }
+  OdometryCalibration calibration;
   std::uint64_t mission_log_begin() const override { return log_dropped; }
   std::uint64_t mission_log_end() const override { return log_dropped + log.size(); }
   const MissionLogEntry* mission_log_line(std::uint64_t n) const override {
@@ -360,7 +362,8 @@ TEST(Console, AnswersHelpWithEveryCommand) {
   const auto reply = command("help");
   CHECK_EQUAL("OK", reply.back());
   for (const char* name :
-       {"help", "status", "stats", "pose", "model", "map", "pause", "resume", "estop",
+       {"help", "status", "stats", "pose", "model", "map", "base-calibration", "pause", "resume",
+        "estop",
         "clear-estop", "get", "set", "log", "param", "fault", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
@@ -406,6 +409,26 @@ TEST(Console, MapSummarisesTheWorldMemoryAndTheGoalOnIt) {
       command("map").at(0).c_str());
   view.counts.goal = GoalKind::kTarget;
   STRCMP_CONTAINS(" goal=target goal_x_m=2.500 ", command("map").at(0).c_str());
+}
+
+TEST(Console, BaseCalibrationSaysWhatItLacksThenTheValuesForTheConfigFile) {
+  view.calibration.intervals = 3;
+  view.calibration.turned_rad = 3.14159265F;
+  view.calibration.driven_m = 1.5F;
+  auto reply = command("base-calibration");
+  STRCMP_EQUAL(
+      "base-calibration intervals=3 turned_deg=180 driven_m=1.50 not enough yet (4 intervals, "
+      "360 deg turned and 2 m driven, with register_looks)",
+      reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.back());
+  view.calibration = {true, 21, 60.0F, 14.25F, 1.0123F, 0.0021F, 0.9951F, 0.0034F};
+  reply = command("base-calibration");
+  STRCMP_EQUAL(
+      "base-calibration intervals=21 turned_deg=3438 driven_m=14.25 odometry_track_scale=1.0123 "
+      "sd=0.0021 odometry_diameter_ratio=0.9951 sd=0.0034",
+      reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.back());
+  STRCMP_CONTAINS("takes no arguments", command("base-calibration now").at(0).c_str());
 }
 
 TEST(Console, ReportsTheTargetEstimateOnceTheMissionHasOne) {

@@ -123,6 +123,21 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
     return params_.thesis_planner ? "thesis" : "frontier";
   }
   TargetEstimate target() const override;
+  OdometryCalibration odometry_calibration() const override {
+    const BaseCalibration e = pose_.calibrator().estimate();
+    OdometryCalibration c;
+    c.valid = e.valid;
+    c.intervals = e.intervals;
+    c.turned_rad = e.turned_rad;
+    c.driven_m = e.driven_m;
+    if (e.valid) {
+      c.track_scale = e.track_m / config_.track_width_m;
+      c.track_scale_sd = e.track_sd_m / config_.track_width_m;
+      c.diameter_ratio = e.diameter_ratio;
+      c.diameter_ratio_sd = e.diameter_ratio_sd;
+    }
+    return c;
+  }
 
   [[nodiscard]] Result result() const { return result_; }
   [[nodiscard]] bool finished() const { return result_ != Result::kRunning; }

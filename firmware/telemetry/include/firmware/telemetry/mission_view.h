@@ -31,6 +31,20 @@ struct MapCounts {
   float goal_path_m = 0.0F;  // path length to it on the grid
 };
 
+// The base's odometry calibration as the looks' registrations show it (UMBmark, Borenstein &
+// Feng 1996): the values for [base] odometry_track_scale and odometry_diameter_ratio, with
+// their standard errors, once there is enough turning and driving to say (`valid`).
+struct OdometryCalibration {
+  bool valid = false;
+  std::uint32_t intervals = 0;  // look-to-look intervals used
+  float turned_rad = 0.0F;      // |turning| over them
+  float driven_m = 0.0F;        // |driving| over them
+  float track_scale = 1.0F;     // effective track / base.track_width_m
+  float track_scale_sd = 0.0F;
+  float diameter_ratio = 1.0F;  // right wheel's effective diameter / the left's
+  float diameter_ratio_sd = 0.0F;
+};
+
 // The mission's idea of where the target is: none yet, seen once (a candidate not yet
 // confirmed by a second view) or confirmed (the goal).
 enum class TargetStatus : std::uint8_t { kNone, kSeen, kConfirmed };
@@ -61,6 +75,7 @@ class MissionView {
   virtual void release_model_text() {}
   virtual MapCounts map_counts() const { return {}; }
   virtual TargetEstimate target() const { return {}; }
+  virtual OdometryCalibration odometry_calibration() const { return {}; }
   // The mission log kept in the state file (MissionState::log), by line number: the first
   // line still kept, one past the last, and a line (nullptr when no longer or not yet kept).
   virtual std::uint64_t mission_log_begin() const { return 0; }
