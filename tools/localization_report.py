@@ -2,12 +2,18 @@
 # Localization report: runs the sim firmware on worlds and seeds and compares, from each trace,
 # the firmware's estimate (est_) and the raw odometry (odo_) with the simulator's true pose.
 """Usage: tools/localization_report.py [--bin build/sim/bin/boticelli] [--realism realistic]
-          [--seeds 1,2] [--max-cycles 45] [--json] WORLD.sdf ...
+          [--seeds 1,2] [--max-cycles 45] [--no-register] [--config FILE] [--json] WORLD.sdf ...
+
+Each run's configuration file sets `[sim] realism` and `[mission] register_looks = true`
+(false with --no-register), then the lines of --config FILE (e.g. a [base] table with the
+odometry's calibration).
 
 Per run: result, cycles, driven path [m], final and worst position [m] and heading [deg]
 error of the estimate and of the odometry (both in the mission frame, placed in the world by
 the start pose, the first trace row's truth), looks registered and registration CPU per look
-[ms] (the firmware's `mission cpu ... register_s= registered=` line)."""
+[ms] (the firmware's `mission cpu ... register_s= registered=` line), and the base's
+calibration the registrations show (`mission base_calibration` line: track scale and wheel
+diameter ratio with their standard errors, when valid)."""
 
 import argparse
 import json
@@ -38,11 +44,13 @@ def field(line, key):
     return float("nan")
 
 
-def run(binary, world, seed, cycles, realism, tmp):
+def run(binary, world, seed, cycles, realism, register, extra, tmp):
     trace = os.path.join(tmp, "trace.csv")
     conf = os.path.join(tmp, "sim.conf")
     with open(conf, "w") as f:
         f.write('[sim]\nrealism = "%s"\n' % realism)
+        f.write("[mission]\nregister_looks = %s\n" % ("true" if register else "false"))
+        f.write(extra)
     cmd = [binary, "--world", world, "--seed", str(seed), "--max-cycles", str(cycles),
            "--trace", trace, "--console", "stdio", "--config", conf]
     out = subprocess.run(cmd, stdin=subprocess.DEVNULL, capture_output=True, text=True).stdout
@@ -58,6 +66,13 @@ def run(binary, world, seed, cycles, realism, tmp):
             looks = field(line, "registered")
             r["registered_looks"] = int(looks) if looks == looks else 0
             r["register_s"] = field(line, "register_s")
+        elif "LOG info mission base_calibration " in line and field(line, "valid") == 1:
+            r["calibration_intervals"] = int(field(line, "intervals"))
+            r["odometry_track_scale"] = field(line, "odometry_track_scale")
+            r["odometry_diameter_ratio"] = field(line, "odometry_diameter_ratio")
+            sds = [p for p in line.split() if p.startswith("sd=")]
+            r["track_scale_sd"] = float(sds[0][3:])
+            r["diameter_ratio_sd"] = float(sds[1][3:])
     rows = []
     with open(trace) as f:
         header = f.readline().strip().split(",")
@@ -103,14 +118,21 @@ def main():
     ap.add_argument("--realism", default="realistic")
     ap.add_argument("--seeds", default="1,2")
     ap.add_argument("--max-cycles", type=int, default=45)
+    ap.add_argument("--no-register", action="store_true")
+    ap.add_argument("--config", default="", help="more configuration lines for every run")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("worlds", nargs="+")
     a = ap.parse_args()
     runs = []
+    extra = ""
+    if a.config:
+        with open(a.config) as f:
+            extra = f.read()
     with tempfile.TemporaryDirectory() as tmp:
         for world in a.worlds:
             for seed in [int(s) for s in a.seeds.split(",")]:
-                r = run(a.bin, world, seed, a.max_cycles, a.realism, tmp)
+                r = run(a.bin, world, seed, a.max_cycles, a.realism, not a.no_register, extra,
+                        tmp)
                 runs.append(r)
                 if a.json:
                     print(json.dumps(r), flush=True)
