@@ -40,8 +40,8 @@ bool add_board_config_keys(ConfigSchema& s, BoardConfig& c) {
          s.add(ConfigKey::number("base", "track_width_m", c.track_width_m, 0.05, 2.0)) &&
          s.add(ConfigKey::number("base", "odometry_track_scale", c.odometry_track_scale, 0.8,
                                  1.25)) &&
-         s.add(ConfigKey::number("base", "odometry_diameter_ratio", c.odometry_diameter_ratio,
-                                 0.9, 1.1)) &&
+         s.add(ConfigKey::number("base", "odometry_diameter_ratio", c.odometry_diameter_ratio, 0.9,
+                                 1.1)) &&
          s.add(ConfigKey::number("base", "max_speed_m_s", c.max_speed_m_s, 0.01, 2.0)) &&
          s.add(
              ConfigKey::number("base", "max_turn_rate_rad_s", c.max_turn_rate_rad_s, 0.05, 5.0)) &&

@@ -445,10 +445,10 @@ void Console::cmd_base_calibration(const Words& w) {
   if (c.valid) {
     reply_.appendf(" odometry_track_scale=%.4f sd=%.4f odometry_diameter_ratio=%.4f sd=%.4f",
                    static_cast<double>(c.track_scale), static_cast<double>(c.track_scale_sd),
-                   static_cast<double>(c.diameter_ratio),
-                   static_cast<double>(c.diameter_ratio_sd));
+                   static_cast<double>(c.diameter_ratio), static_cast<double>(c.diameter_ratio_sd));
   } else {
-    reply_.append(" not enough yet (4 intervals, 360 deg turned and 2 m driven, with register_looks)");
+    reply_.append(
+        " not enough yet (4 intervals, 360 deg turned and 2 m driven, with register_looks)");
   }
   reply_.append("\r\nOK\r\n");
   emit(reply_.view());

@@ -77,9 +77,10 @@ void BaseOdriveCan::close_socket() {
 bool BaseOdriveCan::init() {
   const auto& g = config_.geometry;
   if (!(g.wheel_radius_m > 0.0F) || !(g.track_width_m > 0.0F) || !(g.left_scale > 0.0F) ||
-      !(g.right_scale > 0.0F) || config_.left_node_id > odrive::kMaxNodeId || config_.right_node_id > odrive::kMaxNodeId ||
-      config_.left_node_id == config_.right_node_id) {
-    set_error(error_, "base: bad configuration (wheel radius, track width, wheel scales or node ids)");
+      !(g.right_scale > 0.0F) || config_.left_node_id > odrive::kMaxNodeId ||
+      config_.right_node_id > odrive::kMaxNodeId || config_.left_node_id == config_.right_node_id) {
+    set_error(error_,
+              "base: bad configuration (wheel radius, track width, wheel scales or node ids)");
     health_ = hal::BaseHealth::kStopped;
     return false;
   }

@@ -428,6 +428,9 @@ TEST(MissionThesisRoom, AConfirmedTargetGoneWhenTheRobotArrivesIsMissedThenRevok
       store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
   remove_state_dir(dir);
   CHECK_TEXT(loaded, error);
+  // The state holds the world memory as the last cycle left it (what a resume starts from).
+  DOUBLES_EQUAL(0.05, state.grid_cell_m, 1e-6);
+  CHECK_TEXT(state.grid.size() > 20, std::to_string(state.grid.size()).c_str());
   CHECK(take.removed);
   CHECK_TEXT(r.telemetry_confirmed, r.mission_line.c_str());
   CHECK_TEXT(r.mission_line.find("result=found") == std::string::npos, r.mission_line.c_str());
@@ -747,6 +750,20 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   trace_odometry(second.trace_text, false, after, 10);
   CHECK_TEXT(std::hypot(before[0], before[1]) > 0.3, "the first run's frame moved with the robot");
   CHECK(std::hypot(before[0] - saved[0], before[1] - saved[1]) < 0.05);
+  // Saved where the base came to rest (perfect odometry: the true rest pose in the frame of the
+  // start pose), not where the last cycle ended.
+  {
+    const sim::TraceRow& s0 = first.trace.front();
+    const boticelli::core::Pose2 rest = boticelli::core::compose(
+        boticelli::core::inverse({static_cast<float>(s0.x_m), static_cast<float>(s0.y_m),
+                                  static_cast<float>(s0.yaw_rad)}),
+        first.final_pose);
+    const std::string at = "saved " + std::to_string(saved[0]) + " " + std::to_string(saved[1]) +
+                           ", at rest " + std::to_string(rest.x_m) + " " + std::to_string(rest.y_m);
+    CHECK_TEXT(std::hypot(saved[0] - static_cast<double>(rest.x_m),
+                          saved[1] - static_cast<double>(rest.y_m)) < 0.001,
+               at.c_str());
+  }
   DOUBLES_EQUAL(saved[0], after[0], 0.002);
   DOUBLES_EQUAL(saved[1], after[1], 0.002);
   DOUBLES_EQUAL(0.0, std::remainder(saved[2] - after[2], 2.0 * std::numbers::pi), 0.002);

@@ -101,9 +101,8 @@ BaseCalibration BaseCalibrator::estimate() const {
   e.track_sd_m = static_cast<float>(std::sqrt(var_p) / (p * p));
   e.diameter_ratio = static_cast<float>((2.0 + g) / (2.0 - g));
   // g = q/p to first order; E_d = (2 + g)/(2 − g) has dE_d/dg = 4/(2 − g)².
-  const double var_g =
-      std::fmax(var_q / (p * p) + q * q * var_p / (p * p * p * p) - 2.0 * q * cov_pq / (p * p * p),
-                0.0);
+  const double var_g = std::fmax(
+      var_q / (p * p) + q * q * var_p / (p * p * p * p) - 2.0 * q * cov_pq / (p * p * p), 0.0);
   e.diameter_ratio_sd = static_cast<float>(std::sqrt(var_g) * 4.0 / ((2.0 - g) * (2.0 - g)));
   return e;
 }

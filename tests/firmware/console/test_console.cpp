@@ -363,8 +363,7 @@ TEST(Console, AnswersHelpWithEveryCommand) {
   CHECK_EQUAL("OK", reply.back());
   for (const char* name :
        {"help", "status", "stats", "pose", "model", "map", "base-calibration", "pause", "resume",
-        "estop",
-        "clear-estop", "get", "set", "log", "param", "fault", "ver", "shutdown", "quit"}) {
+        "estop", "clear-estop", "get", "set", "log", "param", "fault", "ver", "shutdown", "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);

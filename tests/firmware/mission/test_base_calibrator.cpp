@@ -25,7 +25,7 @@ struct Base {
   double diameter_ratio = 1.0;  // right / left
   double noise_rad = 0.0;
 
-  double left_m = 0.0;   // the counters (encoder travel at the nominal diameter)
+  double left_m = 0.0;  // the counters (encoder travel at the nominal diameter)
   double right_m = 0.0;
   double true_yaw = 0.0;
   double odometry_yaw = 0.0;

@@ -32,10 +32,10 @@ struct BoardConfig {
   float support_angle_rad = 0.0F;  // angle Ω of the L-support between lever and optical axis [rad]
   float tilt_step_rad = 0.134390352F;  // tilt between the two stereo frames, Φ = 7.7° [rad]
   // Base.
-  float robot_radius_m = 0.25F;      // radius of the cylinder that contains the robot [m]
-  float robot_height_m = 0.8F;       // height of that cylinder [m]
-  float wheel_radius_m = 0.08F;      // [m]
-  float track_width_m = 0.40F;       // distance between the wheels [m]
+  float robot_radius_m = 0.25F;  // radius of the cylinder that contains the robot [m]
+  float robot_height_m = 0.8F;   // height of that cylinder [m]
+  float wheel_radius_m = 0.08F;  // [m]
+  float track_width_m = 0.40F;   // distance between the wheels [m]
   // The odometry's calibration (UMBmark, Borenstein & Feng 1996): the effective track is
   // track_width_m times this, and the right wheel's effective diameter is this ratio times
   // the left's (their mean stays 2 × wheel_radius_m). `base-calibration` on the console
@@ -45,7 +45,9 @@ struct BoardConfig {
   // The calibrated odometry: the effective track [m] and each wheel's effective radius over
   // wheel_radius_m (2/(1 + E_d) and 2·E_d/(1 + E_d)).
   [[nodiscard]] float odometry_track_m() const { return track_width_m * odometry_track_scale; }
-  [[nodiscard]] float odometry_left_scale() const { return 2.0F / (1.0F + odometry_diameter_ratio); }
+  [[nodiscard]] float odometry_left_scale() const {
+    return 2.0F / (1.0F + odometry_diameter_ratio);
+  }
   [[nodiscard]] float odometry_right_scale() const {
     return 2.0F * odometry_diameter_ratio / (1.0F + odometry_diameter_ratio);
   }

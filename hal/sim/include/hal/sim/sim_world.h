@@ -54,11 +54,11 @@ struct BaseParams {
   // Odometry errors of a real base (Borenstein & Feng 1996, UMBmark): what the wheels do
   // against what the odometry assumes. The encoders count the commanded wheel turns; the
   // ground moves by the true diameters and track. 1, 1, 1, 0, 0 is perfect odometry.
-  float wheel_scale_left = 1.0F;     // true left wheel diameter / the odometry's
-  float wheel_scale_right = 1.0F;    // true right wheel diameter / the odometry's
-  float track_scale = 1.0F;          // true effective track width / the odometry's
-  float turn_scrub = 0.0F;           // sd of the share of each in-place turn lost or gained [1]
-  float odometry_noise = 0.0F;       // relative sd of each wheel's step distance (0 = off)
+  float wheel_scale_left = 1.0F;   // true left wheel diameter / the odometry's
+  float wheel_scale_right = 1.0F;  // true right wheel diameter / the odometry's
+  float track_scale = 1.0F;        // true effective track width / the odometry's
+  float turn_scrub = 0.0F;         // sd of the share of each in-place turn lost or gained [1]
+  float odometry_noise = 0.0F;     // relative sd of each wheel's step distance (0 = off)
   // The odometry's calibration, as the firmware configures its HAL (BoardConfig
   // odometry_*): wheel setpoints and odometry use each wheel's effective radius over the
   // nominal one and this share of the track. 1, 1, 1 is the nominal base.

@@ -56,9 +56,9 @@ class BaseCalibrator {
   bool have_reference_ = false;  // counters at the last event
   double left_ref_m_ = 0.0;
   double right_ref_m_ = 0.0;
-  double u_m_ = 0.0;          // Δr − Δl
-  double s_m_ = 0.0;          // (Δr + Δl)/2
-  double theta_rad_ = 0.0;    // the odometry's heading change, unwrapped
+  double u_m_ = 0.0;        // Δr − Δl
+  double s_m_ = 0.0;        // (Δr + Δl)/2
+  double theta_rad_ = 0.0;  // the odometry's heading change, unwrapped
   double driven_m_ = 0.0;
   // The registration that began it.
   float last_residual_rad_ = 0.0F;
