@@ -152,6 +152,23 @@ void remove_state_dir(const std::string& dir) {
   rmdir(dir.c_str());
 }
 
+// Where each look began: the trace's rows where the state becomes "look".
+std::vector<sim::TraceRow> look_starts(const MissionRun& r) {
+  std::vector<sim::TraceRow> looks;
+  for (std::size_t i = 1; i < r.trace.size(); ++i) {
+    if (std::string(r.trace[i].state) == "look" && std::string(r.trace[i - 1].state) != "look") {
+      looks.push_back(r.trace[i]);
+    }
+  }
+  return looks;
+}
+
+// The cycles the MISSION line reports.
+int cycles_of(const MissionRun& r) {
+  const std::size_t c = r.mission_line.find("cycles=");
+  return c == std::string::npos ? -1 : std::atoi(r.mission_line.c_str() + c + 7);
+}
+
 void check_found_safely(const MissionRun& r) {
   CHECK_EQUAL_TEXT(0, r.exit_code, r.mission_line.c_str());
   STRCMP_CONTAINS("MISSION result=found", r.mission_line.c_str());
@@ -286,8 +303,7 @@ TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothing) {
   CHECK(count.frames > 10000);
   UNSIGNED_LONGS_EQUAL_TEXT(0, count.allocations, "heap allocations after init");
   // One PNG per cycle, the last one included.
-  const std::size_t c = r.mission_line.find("cycles=");
-  const int cycles = std::atoi(r.mission_line.c_str() + c + 7);
+  const int cycles = cycles_of(r);
   CHECK(cycles > 1);
   for (int i = 1; i <= cycles; ++i) {
     char name[64];
@@ -494,12 +510,7 @@ TEST(MissionRooms, WithNothingLeftToExploreTheRobotTurnsRoundAndLooksOnceMoreBef
   UNSIGNED_LONGS_EQUAL_TEXT(0, r.check.collisions, r.mission_line.c_str());
   // Where each look began; a turn round is a look begun where the last one was, half a turn
   // from its heading.
-  std::vector<sim::TraceRow> looks;
-  for (std::size_t i = 1; i < r.trace.size(); ++i) {
-    if (std::string(r.trace[i].state) == "look" && std::string(r.trace[i - 1].state) != "look") {
-      looks.push_back(r.trace[i]);
-    }
-  }
+  const std::vector<sim::TraceRow> looks = look_starts(r);
   std::vector<std::size_t> turns;
   for (std::size_t i = 1; i < looks.size(); ++i) {
     const double moved =
@@ -511,8 +522,7 @@ TEST(MissionRooms, WithNothingLeftToExploreTheRobotTurnsRoundAndLooksOnceMoreBef
   CHECK_TEXT(!turns.empty(), r.mission_line.c_str());
   // Every cycle is one look, those after a turn round included (and the last, which ends in
   // its plan).
-  const std::size_t c = r.mission_line.find("cycles=");
-  LONGS_EQUAL_TEXT(std::atoi(r.mission_line.c_str() + c + 7), looks.size(), r.mission_line.c_str());
+  LONGS_EQUAL_TEXT(cycles_of(r), looks.size(), r.mission_line.c_str());
   // The last look is within 0.5 m of the last turn's place.
   const sim::TraceRow& turn = looks[turns.back()];
   CHECK(std::hypot(looks.back().x_m - turn.x_m, looks.back().y_m - turn.y_m) < 0.5);
@@ -618,6 +628,10 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndR
   CHECK(held);
   CHECK(drove_after);
   check_found_safely(r);
+  // The interrupted step ends its cycle and the robot looks again before it drives: every
+  // cycle is still one look, and one look more ends the mission (the glance from the
+  // stand-off that sees the target ends it without ending a cycle).
+  LONGS_EQUAL_TEXT(cycles_of(r) + 1, look_starts(r).size(), r.mission_line.c_str());
 }
 
 namespace {
