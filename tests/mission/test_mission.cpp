@@ -369,8 +369,10 @@ struct PauseScript {
 void on_frame_pause(void* context) {
   auto* p = static_cast<PauseScript*>(context);
   const std::uint64_t now = g_board.sim().now_us();
-  const char* text = p->typed == 0 && now >= 31000000U   ? "pause\r"
-                     : p->typed == 1 && now >= 33000000U ? "resume\r"
+  const char* text = p->typed == 0 && now >= 6500000U    ? "pause\r"
+                     : p->typed == 1 && now >= 12000000U ? "resume\r"
+                     : p->typed == 2 && now >= 31000000U ? "pause\r"
+                     : p->typed == 3 && now >= 33000000U ? "resume\r"
                                                          : nullptr;
   if (text == nullptr) return;
   CHECK(write(p->console_fd, text, std::strlen(text)) == static_cast<ssize_t>(std::strlen(text)));
@@ -379,9 +381,10 @@ void on_frame_pause(void* context) {
 }  // namespace
 
 // The camera gone for 5 s in the first look (a cable pulled and pushed back): the mission holds,
-// its telemetry says so, and it goes on looking once frames come again. A pause and resume by
-// the operator afterwards is a hold of its own: the device hold is over, so it does not count
-// the time since the camera's fault and give up.
+// its telemetry says so, and it goes on looking once frames come again. The operator pauses
+// during the outage (6.5 s) and resumes at 12 s: the camera coming back does not end a hold the
+// operator asked for. A pause and resume afterwards (31 s, 33 s) is a hold of its own: the
+// device hold is over, so it does not count the time since the camera's fault and give up.
 TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeAgain) {
   char dir_template[] = "/tmp/boticelli-faults-XXXXXX";
   const std::string dir = mkdtemp(dir_template);
@@ -399,7 +402,20 @@ TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeA
   CHECK_TEXT(hold != std::string::npos, r.mission_line.c_str());
   const std::size_t looking = r.output.find("state=look", hold);
   CHECK_TEXT(looking != std::string::npos, r.mission_line.c_str());
-  CHECK_EQUAL(2, pause.typed);
+  CHECK_EQUAL(4, pause.typed);
+  // Held from the outage until the operator's resume, though the camera came back at 8 s.
+  bool looked_after_resume = false;
+  double held_from_s = -1.0;
+  for (const sim::TraceRow& row : r.trace) {
+    if (held_from_s < 0.0 && std::string(row.state) == "hold") held_from_s = row.t_s;
+    if (held_from_s >= 0.0 && row.t_s < 11.9) {
+      STRCMP_EQUAL_TEXT("hold", row.state, std::to_string(row.t_s).c_str());
+    }
+    looked_after_resume =
+        looked_after_resume || (row.t_s > 12.0 && std::string(row.state) == "look");
+  }
+  CHECK_TEXT(held_from_s > 3.0 && held_from_s < 6.4, std::to_string(held_from_s).c_str());
+  CHECK(looked_after_resume);
   CHECK_TEXT(r.output.find("state=hold", looking) != std::string::npos, "held by the pause");
   CHECK_TEXT(r.mission_line.find("result=aborted") == std::string::npos, r.mission_line.c_str());
   UNSIGNED_LONGS_EQUAL(0, r.check.collisions);
