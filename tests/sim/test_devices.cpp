@@ -591,6 +591,18 @@ TEST(SimDevices, TheClockReportsHowLateItWokeOnlyWhenItWaitedForTheWallClock) {
   CHECK_EQUAL(-1, clock.last_wake_latency_ns());
 }
 
+namespace {
+// Commands (v, ω) for `us` of simulated time.
+void drive_for(BaseSim& base, ClockSim& clock, float v_m_s, float omega_rad_s, std::uint64_t us) {
+  base.set_velocity(v_m_s, omega_rad_s);
+  clock.sleep_until_us(clock.now_us() + us);
+}
+// Stops the base and waits a second for the wheels to come to rest.
+void stop_and_settle(BaseSim& base, ClockSim& clock) {
+  drive_for(base, clock, 0.0F, 0.0F, 1000000);
+}
+}  // namespace
+
 TEST(SimDevices, AWiderTrueTrackMakesTurnsShortAndUnequalWheelsBendAStraightDrive) {
   // Only the track 1 % wider than the odometry assumes: the base truly turns 1 % less.
   SimParams params;
@@ -600,10 +612,8 @@ TEST(SimDevices, AWiderTrueTrackMakesTurnsShortAndUnequalWheelsBendAStraightDriv
   ClockSim clock(g_sim);
   make_ready(base, clock);
   const float yaw0 = g_sim.true_pose().yaw_rad;
-  base.set_velocity(0.0F, 0.5F);
-  clock.sleep_until_us(clock.now_us() + 2000000);
-  base.set_velocity(0.0F, 0.0F);
-  clock.sleep_until_us(clock.now_us() + 1000000);
+  drive_for(base, clock, 0.0F, 0.5F, 2000000);
+  stop_and_settle(base, clock);
   const double odo_turn = base.odometry().yaw_rad;
   const double true_turn = boticelli::core::wrap_pi(g_sim.true_pose().yaw_rad - yaw0);
   CHECK(odo_turn > 0.8);
@@ -618,10 +628,8 @@ TEST(SimDevices, AWiderTrueTrackMakesTurnsShortAndUnequalWheelsBendAStraightDriv
   ClockSim clock2(g_sim);
   make_ready(base2, clock2);
   const float start_yaw = g_sim.true_pose().yaw_rad;
-  base2.set_velocity(0.2F, 0.0F);
-  clock2.sleep_until_us(clock2.now_us() + 4000000);
-  base2.set_velocity(0.0F, 0.0F);
-  clock2.sleep_until_us(clock2.now_us() + 1000000);
+  drive_for(base2, clock2, 0.2F, 0.0F, 4000000);
+  stop_and_settle(base2, clock2);
   const double driven_m = base2.odometry().x_m;
   DOUBLES_EQUAL(0.0, base2.odometry().yaw_rad, 1e-9);
   DOUBLES_EQUAL(-0.0125 * driven_m, boticelli::core::wrap_pi(g_sim.true_pose().yaw_rad - start_yaw),
@@ -644,13 +652,10 @@ TEST(SimDevices, ACalibratedOdometryFollowsABaseWithAWiderTrackAndUnequalWheels)
   ClockSim clock(g_sim);
   make_ready(base, clock);
   const boticelli::core::Pose2 start_pose = g_sim.true_pose();
-  base.set_velocity(0.0F, 0.5F);
-  clock.sleep_until_us(clock.now_us() + 2000000);
+  drive_for(base, clock, 0.0F, 0.5F, 2000000);
   DOUBLES_EQUAL(0.5, base.odometry().omega_rad_s, 1e-4);
-  base.set_velocity(0.2F, 0.0F);
-  clock.sleep_until_us(clock.now_us() + 4000000);
-  base.set_velocity(0.0F, 0.0F);
-  clock.sleep_until_us(clock.now_us() + 1000000);
+  drive_for(base, clock, 0.2F, 0.0F, 4000000);
+  stop_and_settle(base, clock);
   const boticelli::hal::Odometry o = base.odometry();
   const boticelli::core::Pose2 moved =
       boticelli::core::compose(boticelli::core::inverse(start_pose), g_sim.true_pose());

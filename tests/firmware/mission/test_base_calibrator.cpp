@@ -82,14 +82,21 @@ void drive_a_mission(Base& b, BaseCalibrator& c, int looks) {
 TEST_GROUP(BaseCalibrator) {
   BaseCalibrator calibrator;
   Base base;
+
+  // The estimate after `looks` moves of a base with this true track and diameter ratio.
+  BaseCalibration estimate_of(double track_m, double ratio, int looks, double noise_rad = 0.0) {
+    base.true_track_m = track_m;
+    base.diameter_ratio = ratio;
+    base.noise_rad = noise_rad;
+    drive_a_mission(base, calibrator, looks);
+    const BaseCalibration e = calibrator.estimate();
+    CHECK_TRUE(e.valid);
+    return e;
+  }
 };
 
 TEST(BaseCalibrator, AnExactBaseIsEstimatedExactlyFromNoiselessRegistrations) {
-  base.true_track_m = 0.404;
-  base.diameter_ratio = 1.005;
-  drive_a_mission(base, calibrator, 12);
-  const BaseCalibration e = calibrator.estimate();
-  CHECK_TRUE(e.valid);
+  const BaseCalibration e = estimate_of(0.404, 1.005, 12);
   LONGS_EQUAL(12, e.intervals);
   DOUBLES_EQUAL(17.2, e.turned_rad, 1e-4);  // 4 × 2.5 + 8 × 0.9
   DOUBLES_EQUAL(7.2, e.driven_m, 1e-4);     // backward steps counted by their length
@@ -99,22 +106,13 @@ TEST(BaseCalibrator, AnExactBaseIsEstimatedExactlyFromNoiselessRegistrations) {
 }
 
 TEST(BaseCalibrator, ATrackTooShortAndWheelsTheOtherWayAreEstimatedToo) {
-  base.true_track_m = 0.392;
-  base.diameter_ratio = 0.99;
-  drive_a_mission(base, calibrator, 10);
-  const BaseCalibration e = calibrator.estimate();
-  CHECK_TRUE(e.valid);
+  const BaseCalibration e = estimate_of(0.392, 0.99, 10);
   DOUBLES_EQUAL(0.392, e.track_m, 1e-5);
   DOUBLES_EQUAL(0.99, e.diameter_ratio, 1e-5);
 }
 
 TEST(BaseCalibrator, NoisyRegistrationsGiveAnEstimateWithinItsStandardErrors) {
-  base.true_track_m = 0.404;
-  base.diameter_ratio = 1.005;
-  base.noise_rad = 0.05;  // ±2.9°, as registrations err
-  drive_a_mission(base, calibrator, 40);
-  const BaseCalibration e = calibrator.estimate();
-  CHECK_TRUE(e.valid);
+  const BaseCalibration e = estimate_of(0.404, 1.005, 40, 0.05);  // ±2.9°, as registrations err
   CHECK(e.track_sd_m > 0.0F && e.track_sd_m < 0.004F);
   CHECK(e.diameter_ratio_sd > 0.0F && e.diameter_ratio_sd < 0.02F);
   CHECK(std::fabs(e.track_m - 0.404F) < 3.0F * e.track_sd_m);
@@ -126,10 +124,8 @@ TEST(BaseCalibrator, AHalfTurnWrappedToTheWrongSideIsTakenTheWayTheWheelsTurned)
   base.register_look(calibrator);
   for (int i = 0; i < 6; ++i) {
     // Exactly half a turn each way: the wrapped change reads −π for a left turn of π too.
-    const double before = base.estimate_yaw;
     base.wheels(kPi * base.nominal_track_m, 0.0);
     base.wheels(0.0, 0.5);
-    (void)before;
     calibrator.moved(static_cast<float>(-kPi), true, base.left_m, base.right_m);
     base.register_look(calibrator);
   }
