@@ -14,7 +14,11 @@ file. A mutant is
 
 score = (caught + timed out) / (sampled - not compiling). docs/testing.md, "Mutation score".
 
-  tools/mutation_score.py [--n N] [--seed SEED] [--json] [--list] FILE...
+  tools/mutation_score.py [--n N] [--seed SEED] [--skip K] [--json] [--list] FILE...
+
+--skip K runs only the sample's mutants after its first K (in the listed order): a run that
+was stopped goes on from where it stopped, at the same seed on the same file. The skipped ones
+are reported as not run and left out of the score; their outcomes are the stopped run's.
 
 The scratch copy (--scratch, default ${TMPDIR:-/tmp}/boticelli-mutation-score) and its build
 are kept between runs, so each mutant costs an incremental build of one object and a link.
@@ -64,12 +68,13 @@ class FileResult:
     survived: int = 0
     timed_out: int = 0
     not_compiling: int = 0
+    not_run: int = 0  # the first --skip of the sample: a stopped run's, reported by it
     wall_s: float = 0.0
     error: str = ""
     mutants: list = field(default_factory=list)
 
     def score(self):
-        built = self.sampled - self.not_compiling
+        built = self.sampled - self.not_run - self.not_compiling
         return None if built == 0 else (self.caught + self.timed_out) / built
 
 
@@ -385,7 +390,11 @@ def score_file(scratch, rel, binaries, args):
         plan.append((seconds, name, max(args.timeout, 3.0 * seconds + 10.0)))
     plan = [(name, timeout_s) for _, name, timeout_s in sorted(plan)]
     try:
-        for mu in sample:
+        for index, mu in enumerate(sample):
+            if index < args.skip:
+                mu.outcome = "not run"
+                result.not_run += 1
+                continue
             t = time.monotonic()
             with open(path, "w", encoding="utf-8") as f:
                 f.write(apply(original, mu))
@@ -417,6 +426,8 @@ def main():
     parser.add_argument("files", nargs="+", metavar="FILE", help="a source file, from the top")
     parser.add_argument("--n", type=int, default=30, help="mutants sampled per file (30)")
     parser.add_argument("--seed", type=int, default=1, help="the sample's seed (1)")
+    parser.add_argument("--skip", type=int, default=0,
+                        help="run only the sample's mutants after its first SKIP (a stopped run's)")
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
     parser.add_argument("--list", action="store_true",
                         help="only list the sampled mutants (no build)")
@@ -428,6 +439,8 @@ def main():
         os.environ.get("TMPDIR", "/tmp"), "boticelli-mutation-score")))
     parser.add_argument("--map", default=MAP_FILE)
     args = parser.parse_args()
+    if args.skip < 0 or args.skip > args.n:
+        parser.error(f"--skip must be within 0..{args.n}")
 
     table = load_map(args.map)
     for rel in args.files:
@@ -468,12 +481,12 @@ def main():
                 print(f"  {r.file}:{mu.line}: {mu.describe()}")
     else:
         head = ("file", "generated", "sampled", "caught", "survived", "timed out",
-                "not compiling", "score", "wall s")
+                "not compiling", "not run", "score", "wall s")
         rows = [head]
         for r in results:
             s = r.score()
             rows.append((r.file, r.generated, r.sampled, r.caught, r.survived, r.timed_out,
-                         r.not_compiling, "-" if s is None else f"{100 * s:.0f}%", r.wall_s))
+                         r.not_compiling, r.not_run, "-" if s is None else f"{100 * s:.0f}%", r.wall_s))
         widths = [max(len(str(row[i])) for row in rows) for i in range(len(head))]
         print()
         for row in rows:

@@ -422,6 +422,56 @@ TEST(MissionThesisRoom, ACameraGoneForFiveSecondsHoldsTheMissionUntilFramesComeA
   STRCMP_CONTAINS("cycles=1", r.mission_line.c_str());
 }
 
+// A pan-tilt unit that refuses every move from 3 s on, with the device retry time cut to 5 s
+// (`[faults] retry_s`): its driver stays healthy (it answers), so the mission's own hold gives
+// up: it holds, tries the move again every second, and after 5 s ends for a restart (exit 1,
+// the state still running, so `--resume` carries it on). Its reason is the hold's, once (not a
+// copy per retry), and the mission log's last entry holds it whole, as far as an entry's 95
+// bytes go.
+TEST(MissionThesisRoom, APanTiltUnitRefusingEveryMoveEndsTheMissionForARestartWithTheReasonOnce) {
+  char dir_template[] = "/tmp/boticelli-giveup-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const std::string plan = dir + "/faults.txt";
+  const std::string conf = dir + "/boticelli.conf";
+  std::ofstream(plan) << "3 ptu wrong 600\n";
+  std::ofstream(conf) << "[faults]\nretry_s = 5\n";
+  const MissionRun r = run_mission("thesis_room", "1", 0.0F, nullptr,
+                                   {"--faults", plan.c_str(), "--config", conf.c_str(), "--state",
+                                    dir.c_str(), "--max-cycles", "3"});
+  static boticelli::firmware::MissionState state;
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  const bool loaded =
+      store.open(dir.c_str(), error, sizeof error) &&
+      store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  std::remove(plan.c_str());
+  std::remove(conf.c_str());
+  remove_state_dir(dir);
+  CHECK_TEXT(loaded, error);
+  CHECK_EQUAL_TEXT(boticelli::firmware::kExitFailure, r.exit_code, r.mission_line.c_str());
+  STRCMP_CONTAINS("MISSION result=aborted", r.mission_line.c_str());
+  const std::size_t q = r.mission_line.find("reason=\"");
+  CHECK_TEXT(q != std::string::npos, r.mission_line.c_str());
+  const std::string reason = r.mission_line.substr(q + 8, r.mission_line.size() - q - 9);
+  // The hold's first entry in the mission log gives its reason; the give-up repeats it once.
+  std::string held;
+  for (const boticelli::firmware::MissionLogEntry& e : state.log) {
+    const std::string text = e.text.data();
+    if (held.empty() && text.rfind("held: ", 0) == 0) held = text.substr(6);
+  }
+  STRCMP_CONTAINS_TEXT("pan-tilt unit refused a move", held.c_str(), reason.c_str());
+  STRCMP_EQUAL(("gave up after 5 s: " + held).c_str(), reason.c_str());
+  CHECK_TEXT(state.end == boticelli::firmware::MissionEnd::kRunning, "resumable");
+  CHECK_TEXT(!state.log.empty(), "a mission log");
+  const std::string last = state.log.back().text.data();
+  const std::string whole = ("mission aborted: " + reason)
+                                .substr(0, boticelli::firmware::MissionLogEntry::kMaxTextBytes);
+  STRCMP_EQUAL(whole.c_str(), last.c_str());
+  // Long enough that a shorter entry would cut it (the PTU's own words follow).
+  CHECK_TEXT(whole.size() >= boticelli::firmware::MissionLogEntry::kMaxTextBytes - 1, last.c_str());
+  UNSIGNED_LONGS_EQUAL(0, r.check.collisions);
+}
+
 namespace {
 // Takes the target away once the robot is within 1.2 m of it (on its way to the stand-off,
 // 0.75 m, after the target was confirmed from two places).
