@@ -615,6 +615,7 @@ struct EstopScript {
   float moved_after_release_m = -1.0F;
   float moved_after_reset_m = -1.0F;
   bool stopped_until_resume = true;  // the base reported stopped at every frame before it
+  bool asked_status = false;         // `status` typed near the target, after the resume
 };
 
 void on_frame_estop(void* context) {
@@ -629,7 +630,19 @@ void on_frame_estop(void* context) {
     }
     return;
   }
-  if (e->phase == EstopScript::kResumed) return;
+  if (e->phase == EstopScript::kResumed) {
+    // Near the target (on the way to its stand-off, so confirmed): what the operator sees of
+    // it; the reply is checked after the run.
+    const boticelli::core::Pose2 p = w.true_pose();
+    const Eigen::Vector3f target = g_board.target_m();
+    if (!e->asked_status && std::hypot(p.x_m - target.x(), p.y_m - target.y()) < 1.2F) {
+      e->asked_status = true;
+      const char* text = "status\r";
+      CHECK(write(e->console_fd, text, std::strlen(text)) ==
+            static_cast<ssize_t>(std::strlen(text)));
+    }
+    return;
+  }
   ++e->frames;
   const bool stopped = w.base_health() == boticelli::hal::BaseHealth::kStopped;
   if (e->frames_to_stop < 0 && stopped) e->frames_to_stop = e->frames;
@@ -694,6 +707,24 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndR
   CHECK(held);
   CHECK(drove_after);
   check_found_safely(r);
+  // `status` near the target gives it confirmed and where, in the mission frame (the start
+  // pose's), within 0.3 m of the truth there.
+  CHECK(e.asked_status);
+  const std::size_t status = r.output.find("status state=");
+  CHECK_TEXT(status != std::string::npos, "a status reply");
+  const std::string reply = r.output.substr(status, r.output.find('\n', status) - status);
+  STRCMP_CONTAINS_TEXT(" target=confirmed ", reply.c_str(), reply.c_str());
+  const std::size_t x = reply.find("target_x_m=");
+  const std::size_t y = reply.find("target_y_m=");
+  CHECK_TEXT(x != std::string::npos && y != std::string::npos, reply.c_str());
+  const sim::TraceRow& start = r.trace.front();
+  const boticelli::core::Point2 truth = boticelli::core::to_robot(
+      {static_cast<float>(start.x_m), static_cast<float>(start.y_m),
+       static_cast<float>(start.yaw_rad)},
+      r.target);
+  const float off_m = std::hypot(static_cast<float>(std::atof(reply.c_str() + x + 11)) - truth.x_m,
+                                 static_cast<float>(std::atof(reply.c_str() + y + 11)) - truth.y_m);
+  CHECK_TEXT(off_m <= 0.3F, (reply + ", " + std::to_string(off_m) + " m off").c_str());
   // The interrupted step ends its cycle and the robot looks again before it drives: every
   // cycle is still one look, and one look more ends the mission (the glance from the
   // stand-off that sees the target ends it without ending a cycle).
