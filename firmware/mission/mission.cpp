@@ -558,9 +558,12 @@ bool Mission::resume_from_wheels(std::uint64_t now_us) {
                  left_m, right_m);
   } else {
     // What the robot did while no firmware ran (the last step's end, the ODrives' watchdog
-    // stopping it), from the counters the controllers kept.
+    // stopping it), from the counters the controllers kept (at the nominal wheels: the base's
+    // calibration, [base] odometry_*, applies here as it does to the odometry).
     const core::Pose2 moved =
-        core::arc_motion(left_m, right_m, static_cast<double>(config_.track_width_m));
+        core::arc_motion(left_m * static_cast<double>(config_.odometry_left_scale()),
+                         right_m * static_cast<double>(config_.odometry_right_scale()),
+                         static_cast<double>(config_.odometry_track_m()));
     state_.pose = core::compose(state_.pose, moved);
     line.appendf("resumed pose moved on by the wheels: %.3f m, %.1f deg",
                  static_cast<double>(std::hypot(moved.x_m, moved.y_m)),
