@@ -1,5 +1,6 @@
-// Benchmark suite "mission": the firmware binary run on every shipped and test world, per seed and
-// planner, checked against each world's geometry.
+// Benchmark suites "mission" and "localization": the firmware binary run on every shipped and
+// test world, per seed and planner, checked against each world's geometry; "localization" runs
+// the simulator's realistic setting with every look registered and reports the pose estimate.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -36,7 +37,9 @@
 namespace boticelli::bench {
 namespace {
 
-constexpr const char* kSuite = "mission";
+constexpr const char* kMissionSuite = "mission";
+constexpr const char* kLocalizationSuite = "localization";
+const char* g_suite = kMissionSuite;   // the suite running (its rows' and messages' name)
 constexpr double kGridCellM = 0.1;     // the grid the model's size is compared with [m]
 constexpr double kGridCeilingM = 2.5;  // its height: BoardConfig::ceiling_height_m [m]
 
@@ -54,8 +57,11 @@ struct MissionLine {
   double look_s = std::numeric_limits<double>::quiet_NaN();
   double think_s = std::numeric_limits<double>::quiet_NaN();
   double plan_s = std::numeric_limits<double>::quiet_NaN();
-  std::string longest_line;  // "LOG info mission longest_ms view=… task=…"
-  std::string map_line;      // "LOG info mission map planner=… grid_bytes=… …"
+  double register_s = std::numeric_limits<double>::quiet_NaN();
+  double registered = std::numeric_limits<double>::quiet_NaN();  // looks registered
+  std::string calibration_line;  // "LOG info mission base_calibration valid=… …"
+  std::string longest_line;      // "LOG info mission longest_ms view=… task=…"
+  std::string map_line;          // "LOG info mission map planner=… grid_bytes=… …"
 };
 
 // The longest unit of each kind, as the firmware names them (mission::unit_name).
@@ -107,6 +113,10 @@ MissionLine parse_output(const std::string& path) {
       m.look_s = field(line, "look_s");
       m.think_s = field(line, "think_s");
       m.plan_s = field(line, "plan_s");
+      m.register_s = field(line, "register_s");
+      m.registered = field(line, "registered");
+    } else if (line.find("LOG info mission base_calibration ") != std::string::npos) {
+      m.calibration_line = line;
     }
   }
   return m;
@@ -133,7 +143,7 @@ ModelSize model_size(const std::string& state_dir) {
   char why[512] = "";
   if (!g_store.open(state_dir.c_str(), why, sizeof why) ||
       g_store.load(g_state, why, sizeof why) != firmware::LoadResult::kLoaded) {
-    std::fprintf(stderr, "mission: %s: %s\n", state_dir.c_str(), why);
+    std::fprintf(stderr, "%s: %s: %s\n", g_suite, state_dir.c_str(), why);
     return s;
   }
   s.text_bytes = g_state.model_bytes;
@@ -181,49 +191,141 @@ hal::sim::World g_world;
 
 constexpr double kObstacleOffM = 0.3;  // an occupied cell farther than this from a surface
 
+// A trace's columns by name and its rows as numbers (the state column reads as 0).
+struct TraceTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+  [[nodiscard]] int column(const char* name) const {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i] == name) return static_cast<int>(i);
+    }
+    return -1;
+  }
+};
+
+std::vector<std::string> split_commas(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t at = 0;
+  while (at <= line.size()) {
+    const std::size_t comma = std::min(line.find(',', at), line.size());
+    out.push_back(line.substr(at, comma - at));
+    at = comma + 1;
+  }
+  return out;
+}
+
+bool read_table(const std::string& trace, TraceTable& t) {
+  const std::string text = read_file(trace);
+  std::size_t at = text.find('\n');
+  if (at == std::string::npos) return false;
+  t.names = split_commas(text.substr(0, at));
+  while (++at < text.size()) {
+    const std::size_t eol = std::min(text.find('\n', at), text.size());
+    std::vector<double> row;
+    for (const std::string& f : split_commas(text.substr(at, eol - at))) {
+      row.push_back(std::strtod(f.c_str(), nullptr));
+    }
+    if (row.size() == t.names.size()) t.rows.push_back(std::move(row));
+    at = eol;
+  }
+  return !t.rows.empty();
+}
+
+// A pose of a row: the columns PREFIXx_m, PREFIXy_m, PREFIXyaw_rad ("", "odo_", "est_").
+bool row_pose(const TraceTable& t, const std::vector<double>& row, const std::string& prefix,
+              core::Pose2& pose) {
+  const int x = t.column((prefix + "x_m").c_str());
+  const int y = t.column((prefix + "y_m").c_str());
+  const int yaw = t.column((prefix + "yaw_rad").c_str());
+  if (x < 0 || y < 0 || yaw < 0) return false;
+  pose = {static_cast<float>(row[static_cast<std::size_t>(x)]),
+          static_cast<float>(row[static_cast<std::size_t>(y)]),
+          static_cast<float>(row[static_cast<std::size_t>(yaw)])};
+  return true;
+}
+
 // The mission frame in the world: the first trace row's true pose composed with the inverse
 // of its odometry pose (the odo_* columns; the frame is the odometry's at the base's start).
-bool mission_frame(const std::string& trace, core::Pose2& origin) {
-  const std::string text = read_file(trace);
-  const std::size_t eol = text.find('\n');
-  if (eol == std::string::npos) return false;
-  std::vector<std::string> names;
-  std::vector<double> values;
-  std::size_t at = 0;
-  const std::string header = text.substr(0, eol);
-  while (at <= header.size()) {
-    const std::size_t comma = std::min(header.find(',', at), header.size());
-    names.push_back(header.substr(at, comma - at));
-    at = comma + 1;
-  }
-  const std::size_t eol2 = text.find('\n', eol + 1);
-  const std::string row =
-      text.substr(eol + 1, eol2 == std::string::npos ? std::string::npos : eol2 - eol - 1);
-  at = 0;
-  while (at <= row.size()) {
-    const std::size_t comma = std::min(row.find(',', at), row.size());
-    values.push_back(std::strtod(row.substr(at, comma - at).c_str(), nullptr));
-    at = comma + 1;
-  }
-  const auto value = [&](const char* name, double& v) {
-    for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) {
-      if (names[i] == name) {
-        v = values[i];
-        return true;
-      }
-    }
-    return false;
-  };
-  double x = 0, y = 0, yaw = 0, ox = 0, oy = 0, oyaw = 0;
-  if (!value("x_m", x) || !value("y_m", y) || !value("yaw_rad", yaw) || !value("odo_x_m", ox) ||
-      !value("odo_y_m", oy) || !value("odo_yaw_rad", oyaw)) {
+bool mission_frame(const TraceTable& t, core::Pose2& origin) {
+  core::Pose2 truth{};
+  core::Pose2 odo{};
+  if (t.rows.empty() || !row_pose(t, t.rows.front(), "", truth) ||
+      !row_pose(t, t.rows.front(), "odo_", odo)) {
     return false;
   }
-  const double ryaw = yaw - oyaw;
-  const double c = std::cos(ryaw), s = std::sin(ryaw);
-  origin = {static_cast<float>(x - (c * ox - s * oy)), static_cast<float>(y - (s * ox + c * oy)),
-            static_cast<float>(ryaw)};
+  origin = core::compose(truth, core::inverse(odo));
   return true;
+}
+
+// How far the firmware's estimate (est_*) and the raw odometry (odo_*), both in the mission
+// frame, are from the true pose: at the end and at worst over the run [m, deg], and the path
+// the robot truly drove [m].
+struct PoseErrors {
+  bool ok = false;
+  double path_m = 0.0;
+  double final_m[2] = {0.0, 0.0};  // [estimate, odometry]
+  double final_deg[2] = {0.0, 0.0};
+  double worst_m[2] = {0.0, 0.0};
+  double worst_deg[2] = {0.0, 0.0};
+};
+
+PoseErrors pose_errors(const TraceTable& t) {
+  PoseErrors e;
+  core::Pose2 origin{};
+  if (!mission_frame(t, origin)) return e;
+  const char* prefixes[2] = {"est_", "odo_"};
+  core::Pose2 last{};
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    core::Pose2 truth{};
+    if (!row_pose(t, t.rows[r], "", truth)) return e;
+    if (r > 0)
+      e.path_m += static_cast<double>(std::hypot(truth.x_m - last.x_m, truth.y_m - last.y_m));
+    last = truth;
+    for (int k = 0; k < 2; ++k) {
+      core::Pose2 p{};
+      if (!row_pose(t, t.rows[r], prefixes[k], p)) return e;
+      const core::Pose2 w = core::compose(origin, p);
+      e.final_m[k] = static_cast<double>(std::hypot(w.x_m - truth.x_m, w.y_m - truth.y_m));
+      e.final_deg[k] = static_cast<double>(std::fabs(core::wrap_pi(w.yaw_rad - truth.yaw_rad))) *
+                       180.0 / 3.14159265358979323846;
+      e.worst_m[k] = std::max(e.worst_m[k], e.final_m[k]);
+      e.worst_deg[k] = std::max(e.worst_deg[k], e.final_deg[k]);
+    }
+  }
+  e.ok = true;
+  return e;
+}
+
+// The median of `v` (NaN when empty).
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A configuration text with `key = value` in [table]: the user's own setting of it stays;
+// otherwise it goes into the user's [table] (TOML defines a table once) or a new one.
+std::string with_key(std::string text, const char* table, const char* key, const char* value) {
+  const std::string head = std::string("[") + table + "]\n";
+  std::size_t at = text.find(head);
+  while (at != std::string::npos && at != 0 && text[at - 1] != '\n') at = text.find(head, at + 1);
+  const std::string line = std::string(key) + " = " + value + "\n";
+  if (at == std::string::npos) return text + head + line;
+  const std::size_t body = at + head.size();
+  std::size_t end = text.find("\n[", body - 1);
+  end = end == std::string::npos ? text.size() : end + 1;
+  for (std::size_t l = body; l < end;) {
+    const std::size_t eol = std::min(text.find('\n', l), end);
+    const std::string k = text.substr(l, eol - l);
+    const std::size_t eq = k.find('=');
+    std::string name = k.substr(0, eq == std::string::npos ? 0 : eq);
+    while (!name.empty() && (name.back() == ' ' || name.back() == '\t')) name.pop_back();
+    if (name == key) return text;
+    l = eol + 1;
+  }
+  text.insert(body, line);
+  return text;
 }
 
 // The map the firmware wrote (--map PREFIX: PGM + map_server YAML) against the world: occupied
@@ -294,6 +396,8 @@ struct Tally {
   std::size_t contacts = 0;
   double spl_sum = 0.0;
   double found_sim_s = 0.0;
+  std::vector<double> est_final_m, est_final_deg, odo_final_m, odo_final_deg, register_ms;
+  std::size_t within_target = 0;  // estimate within 0.05 m and 2 deg of the truth at the end
 };
 
 std::vector<long> seed_list() {
@@ -315,11 +419,14 @@ std::vector<long> seed_list() {
   return seeds.empty() ? std::vector<long>{1} : seeds;
 }
 
-int run() {
+// `localization`: the simulator's realistic setting and every look registered, unless the
+// user's configuration (BOTICELLI_MISSION_CONFIG) sets either.
+int run(bool localization) {
+  g_suite = localization ? kLocalizationSuite : kMissionSuite;
   const std::string bin_dir = own_directory();
   const std::string firmware_bin = bin_dir + "/boticelli";
   if (::access(firmware_bin.c_str(), X_OK) != 0) {
-    std::fprintf(stderr, "mission: no firmware binary at %s (build the 'boticelli' target)\n",
+    std::fprintf(stderr, "%s: no firmware binary at %s (build the 'boticelli' target)\n", g_suite,
                  firmware_bin.c_str());
     return 1;
   }
@@ -340,8 +447,8 @@ int run() {
       }
     }
     if (planners.empty()) {
-      std::fprintf(stderr,
-                   "mission: BOTICELLI_MISSION_PLANNERS lists neither thesis nor frontier\n");
+      std::fprintf(stderr, "%s: BOTICELLI_MISSION_PLANNERS lists neither thesis nor frontier\n",
+                   g_suite);
       return 1;
     }
   }
@@ -349,7 +456,7 @@ int run() {
   char tmp_template[] = "/tmp/boticelli-mission-XXXXXX";
   const char* tmp = ::mkdtemp(tmp_template);
   if (tmp == nullptr) {
-    std::fprintf(stderr, "mission: cannot create a temporary directory: %s\n",
+    std::fprintf(stderr, "%s: cannot create a temporary directory: %s\n", g_suite,
                  std::strerror(errno));
     return 1;
   }
@@ -359,7 +466,7 @@ int run() {
   if (const char* path = std::getenv("BOTICELLI_MISSION_CONFIG"); path != nullptr && *path) {
     FILE* in = std::fopen(path, "r");
     if (in == nullptr) {
-      std::fprintf(stderr, "mission: cannot read BOTICELLI_MISSION_CONFIG %s: %s\n", path,
+      std::fprintf(stderr, "%s: cannot read BOTICELLI_MISSION_CONFIG %s: %s\n", g_suite, path,
                    std::strerror(errno));
       return 1;
     }
@@ -373,18 +480,19 @@ int run() {
     const std::string conf = std::string(tmp) + "/" + planner + ".conf";
     FILE* f = std::fopen(conf.c_str(), "w");
     if (f == nullptr) {
-      std::fprintf(stderr, "mission: cannot write %s\n", conf.c_str());
+      std::fprintf(stderr, "%s: cannot write %s\n", g_suite, conf.c_str());
       return 1;
     }
-    // TOML defines a table once: the planner's key goes into the user's [mission] if any.
-    const std::string key =
-        std::string("thesis_planner = ") + (planner == "thesis" ? "true" : "false") + "\n";
+    // The planner knob decides the planner, whatever the user's file says.
     std::string text = extra;
-    const std::size_t table = text.find("[mission]\n");
-    if (table != std::string::npos && (table == 0 || text[table - 1] == '\n')) {
-      text.insert(table + 10, key);
-    } else {
-      text += "[mission]\n" + key;
+    for (std::size_t at = text.find("thesis_planner"); at != std::string::npos;
+         at = text.find("thesis_planner", at + 1)) {
+      if (at == 0 || text[at - 1] == '\n') text.insert(at, "# ");
+    }
+    text = with_key(text, "mission", "thesis_planner", planner == "thesis" ? "true" : "false");
+    if (localization) {
+      text = with_key(text, "sim", "realism", "\"realistic\"");
+      text = with_key(text, "mission", "register_looks", "true");
     }
     std::fputs(text.c_str(), f);
     std::fclose(f);
@@ -407,12 +515,12 @@ int run() {
   std::vector<std::string> listed_anywhere;  // what the filter found in some set
   for (const Set& set : sets) {
     for (const std::string& name :
-         world_names(set.dir, "BOTICELLI_MISSION_WORLDS", kSuite, false)) {
+         world_names(set.dir, "BOTICELLI_MISSION_WORLDS", g_suite, false)) {
       listed_anywhere.push_back(name);
       const std::string path = set.dir + "/" + name + ".sdf";
       char error[256] = "";
       if (!hal::sim::load_world(path.c_str(), g_world, error, sizeof error)) {
-        std::fprintf(stderr, "mission: %s\n", error);
+        std::fprintf(stderr, "%s: %s\n", g_suite, error);
         continue;
       }
       bool has_target = false;
@@ -420,7 +528,7 @@ int run() {
         has_target = has_target || g_world.surfaces[i].target_face != hal::sim::kNoFace;
       }
       if (!has_target) {
-        JsonLine(kSuite, name.c_str())
+        JsonLine(g_suite, name.c_str())
             .text("world", path.c_str())
             .text("skipped", "no target")
             .emit();
@@ -455,7 +563,7 @@ int run() {
         item.resize(item.size() - 4);
       if (!item.empty() && std::find(listed_anywhere.begin(), listed_anywhere.end(), item) ==
                                listed_anywhere.end()) {
-        std::fprintf(stderr, "mission: no world '%s' in any set\n", item.c_str());
+        std::fprintf(stderr, "%s: no world '%s' in any set\n", g_suite, item.c_str());
       }
       at = comma + 1;
     }
@@ -512,7 +620,7 @@ int run() {
     if (trace_ok) {
       check = hal::sim::check_trace(g_world, rows, config.robot_radius_m, config.robot_height_m);
     } else {
-      std::fprintf(stderr, "mission: %s: %s\n", r.world.c_str(), trace_error.c_str());
+      std::fprintf(stderr, "%s: %s: %s\n", g_suite, r.world.c_str(), trace_error.c_str());
     }
     const core::Point2 start{g_world.start.x_m, g_world.start.y_m};
     const core::Point2 goal{g_world.target_point_m.x(), g_world.target_point_m.y()};
@@ -528,9 +636,14 @@ int run() {
     const ModelSize size = model_size(r.dir + "/state");
     core::Pose2 origin{};
     MapCheck map_check{};
-    if (mission_frame(r.dir + "/trace.csv", origin)) {
+    TraceTable table;
+    const bool table_ok = read_table(r.dir + "/trace.csv", table);
+    if (table_ok && mission_frame(table, origin)) {
       map_check = check_map(r.dir + "/map", origin, config.robot_height_m);
     }
+    const PoseErrors pose = table_ok ? pose_errors(table) : PoseErrors{};
+    const double register_ms = m.registered > 0.0 ? 1e3 * m.register_s / m.registered
+                                                  : std::numeric_limits<double>::quiet_NaN();
     const double free_m2 = field(m.map_line, "free_m2");
 
     const std::string key = r.set + " " + r.planner;
@@ -546,8 +659,16 @@ int run() {
     t.contacts += trace_ok ? check.collisions : 1U;
     t.spl_sum += spl;
     t.found_sim_s += success ? m.sim_time_s : 0.0;
+    if (pose.ok) {
+      t.est_final_m.push_back(pose.final_m[0]);
+      t.est_final_deg.push_back(pose.final_deg[0]);
+      t.odo_final_m.push_back(pose.final_m[1]);
+      t.odo_final_deg.push_back(pose.final_deg[1]);
+      t.within_target += pose.final_m[0] <= 0.05 && pose.final_deg[0] <= 2.0 ? 1U : 0U;
+    }
+    if (std::isfinite(register_ms)) t.register_ms.push_back(register_ms);
 
-    JsonLine line(kSuite, r.name.c_str());
+    JsonLine line(g_suite, r.name.c_str());
     line.text("world", r.world.c_str())
         .text("set", r.set.c_str())
         .integer("seed", r.seed)
@@ -602,12 +723,40 @@ int run() {
           .integer("map_points_bytes", static_cast<std::int64_t>(size.points_bytes));
     }
     line.integer("grid_0_1m_bytes", static_cast<std::int64_t>(grid_bytes(g_world)));
+    // The pose: the estimate's and the odometry's error against the truth, at the end and at
+    // worst, per metre driven; registration CPU per registered look; the base's calibration.
+    if (pose.ok) {
+      const char* kinds[2] = {"est", "odo"};
+      for (int k = 0; k < 2; ++k) {
+        const std::string kind = kinds[k];
+        line.num((kind + "_final_m").c_str(), pose.final_m[k])
+            .num((kind + "_final_deg").c_str(), pose.final_deg[k])
+            .num((kind + "_worst_m").c_str(), pose.worst_m[k])
+            .num((kind + "_worst_deg").c_str(), pose.worst_deg[k])
+            .num((kind + "_final_m_per_m").c_str(),
+                 pose.path_m > 0.0 ? pose.final_m[k] / pose.path_m : 0.0)
+            .num((kind + "_final_deg_per_m").c_str(),
+                 pose.path_m > 0.0 ? pose.final_deg[k] / pose.path_m : 0.0);
+      }
+      line.num("true_path_m", pose.path_m);
+    }
+    line.num("registered_looks", m.registered).num("register_ms_per_look", register_ms);
+    if (field(m.calibration_line, "valid") == 1.0) {
+      // "odometry_track_scale=A sd=B odometry_diameter_ratio=C sd=D"
+      const std::size_t ratio = m.calibration_line.find(" odometry_diameter_ratio=");
+      line.num("calibrated_track_scale", field(m.calibration_line, "odometry_track_scale"))
+          .num("calibrated_track_scale_sd", field(m.calibration_line.substr(0, ratio), "sd"))
+          .num("calibrated_diameter_ratio", field(m.calibration_line, "odometry_diameter_ratio"))
+          .num("calibrated_diameter_ratio_sd", ratio == std::string::npos
+                                                   ? std::numeric_limits<double>::quiet_NaN()
+                                                   : field(m.calibration_line.substr(ratio), "sd"));
+    }
     for (const char* unit : kUnitNames) {
       line.num((std::string("longest_") + unit + "_ms").c_str(), field(m.longest_line, unit));
     }
     line.emit();
     if (!m.found_line || !m.found_cpu || m.map_line.empty()) {
-      std::fprintf(stderr, "mission: %s seed %ld %s: %s%s%s (console output in %s)\n",
+      std::fprintf(stderr, "%s: %s seed %ld %s: %s%s%s (console output in %s)\n", g_suite,
                    r.world.c_str(), r.seed, r.planner.c_str(),
                    m.found_line ? "" : "no MISSION line ", m.found_cpu ? "" : "no cpu line ",
                    m.map_line.empty() ? "no map line" : "", (r.dir + "/console.txt").c_str());
@@ -620,7 +769,7 @@ int run() {
     }
     ::rmdir(tmp);
   } else {
-    std::fprintf(stderr, "mission: outputs kept in %s\n", tmp);
+    std::fprintf(stderr, "%s: outputs kept in %s\n", g_suite, tmp);
   }
   std::string seed_text;
   for (const long s : seeds) seed_text += (seed_text.empty() ? "" : ",") + std::to_string(s);
@@ -628,7 +777,7 @@ int run() {
     const std::size_t space = key.find(' ');
     const std::string set = key.substr(0, space);
     const std::string planner = key.substr(space + 1);
-    JsonLine(kSuite, "summary")
+    JsonLine(g_suite, "summary")
         .text("set", set.c_str())
         .text("planner", planner.c_str())
         .flag("default", planner == default_planner)
@@ -640,13 +789,37 @@ int run() {
         .num("mean_sim_time_to_find_s", t.found > 0 ? t.found_sim_s / static_cast<double>(t.found)
                                                     : std::numeric_limits<double>::quiet_NaN())
         .integer("max_cycles", max_cycles)
+        .integer("est_within_5cm_2deg", static_cast<std::int64_t>(t.within_target))
+        .num("est_final_m_median", median(t.est_final_m))
+        .num("est_final_deg_median", median(t.est_final_deg))
+        .num("est_final_m_max", t.est_final_m.empty()
+                                    ? std::numeric_limits<double>::quiet_NaN()
+                                    : *std::max_element(t.est_final_m.begin(), t.est_final_m.end()))
+        .num("odo_final_m_median", median(t.odo_final_m))
+        .num("odo_final_deg_median", median(t.odo_final_deg))
+        .num("register_ms_per_look_max",
+             t.register_ms.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                   : *std::max_element(t.register_ms.begin(), t.register_ms.end()))
         .emit();
   }
   return 0;
 }
 
+int run_mission() {
+  return run(false);
+}
+int run_localization() {
+  return run(true);
+}
+
 [[maybe_unused]] const bool g_registered = register_suite(
-    {kSuite, "firmware binary on every shipped and test world, per seed and planner", &run});
+    {kMissionSuite, "firmware binary on every shipped and test world, per seed and planner",
+     &run_mission});
+[[maybe_unused]] const bool g_registered_localization = register_suite(
+    {kLocalizationSuite,
+     "the mission suite with the realistic sim and every look registered: the pose estimate "
+     "and the raw odometry against the truth",
+     &run_localization});
 
 }  // namespace
 }  // namespace boticelli::bench
