@@ -464,8 +464,8 @@ TEST(MissionThesisRoom, APanTiltUnitRefusingEveryMoveEndsTheMissionForARestartWi
   CHECK_TEXT(state.end == boticelli::firmware::MissionEnd::kRunning, "resumable");
   CHECK_TEXT(!state.log.empty(), "a mission log");
   const std::string last = state.log.back().text.data();
-  const std::string whole = ("mission aborted: " + reason)
-                                .substr(0, boticelli::firmware::MissionLogEntry::kMaxTextBytes);
+  const std::string whole =
+      ("mission aborted: " + reason).substr(0, boticelli::firmware::MissionLogEntry::kMaxTextBytes);
   STRCMP_EQUAL(whole.c_str(), last.c_str());
   // Long enough that a shorter entry would cut it (the PTU's own words follow).
   CHECK_TEXT(whole.size() >= boticelli::firmware::MissionLogEntry::kMaxTextBytes - 1, last.c_str());
@@ -718,10 +718,10 @@ TEST(MissionEstop, PressedMidDriveTheBaseStopsAndStaysStoppedUntilClearEstopAndR
   const std::size_t y = reply.find("target_y_m=");
   CHECK_TEXT(x != std::string::npos && y != std::string::npos, reply.c_str());
   const sim::TraceRow& start = r.trace.front();
-  const boticelli::core::Point2 truth = boticelli::core::to_robot(
-      {static_cast<float>(start.x_m), static_cast<float>(start.y_m),
-       static_cast<float>(start.yaw_rad)},
-      r.target);
+  const boticelli::core::Point2 truth =
+      boticelli::core::to_robot({static_cast<float>(start.x_m), static_cast<float>(start.y_m),
+                                 static_cast<float>(start.yaw_rad)},
+                                r.target);
   const float off_m = std::hypot(static_cast<float>(std::atof(reply.c_str() + x + 11)) - truth.x_m,
                                  static_cast<float>(std::atof(reply.c_str() + y + 11)) - truth.y_m);
   CHECK_TEXT(off_m <= 0.3F, (reply + ", " + std::to_string(off_m) + " m off").c_str());
