@@ -27,6 +27,9 @@ const Console::Command Console::kCommands[] = {
     {"base-calibration", "",
      "the odometry's track scale and wheel diameter ratio the looks' registrations show",
      &Console::cmd_base_calibration},
+    {"camera-calibration", "",
+     "the camera rig's calibration as the floor shows it, and the stereo's correction",
+     &Console::cmd_camera_calibration},
     {"pause", "", "pause the background work (mission)", &Console::cmd_pause},
     {"resume", "", "after pause or clear-estop: the background work and the base go on",
      &Console::cmd_resume},
@@ -450,6 +453,25 @@ void Console::cmd_base_calibration(const Words& w) {
     reply_.append(
         " not enough yet (4 intervals, 360 deg turned and 2 m driven, with register_looks)");
   }
+  reply_.append("\r\nOK\r\n");
+  emit(reply_.view());
+}
+
+void Console::cmd_camera_calibration(const Words& w) {
+  if (!no_args(w)) return reply_error("camera-calibration takes no arguments");
+  const CameraCalibration c = view_.camera_calibration();
+  reply_.appendf("camera-calibration bases=%u", c.bases);
+  if (c.bases > 0) {
+    reply_.appendf(" stereo_to_floor=%.3f", static_cast<double>(c.stereo_to_floor));
+  } else {
+    reply_.append(" no check yet (30 stereo points low on obstacles whose base the floor shows)");
+  }
+  reply_.appendf(
+      " self_calibration=%s inverse_range_bias_per_m=%.4f focal_scale=%.4f "
+      "tilt_step_error_deg=%.3f",
+      c.self_calibrating ? "on" : "off", static_cast<double>(c.inverse_range_bias_per_m),
+      static_cast<double>(c.focal_scale),
+      static_cast<double>(c.tilt_step_error_rad) * 180.0 / 3.14159265358979323846);
   reply_.append("\r\nOK\r\n");
   emit(reply_.view());
 }

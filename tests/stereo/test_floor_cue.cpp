@@ -1502,12 +1502,20 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
   CHECK(std::fabs(look_ratio(1.0F, -0.15F, 0.0F) - 1.0F) > 0.03F);   // a lens nobody calibrated
   CHECK(std::fabs(look_ratio(1.0F, 0.0F, 0.0035F) - 1.0F) > 0.03F);  // the step 0.2° off
   // Self-calibration: the bias the look measured removed, the look is drawn and read again.
+  // The bias each error leaves is that error's own (bias_as_focal_scale, …_tilt_step_error_rad).
   const auto calibrated_ratio = [&](float focal_scale, float phi_error) {
     stereo_processor.set_inverse_range_bias(0.0F);
     (void)look_ratio(focal_scale, 0.0F, phi_error);
     float bias = 0.0F;
     std::size_t n = 0;
     CHECK(check.inverse_bias(bias, n));
+    if (phi_error == 0.0F) {
+      DOUBLES_EQUAL(focal_scale, boticelli::stereo::bias_as_focal_scale(bias, g_rig.params()),
+                    0.004);
+    } else {
+      DOUBLES_EQUAL(phi_error, boticelli::stereo::bias_as_tilt_step_error_rad(bias, g_rig.params()),
+                    0.0005);
+    }
     stereo_processor.set_inverse_range_bias(bias);
     const float ratio = look_ratio(focal_scale, 0.0F, phi_error);
     std::printf(" after removing %.4f /m", static_cast<double>(bias));

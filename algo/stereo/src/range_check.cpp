@@ -83,6 +83,14 @@ float updated_inverse_bias(float in_use_per_m, float residual_per_m, std::size_t
   return std::fabs(bias) < params.self_calibration_min_bias_per_m ? 0.0F : bias;
 }
 
+float bias_as_focal_scale(float bias_per_m, const RigParams& rig) {
+  return 1.0F + bias_per_m * rig.lever_m;
+}
+
+float bias_as_tilt_step_error_rad(float bias_per_m, const RigParams& rig) {
+  return bias_per_m * rig.lever_m * rig.tilt_step_rad;
+}
+
 bool RangeCheck::median(float& ratio, std::size_t& count) {
   count = count_;
   return median_of(ratios_, count_, ratio);

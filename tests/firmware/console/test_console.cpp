@@ -56,6 +56,8 @@ class FakeView final : public MissionView {
   TargetEstimate target() const override { return target_value; }
   OdometryCalibration odometry_calibration() const override { return calibration; }
   OdometryCalibration calibration;
+  CameraCalibration camera_calibration() const override { return camera; }
+  CameraCalibration camera;
   std::uint64_t mission_log_begin() const override { return log_dropped; }
   std::uint64_t mission_log_end() const override { return log_dropped + log.size(); }
   const MissionLogEntry* mission_log_line(std::uint64_t n) const override {
@@ -361,9 +363,26 @@ TEST_GROUP(Console) {
 TEST(Console, AnswersHelpWithEveryCommand) {
   const auto reply = command("help");
   CHECK_EQUAL("OK", reply.back());
-  for (const char* name :
-       {"help", "status", "stats", "pose", "model", "map", "base-calibration", "pause", "resume",
-        "estop", "clear-estop", "get", "set", "log", "param", "fault", "ver", "shutdown", "quit"}) {
+  for (const char* name : {"help",
+                           "status",
+                           "stats",
+                           "pose",
+                           "model",
+                           "map",
+                           "base-calibration",
+                           "camera-calibration",
+                           "pause",
+                           "resume",
+                           "estop",
+                           "clear-estop",
+                           "get",
+                           "set",
+                           "log",
+                           "param",
+                           "fault",
+                           "ver",
+                           "shutdown",
+                           "quit"}) {
     bool found = false;
     for (const auto& l : reply) found = found || l.rfind(std::string(name) + " ", 0) == 0;
     CHECK_TEXT(found, name);
@@ -428,6 +447,25 @@ TEST(Console, BaseCalibrationSaysWhatItLacksThenTheValuesForTheConfigFile) {
       reply.at(0).c_str());
   CHECK_EQUAL("OK", reply.back());
   STRCMP_CONTAINS("takes no arguments", command("base-calibration now").at(0).c_str());
+}
+
+TEST(Console, CameraCalibrationSaysWhatItLacksThenTheFloorsRatioAndTheCorrection) {
+  view.camera.self_calibrating = true;
+  auto reply = command("camera-calibration");
+  STRCMP_EQUAL(
+      "camera-calibration bases=0 no check yet (30 stereo points low on obstacles whose base the "
+      "floor shows) self_calibration=on inverse_range_bias_per_m=0.0000 focal_scale=1.0000 "
+      "tilt_step_error_deg=0.000",
+      reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.back());
+  view.camera = {412, 0.9431F, false, 0.0476F, 1.0100F, 0.001344F};
+  reply = command("camera-calibration");
+  STRCMP_EQUAL(
+      "camera-calibration bases=412 stereo_to_floor=0.943 self_calibration=off "
+      "inverse_range_bias_per_m=0.0476 focal_scale=1.0100 tilt_step_error_deg=0.077",
+      reply.at(0).c_str());
+  CHECK_EQUAL("OK", reply.back());
+  STRCMP_CONTAINS("takes no arguments", command("camera-calibration now").at(0).c_str());
 }
 
 TEST(Console, ReportsTheTargetEstimateOnceTheMissionHasOne) {

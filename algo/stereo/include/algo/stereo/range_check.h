@@ -38,6 +38,14 @@ struct RangeCheckParams {
 float updated_inverse_bias(float in_use_per_m, float residual_per_m, std::size_t pairs,
                            const StereoParams& params);
 
+// The one rig error that alone leaves an inverse-range bias b [1/m] (1/r_read = 1/r + b): the
+// stereo takes F·Φ of a pair's parallax as the tilt step's rotation and reads the range from
+// the rest, F·L·Φ/r (lever L). A true focal length s·F leaves (s − 1)·F·Φ of it, so
+// b = (s − 1)/L and s = 1 + b·L; a true tilt step Φ + δ leaves F·δ, so b = δ/(L·Φ) and
+// δ = b·L·Φ. What an operator checks first: camera.focal_px, then ptu.tilt_step_rad.
+float bias_as_focal_scale(float bias_per_m, const RigParams& rig);
+float bias_as_tilt_step_error_rad(float bias_per_m, const RigParams& rig);
+
 class RangeCheck {
  public:
   static constexpr std::size_t kCapacity = 2048;  // ratios kept per look

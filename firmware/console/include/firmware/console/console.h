@@ -115,6 +115,7 @@ class Console {
   void cmd_model(const Words& w);
   void cmd_map(const Words& w);
   void cmd_base_calibration(const Words& w);
+  void cmd_camera_calibration(const Words& w);
   void cmd_pause(const Words& w);
   void cmd_resume(const Words& w);
   void cmd_estop(const Words& w);

@@ -9,6 +9,7 @@
 
 #include "algo/core/fixed_vector.h"
 #include "algo/core/geometry.h"
+#include "algo/stereo/range_check.h"
 #include "firmware/common/board_config.h"
 #include "firmware/common/text_buffer.h"
 #include "firmware/executive/executive.h"
@@ -123,6 +124,17 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
     return params_.thesis_planner ? "thesis" : "frontier";
   }
   TargetEstimate target() const override;
+  CameraCalibration camera_calibration() const override {
+    CameraCalibration c;
+    c.bases = calibration_bases_;
+    c.stereo_to_floor = calibration_ratio_;
+    c.self_calibrating = params_.stereo.self_calibration;
+    c.inverse_range_bias_per_m = look_.stereo().inverse_range_bias();
+    c.focal_scale = stereo::bias_as_focal_scale(c.inverse_range_bias_per_m, params_.rig);
+    c.tilt_step_error_rad =
+        stereo::bias_as_tilt_step_error_rad(c.inverse_range_bias_per_m, params_.rig);
+    return c;
+  }
   OdometryCalibration odometry_calibration() const override {
     const BaseCalibration e = pose_.calibrator().estimate();
     OdometryCalibration c;

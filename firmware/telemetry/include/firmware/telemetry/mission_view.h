@@ -45,6 +45,19 @@ struct OdometryCalibration {
   float diameter_ratio_sd = 0.0F;
 };
 
+// The camera rig's calibration as the floor shows it (stereo::RangeCheck and the stereo's
+// self-calibration; docs/configuration.md): the median ratio of stereo to floor distances at
+// obstacle bases over the looks that had enough of them, the inverse-range bias the stereo
+// removes, and that bias as the one rig error that would cause it alone.
+struct CameraCalibration {
+  std::uint32_t bases = 0;                // ratios the check is over (0: none yet)
+  float stereo_to_floor = 0.0F;           // their median, 1 for a calibrated rig
+  bool self_calibrating = false;          // [mission] stereo_self_calibration
+  float inverse_range_bias_per_m = 0.0F;  // b in 1/r_read = 1/r + b, removed [1/m]
+  float focal_scale = 1.0F;               // b as a true focal length of camera.focal_px times this
+  float tilt_step_error_rad = 0.0F;       // or as a true tilt step ptu.tilt_step_rad plus this
+};
+
 // The mission's idea of where the target is: none yet, seen once (a candidate not yet
 // confirmed by a second view) or confirmed (the goal).
 enum class TargetStatus : std::uint8_t { kNone, kSeen, kConfirmed };
@@ -76,6 +89,7 @@ class MissionView {
   virtual MapCounts map_counts() const { return {}; }
   virtual TargetEstimate target() const { return {}; }
   virtual OdometryCalibration odometry_calibration() const { return {}; }
+  virtual CameraCalibration camera_calibration() const { return {}; }
   // The mission log kept in the state file (MissionState::log), by line number: the first
   // line still kept, one past the last, and a line (nullptr when no longer or not yet kept).
   virtual std::uint64_t mission_log_begin() const { return 0; }
