@@ -146,6 +146,7 @@ void Mission::start(std::uint64_t now_us) {
   cycles_this_run_ = 0;
   planner_.clear();
   map_.start(state_, params_.grid);
+  look_.restore_inverse_range_bias(state_.stereo_bias_per_m);
   pose_.anchor(state_.pose);
   tracker_.clear();
   if (state_.has_goal) {
@@ -585,6 +586,7 @@ void Mission::end_cycle(const char* what) {
   ++cycles_this_run_;
   take_pose();
   map_.save(state_);
+  state_.stereo_bias_per_m = look_.stereo().inverse_range_bias();
   state_.has_goal = tracker_.confirmed();
   if (state_.has_goal) {
     state_.goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};

@@ -65,6 +65,7 @@ void MissionState::clear() {
   pose_time_ms = 0;
   wheels_known = false;
   wheel_left_m = wheel_right_m = 0.0;
+  stereo_bias_per_m = 0.0F;
   has_goal = false;
   goal = {};
   goal_height_m = 0.0F;
@@ -93,7 +94,7 @@ bool operator==(const MissionState& a, const MissionState& b) {
   if (a.cycle != b.cycle || a.seed != b.seed || a.pose.x_m != b.pose.x_m ||
       a.pose.y_m != b.pose.y_m || a.pose.yaw_rad != b.pose.yaw_rad ||
       a.pose_time_ms != b.pose_time_ms || a.has_goal != b.has_goal ||
-      a.wheels_known != b.wheels_known) {
+      a.wheels_known != b.wheels_known || a.stereo_bias_per_m != b.stereo_bias_per_m) {
     return false;
   }
   if (a.wheels_known && (a.wheel_left_m != b.wheel_left_m || a.wheel_right_m != b.wheel_right_m)) {

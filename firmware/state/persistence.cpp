@@ -292,6 +292,13 @@ bool decode_body(Reader& r, MissionState& s, std::uint64_t& sequence) {
       }
     }
   }
+  if (version >= 6) {
+    float bias = 0.0F;
+    if (!r.keyed("stereo_bias", v) || !parse_floats(v, &bias, 1) || std::fabs(bias) > 1.0F) {
+      return r.fail("bad stereo bias");
+    }
+    s.stereo_bias_per_m = bias;
+  }
   if (!r.keyed("goal", v)) return false;
   if (v == "none") {
     s.has_goal = false;
@@ -363,6 +370,7 @@ std::size_t encode_state(const MissionState& s, char* out, std::size_t capacity,
   } else {
     w.printf("wheels none\n");
   }
+  w.printf("stereo_bias %.9g\n", static_cast<double>(s.stereo_bias_per_m));
   if (s.has_goal) {
     w.printf("goal %.9g %.9g %.9g\n", static_cast<double>(s.goal.x_m),
              static_cast<double>(s.goal.y_m), static_cast<double>(s.goal_height_m));

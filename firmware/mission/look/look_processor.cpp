@@ -1,6 +1,9 @@
 // LookProcessor: stereo, target and floor cue per view part (see look_processor.h).
 #include "firmware/mission/look/look_processor.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace boticelli::firmware::mission {
 
 void LookReadings::clear() {
@@ -84,6 +87,14 @@ void LookProcessor::end_look(const evidence::ReadingLimits& limits) {
   if (floor_cue_.model().valid && floor_cue_.model().textured) {
     (void)evidence::floor_readings(readings_.features, limits);
   }
+}
+
+void LookProcessor::restore_inverse_range_bias(float bias_per_m) {
+  const stereo::StereoParams& p = stereo_.params();
+  const float limit = p.self_calibration_max_bias_per_m;
+  stereo_.set_inverse_range_bias(p.self_calibration && std::isfinite(bias_per_m)
+                                     ? std::clamp(bias_per_m, -limit, limit)
+                                     : 0.0F);
 }
 
 void LookProcessor::self_calibrate() {

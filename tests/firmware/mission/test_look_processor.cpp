@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 
 #include <Eigen/Core>
@@ -191,4 +192,21 @@ TEST(LookProcessor, AFixInTheWorldTurnsThePtuFramePointWithTheLookPoseAndAddsThe
   DOUBLES_EQUAL(0.5, w.x(), 1e-5);
   DOUBLES_EQUAL(1.0, w.y(), 1e-5);
   DOUBLES_EQUAL(0.9, w.z(), 1e-5);
+}
+
+// A resumed mission's learnt bias is the stereo's from the start, held to the self-calibration's
+// bound; nothing when the self-calibration is off, or when the saved value is not a number.
+TEST(LookProcessor, ARestoredStereoBiasIsUsedHeldToItsBoundAndOnlyWithTheSelfCalibrationOn) {
+  const float limit = params.stereo.self_calibration_max_bias_per_m;
+  look->restore_inverse_range_bias(0.0473F);
+  DOUBLES_EQUAL(0.0473, look->stereo().inverse_range_bias(), 1e-7);
+  look->restore_inverse_range_bias(-3.0F * limit);
+  DOUBLES_EQUAL(-limit, look->stereo().inverse_range_bias(), 1e-7);
+  look->restore_inverse_range_bias(std::numeric_limits<float>::quiet_NaN());
+  DOUBLES_EQUAL(0.0, look->stereo().inverse_range_bias(), 0.0);
+  boticelli::stereo::StereoParams off = params.stereo;
+  off.self_calibration = false;
+  LookProcessor plain(params.rig, off, true);
+  plain.restore_inverse_range_bias(0.0473F);
+  DOUBLES_EQUAL(0.0, plain.stereo().inverse_range_bias(), 0.0);
 }

@@ -68,6 +68,7 @@ void make_state(std::uint64_t cycle, MissionState& s) {
   s.wheels_known = cycle % 2 == 1;
   s.wheel_left_m = 1234.5678901234567 + 0.1 * static_cast<double>(cycle);
   s.wheel_right_m = -0.1 / 3.0 * static_cast<double>(cycle);
+  s.stereo_bias_per_m = 0.0473F - 0.001F * static_cast<float>(cycle % 97);
   s.has_goal = cycle % 3 == 0;
   s.goal = {1.0F / 3.0F, 2.5e-7F * static_cast<float>(cycle)};
   s.goal_height_m = 0.01F * static_cast<float>(cycle % 40);
@@ -435,6 +436,41 @@ TEST(Persistence, TheWheelCountersRoundTripExactlyAndAVersionFourFileHasNone) {
   v5.insert(v5.find("goal none"), "wheels 1.5 nan\n");
   CHECK_FALSE(decode_state(with_crc(v5), g_b, &why));
   STRCMP_EQUAL("bad wheels", why);
+}
+
+// The stereo's learnt bias round trips exactly; a version 5 file has none (0) and still loads,
+// a version 6 file must say, and a bias that is not a number or beyond ±1 /m is refused.
+TEST(Persistence, TheStereoBiasRoundTripsAndAVersionFiveFileHasNone) {
+  make_state(3, g_a);
+  std::size_t n = encode_state(g_a, g_file, sizeof g_file);
+  const char* why = "";
+  CHECK_TRUE_TEXT(decode_state({g_file, n}, g_b, &why), why);
+  CHECK(g_a.stereo_bias_per_m != 0.0F);
+  CHECK(g_a.stereo_bias_per_m == g_b.stereo_bias_per_m);
+  g_b.stereo_bias_per_m = std::nextafter(g_b.stereo_bias_per_m, 0.0F);
+  CHECK_FALSE(g_a == g_b);  // compared too
+  const std::string v5 =
+      "BOTICELLI-STATE 5\nsequence 2\ncycle 3\nseed 1\nresult running\npose 0 0 0\n"
+      "pose_time_ms 0\nwheels none\ngoal none\nobstacles 0\nexploration 0\ngrid 0 0\nmodel 0\n"
+      "\nlog 0\nend\n";
+  g_b.stereo_bias_per_m = 0.25F;
+  CHECK_TRUE_TEXT(decode_state(with_crc(v5), g_b, &why), why);
+  DOUBLES_EQUAL(0.0, g_b.stereo_bias_per_m, 0.0);
+  std::string v6 = v5;
+  v6.replace(v6.find(" 5\n"), 3, " 6\n");
+  CHECK_FALSE(decode_state(with_crc(v6), g_b, &why));  // the line missing
+  const std::size_t at = v6.find("goal none");
+  for (const char* bad : {"stereo_bias nan\n", "stereo_bias 1.5\n", "stereo_bias -2\n",
+                          "stereo_bias 0.1 0.2\n", "stereo_bias\n"}) {
+    std::string text = v6;
+    text.insert(at, bad);
+    CHECK_FALSE_TEXT(decode_state(with_crc(text), g_b, &why), bad);
+    STRCMP_EQUAL("bad stereo bias", why);
+  }
+  std::string good = v6;
+  good.insert(at, "stereo_bias -0.0625\n");
+  CHECK_TRUE_TEXT(decode_state(with_crc(good), g_b, &why), why);
+  DOUBLES_EQUAL(-0.0625, g_b.stereo_bias_per_m, 0.0);
 }
 
 // The grid's tiles round trip exactly; a tile with a bad place, a short or non-hex line, or a

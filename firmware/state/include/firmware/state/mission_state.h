@@ -53,6 +53,10 @@ struct MissionState {
   bool wheels_known = false;
   double wheel_left_m = 0.0;
   double wheel_right_m = 0.0;
+  // The stereo's learnt inverse-range bias [1/m] (StereoProcessor::inverse_range_bias, the
+  // self-calibration from the floor): a resumed run reads its first look corrected. 0 in a
+  // state from before version 6.
+  float stereo_bias_per_m = 0.0F;
   bool has_goal = false;
   core::Point2 goal;           // target position once confirmed, mission frame [m]
   float goal_height_m = 0.0F;  // the target's height above the floor [m]

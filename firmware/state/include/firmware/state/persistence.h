@@ -23,7 +23,8 @@ std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
 // Versions 1 (a goal without its height), 2 (no sequence, no result), 3 (no pose time) and 4
 // (no wheels, no grid) are still read: their sequence is 0 (before 3), their mission running,
 // their pose's time unknown, no wheel counters, no grid.
-inline constexpr std::uint32_t kStateFormatVersion = 5;  // 5: the wheel counters, the grid
+// 5: the wheel counters, the grid; 6: the stereo's learnt bias
+inline constexpr std::uint32_t kStateFormatVersion = 6;
 inline constexpr std::size_t kMaxStateFileBytes =
     256 + 40 * (MissionState::kMaxObstaclePoints + MissionState::kMaxExplorationPoints) +
     MissionState::kMaxModelBytes + 32 + MissionState::kMaxLogEntries * 124 + 64 + 224 + 32 +

@@ -63,6 +63,10 @@ class LookProcessor {
   // A new mission: begin_look() and nothing learnt about the floor either. The stereo's
   // self-calibration is the rig's and is kept.
   void reset();
+  // The stereo's self-calibration a resumed mission learnt before (MissionState): the
+  // inverse-range bias in use from now on, held to ±self_calibration_max_bias_per_m; 0 when
+  // the self-calibration is off or the value is not finite.
+  void restore_inverse_range_bias(float bias_per_m);
   // One part of a view; true when the view is done. kTarget fills `fixes` (else untouched).
   bool process(ViewPart part, const GrabbedView& view, TargetFixes& fixes);
   // The look is complete: the stereo's self-calibration takes the look's range check
