@@ -30,6 +30,7 @@
 #include "mission_runner.h"
 #include "png_image.h"
 #include "sim_board.h"
+#include "world_truth_file.h"
 
 #include "alloc_guard.h"
 #include "CppUTest/TestHarness.h"
@@ -905,14 +906,22 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
 namespace {
 // A firmware killed (SIGKILL: no handler, no last save) at the first frame after 6 s, with a
 // state saved, in which the robot drives straight at speed, or turns on the spot at speed.
-enum class KillWhile { kDriving, kTurning };
+// Or, kLooking, while the PTU moves and the base stands, once the robot has driven 0.3 m
+// from where it started (a look after a completed cycle).
+enum class KillWhile { kDriving, kTurning, kLooking };
 struct KillPlan {
   KillWhile when = KillWhile::kDriving;
   int frames = 0;
   std::string state_a, state_b;  // nothing to resume before a state was saved
+  boticelli::core::Pose2 start{};
+  bool drove = false;
 };
 void kill_in_motion(void* context) {
   auto* plan = static_cast<KillPlan*>(context);
+  const boticelli::core::Pose2 here = g_board.sim().true_pose();
+  if (plan->frames == 0) plan->start = here;
+  plan->drove =
+      plan->drove || std::hypot(here.x_m - plan->start.x_m, here.y_m - plan->start.y_m) > 0.3F;
   if (++plan->frames < 600) return;
   if (access(plan->state_a.c_str(), F_OK) != 0 && access(plan->state_b.c_str(), F_OK) != 0) return;
   const auto s = g_board.sim().physical_state();
@@ -920,10 +929,35 @@ void kill_in_motion(void* context) {
   const float spin = 0.5F * (s.wheel_right_m_s - s.wheel_left_m_s);
   const bool driving = v > 0.25F && std::fabs(spin) < 0.02F;
   const bool turning = std::fabs(spin) > 0.1F && std::fabs(v) < 0.02F;
+  const bool looking = plan->drove && std::fabs(v) < 1e-4F && std::fabs(spin) < 1e-4F &&
+                       (g_board.sim().pan().moving() || g_board.sim().tilt().moving());
   if ((plan->when == KillWhile::kDriving && driving) ||
-      (plan->when == KillWhile::kTurning && turning)) {
+      (plan->when == KillWhile::kTurning && turning) ||
+      (plan->when == KillWhile::kLooking && looking)) {
     ::raise(SIGKILL);
   }
+}
+
+// Kills a mission in `dir` as planned (in a forked child) and returns the child's status.
+int kill_mission(KillWhile when, const std::string& dir,
+                 const std::vector<const char*>& config = {}) {
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t child = fork();
+  if (child == 0) {
+    static KillPlan plan;
+    plan.when = when;
+    plan.state_a = dir + "/mission.state.a";
+    plan.state_b = dir + "/mission.state.b";
+    static boticelli::firmware::MainHooks hooks;
+    hooks.after_frame = kill_in_motion;
+    hooks.context = &plan;
+    std::vector<const char*> args = {"--state", dir.c_str()};
+    args.insert(args.end(), config.begin(), config.end());
+    (void)run_mission("thesis_room", "1", 0.0F, &hooks, args);
+    _exit(3);  // the mission ended before the kill
+  }
+  return boticelli::test::wait_for_child(child, 600000);
 }
 
 // Kills a mission in `dir` as planned (in a forked child), then resumes it here for one
@@ -942,23 +976,7 @@ struct KilledAndResumed {
 KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir,
                                  const std::vector<const char*>& config = {}) {
   KilledAndResumed out;
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t child = fork();
-  if (child == 0) {
-    static KillPlan plan;
-    plan.when = when;
-    plan.state_a = dir + "/mission.state.a";
-    plan.state_b = dir + "/mission.state.b";
-    static boticelli::firmware::MainHooks hooks;
-    hooks.after_frame = kill_in_motion;
-    hooks.context = &plan;
-    std::vector<const char*> args = {"--state", dir.c_str()};
-    args.insert(args.end(), config.begin(), config.end());
-    (void)run_mission("thesis_room", "1", 0.0F, &hooks, args);
-    _exit(3);  // the mission ended before the kill
-  }
-  out.child_status = boticelli::test::wait_for_child(child, 600000);
+  out.child_status = kill_mission(when, dir, config);
   // The pose the killed firmware last saved (mission frame).
   static boticelli::firmware::MissionState saved;
   static boticelli::firmware::StateStore store;
@@ -1031,6 +1049,45 @@ TEST(MissionResume, KilledMidDriveItResumesWithinFiveCentimetresOfWhereTheRobotS
              (std::to_string(r.estimate_off_m) + " m off: " + r.log).c_str());
   CHECK_TEXT(r.estimate_off_rad <= 1.0 * std::numbers::pi / 180.0,
              std::to_string(r.estimate_off_rad).c_str());
+}
+
+// Killed in the middle of a look, after a completed cycle (nothing is saved during a look):
+// the state holds that cycle's end, its log line and where the robot stands (it has not moved
+// since), so a resumed mission loses none of what it had seen.
+TEST(MissionResume, KilledMidLookTheStateHoldsTheLastCycleAndWhereTheRobotStands) {
+  char dir_template[] = "/tmp/boticelli-kill-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const int status = kill_mission(KillWhile::kLooking, dir);
+  static boticelli::firmware::MissionState saved;
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  const bool loaded =
+      store.open(dir.c_str(), error, sizeof error) &&
+      store.load(saved, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  // Where the killed firmware left the robot: the sim world's own file keeps it.
+  static sim::World world;
+  char why[256] = "";
+  CHECK_TEXT(sim::load_world(BOTICELLI_WORLDS_DIR "/thesis_room.sdf", world, why, sizeof why), why);
+  sim::SimWorld::PhysicalState stands{};
+  const auto truth_loaded = boticelli::boards::sim::WorldTruthFile::load(
+      (dir + "/sim-world.truth").c_str(), boticelli::boards::sim::WorldTruthFile::world_id(world),
+      stands, why, sizeof why);
+  remove_state_dir(dir);
+  CHECK_TEXT(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL, "killed mid-look");
+  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(truth_loaded == boticelli::boards::sim::WorldTruthFile::Load::kLoaded, why);
+  CHECK(saved.cycle >= 1);
+  CHECK(!saved.log.empty());
+  const std::string last = saved.log.back().text.data();
+  CHECK_EQUAL_TEXT(saved.cycle, saved.log.back().cycle, last.c_str());
+  STRCMP_CONTAINS("cycle ", last.c_str());
+  const boticelli::core::Pose2 truth =
+      boticelli::core::compose(boticelli::core::inverse(world.start),
+                               {static_cast<float>(stands.x_m), static_cast<float>(stands.y_m),
+                                static_cast<float>(stands.yaw_rad)});
+  const double off_m = std::hypot(static_cast<double>(saved.pose.x_m - truth.x_m),
+                                  static_cast<double>(saved.pose.y_m - truth.y_m));
+  CHECK_TEXT(off_m < 0.01, (std::to_string(off_m) + " m from where the robot stands").c_str());
 }
 
 // Killed while turning on the spot: the heading the saved pose misses comes back too. The
