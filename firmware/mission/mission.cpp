@@ -605,13 +605,8 @@ void Mission::end_cycle(const char* what) {
     snapshot_state_ = phase_name(phase_);
     snapshot_look_pose_ = look_pose_;
   }
-  if (path_.size() == path_.capacity()) {
-    // Keep every other point: the path stays whole at half the resolution.
-    std::size_t kept = 0;
-    for (std::size_t i = 0; i < path_.size(); i += 2) path_[kept++] = path_[i];
-    path_.resize(kept);
-  }
-  (void)path_.push_back({state_.pose.x_m, state_.pose.y_m});
+  // When full, every other point goes: the path stays whole at half the resolution.
+  (void)path_.push_back_thinning({state_.pose.x_m, state_.pose.y_m});
 }
 
 void Mission::write_trace(std::uint64_t now_us) {

@@ -55,3 +55,22 @@ TEST(FixedVector, CopiesOnlyTheLiveElements) {
   LONGS_EQUAL(2, static_cast<long>(b.size()));
   LONGS_EQUAL(11, sum(b));
 }
+
+TEST(FixedVector, APushThinningIntoAFullVectorKeepsEveryOtherElementFromTheFirstThenAppends) {
+  FixedVector<int, 5> v;
+  for (int i = 0; i < 5; ++i) CHECK(v.push_back_thinning(i));
+  LONGS_EQUAL(5, static_cast<long>(v.size()));  // not full before this push: nothing thinned
+  CHECK(v.push_back_thinning(5));               // full: 0, 2, 4 kept, then 5
+  LONGS_EQUAL(4, static_cast<long>(v.size()));
+  LONGS_EQUAL(0, v[0]);
+  LONGS_EQUAL(2, v[1]);
+  LONGS_EQUAL(4, v[2]);
+  LONGS_EQUAL(5, v[3]);
+  CHECK(v.push_back_thinning(6));
+  CHECK(v.push_back_thinning(7));  // full again: 0, 4, 6 kept, then 7
+  LONGS_EQUAL(4, static_cast<long>(v.size()));
+  LONGS_EQUAL(0, v[0]);
+  LONGS_EQUAL(4, v[1]);
+  LONGS_EQUAL(6, v[2]);
+  LONGS_EQUAL(7, v[3]);
+}

@@ -48,6 +48,18 @@ class FixedVectorBase {
     return size_;
   }
 
+  // Appends, and when full first keeps every other element (the first, the third, ...): a
+  // history that stays whole from its beginning at half the resolution (FixedVector has a
+  // capacity of at least 1, so this always appends).
+  bool push_back_thinning(const T& value) {
+    if (size_ == capacity_) {
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < size_; i += 2) data_[kept++] = data_[i];
+      size_ = kept;
+    }
+    return push_back(value);
+  }
+
   T& operator[](std::size_t i) { return data_[i]; }
   const T& operator[](std::size_t i) const { return data_[i]; }
   T& back() { return data_[size_ - 1]; }
