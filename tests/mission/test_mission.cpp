@@ -303,6 +303,22 @@ TEST(MissionThesisRoom, AWholeMissionAfterInitAllocatesNothing) {
   CHECK(count.ended);
   CHECK(count.frames > 10000);
   UNSIGNED_LONGS_EQUAL_TEXT(0, count.allocations, "heap allocations after init");
+  // The CPU each stage took, as the end of the run reports it: every stage had its share, and
+  // every kind of unit ran (snapshots included).
+  const auto number_after = [&](const char* line_start, const char* key) {
+    const std::size_t line = r.output.find(line_start);
+    if (line == std::string::npos) return -1.0;
+    const std::size_t at = r.output.find(std::string(" ") + key + "=", line);
+    const std::size_t eol = r.output.find('\n', line);
+    if (at == std::string::npos || at > eol) return -1.0;
+    return std::atof(r.output.c_str() + at + std::strlen(key) + 2);
+  };
+  for (const char* stage : {"look_s", "think_s", "plan_s"}) {
+    CHECK_TEXT(number_after("mission cpu ", stage) > 0.0, stage);
+  }
+  for (const char* unit : {"view", "model", "map", "value", "step", "snapshot"}) {
+    CHECK_TEXT(number_after("mission longest_ms ", unit) > 0.0, unit);
+  }
   // One PNG per cycle, the last one included.
   const int cycles = cycles_of(r);
   CHECK(cycles > 1);
