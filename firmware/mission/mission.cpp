@@ -772,15 +772,9 @@ bool Mission::process_view(ViewPart part) {
 
 bool Mission::target_in_clear_sight() const {
   const Eigen::Vector3f& g = tracker_.estimate_m();
-  const core::Point2 from{look_pose_.x_m, look_pose_.y_m};
-  const core::Point2 to{g.x(), g.y()};
-  const float d = core::distance_m(from, to);
   // The target hangs on a surface: the map's last cells before it may be that surface.
-  const float keep = d - params_.target_surface_margin_m;
-  if (keep <= 0.0F) return true;
-  const core::Point2 end{from.x_m + (to.x_m - from.x_m) * keep / d,
-                         from.y_m + (to.y_m - from.y_m) * keep / d};
-  return !map_.grid().segment_blocked(from, end);
+  return map_.grid().sight_clear({look_pose_.x_m, look_pose_.y_m}, {g.x(), g.y()},
+                                 params_.target_surface_margin_m);
 }
 
 bool Mission::add_target_fix(const stereo::TargetFix& fix, std::uint32_t view) {

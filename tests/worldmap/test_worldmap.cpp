@@ -163,6 +163,25 @@ TEST(GridMap, ASegmentIsBlockedOnlyByAnOccupiedCellOnIt) {
   CHECK(g_map.segment_blocked({1.0F, 0.0F}, {1.0F, 0.0F}));
 }
 
+// A line of sight stops short of its end by the margin (the surface a target hangs on), in
+// its own direction: an occupied cell off the line, or mirrored across either axis, does not
+// block it.
+TEST(GridMap, ASightIsClearUnlessAnOccupiedCellLiesOnItBeforeTheMarginAtItsEnd) {
+  const Point2 from{0.5F, 0.25F};
+  const Point2 to{2.5F, 1.25F};  // 2.24 m away, up and to the right
+  CHECK(g_map.sight_clear(from, to, 0.3F));
+  CHECK(g_map.add(g_map.cell_of({2.4F, 1.2F}), 10));  // within the margin: the wall itself
+  CHECK(g_map.sight_clear(from, to, 0.3F));
+  CHECK_FALSE(g_map.sight_clear(from, to, 0.05F));
+  // Cells where a mirrored line would run: below the start, left of it.
+  CHECK(g_map.add(g_map.cell_of({1.5F, -0.25F}), 10));
+  CHECK(g_map.add(g_map.cell_of({-0.5F, 0.75F}), 10));
+  CHECK(g_map.sight_clear(from, to, 0.3F));
+  CHECK(g_map.add(g_map.cell_of({1.5F, 0.75F}), 10));  // on the line, halfway
+  CHECK_FALSE(g_map.sight_clear(from, to, 0.3F));
+  CHECK(g_map.sight_clear(from, {1.5F, 0.75F}, 1.2F));  // shorter than the margin: clear
+}
+
 TEST(GridMap, PointsMapToTheCellsThatHoldThem) {
   const wm::Cell c = g_map.cell_of({-0.01F, 0.07F});
   LONGS_EQUAL(-1, c.ix);

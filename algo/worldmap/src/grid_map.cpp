@@ -109,6 +109,14 @@ bool GridMap::segment_blocked(core::Point2 a, core::Point2 b) const {
   return false;
 }
 
+bool GridMap::sight_clear(core::Point2 a, core::Point2 b, float stop_short_m) const {
+  const float d = core::distance_m(a, b);
+  const float keep = d - stop_short_m;
+  if (keep <= 0.0F) return true;
+  const core::Point2 end{a.x_m + (b.x_m - a.x_m) * keep / d, a.y_m + (b.y_m - a.y_m) * keep / d};
+  return !segment_blocked(a, end);
+}
+
 bool GridMap::tile_bounds(Cell& lo, Cell& hi) const {
   int tx0 = kDirectoryTiles, ty0 = kDirectoryTiles, tx1 = -1, ty1 = -1;
   for (int ty = 0; ty < kDirectoryTiles; ++ty) {

@@ -77,6 +77,10 @@ class GridMap {
   // Whether an occupied cell lies on the segment a→b (sampled every half cell, both ends
   // included): a line of sight the map says is blocked.
   [[nodiscard]] bool segment_blocked(core::Point2 a, core::Point2 b) const;
+  // Whether a line of sight from a towards b is clear of occupied cells up to stop_short_m
+  // before b (the cells just before a target may be the surface it hangs on); a sight no
+  // longer than stop_short_m is clear.
+  [[nodiscard]] bool sight_clear(core::Point2 a, core::Point2 b, float stop_short_m) const;
 
   [[nodiscard]] std::size_t tiles_used() const { return tiles_used_; }
   [[nodiscard]] std::size_t dropped() const { return dropped_; }
