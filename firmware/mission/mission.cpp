@@ -387,23 +387,11 @@ void Mission::begin_look(std::uint64_t now_us, bool glance) {
 }
 
 AimedPair Mission::aim_at_target() const {
-  AimedPair aimed;
-  if (tracker_.sightings() == 0) return aimed;
+  if (tracker_.sightings() == 0) return {};
   const Eigen::Vector3f& c = tracker_.confirmed() ? tracker_.estimate_m() : tracker_.candidate_m();
   const core::Point2 q = core::to_robot(look_pose_, {c.x(), c.y()});
-  const float d = std::hypot(q.x_m, q.y_m);
-  const hal::PanTiltLimits lim = hal_.pan_tilt.limits();
-  const float pan = std::atan2(q.y_m, q.x_m);
-  if (d > params_.limits.max_range_m || pan < lim.pan_min_rad || pan > lim.pan_max_rad) {
-    return aimed;
-  }
-  // The vertex midway between the pair's two tilts, so both frames hold it.
-  const float elevation = std::atan2(c.z() - params_.rig.ptu_height_m, d);
-  const float phi = params_.rig.tilt_step_rad;
-  aimed.pan_rad = pan;
-  aimed.tilt_rad = std::clamp(elevation + 0.5F * phi, lim.tilt_min_rad + phi, lim.tilt_max_rad);
-  aimed.aimed = true;
-  return aimed;
+  return aim_pair_at({q.x_m, q.y_m, c.z()}, params_.rig.ptu_height_m, params_.rig.tilt_step_rad,
+                     params_.limits.max_range_m, hal_.pan_tilt.limits());
 }
 
 void Mission::control_look(std::uint64_t now_us) {

@@ -2,10 +2,25 @@
 #include "firmware/mission/look/look_scan.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "algo/image/low_res_frame.h"
 
 namespace boticelli::firmware::mission {
+
+AimedPair aim_pair_at(const Eigen::Vector3f& target_m, float ptu_height_m, float tilt_step_rad,
+                      float max_range_m, const hal::PanTiltLimits& limits) {
+  AimedPair aimed;
+  const float d = std::hypot(target_m.x(), target_m.y());
+  const float pan = std::atan2(target_m.y(), target_m.x());
+  if (d > max_range_m || pan < limits.pan_min_rad || pan > limits.pan_max_rad) return aimed;
+  const float elevation = std::atan2(target_m.z() - ptu_height_m, d);
+  aimed.pan_rad = pan;
+  aimed.tilt_rad = std::clamp(elevation + 0.5F * tilt_step_rad, limits.tilt_min_rad + tilt_step_rad,
+                              limits.tilt_max_rad);
+  aimed.aimed = true;
+  return aimed;
+}
 
 float tilt_approach_rad(float from_rad, float to_rad, float approach_rad, float max_rad) {
   if (approach_rad <= 0.0F || from_rad > to_rad) return to_rad;

@@ -1,6 +1,7 @@
 // Tests of the LookScan against a mock PTU: move, settle, grab, hand over; a pair's two tilts;
 // the aimed pair last; the PTU's and the camera's faults; a hold and its resume.
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "firmware/mission/look/look_scan.h"
@@ -347,4 +348,31 @@ TEST(LookScan, TheApproachGoesAboveThePairWithinTheTiltLimitOrStraightThereFromA
   DOUBLES_EQUAL(0.5, tilt_approach_rad(0.0F, 0.495F, 0.01F, 0.5F), 1e-6);    // at the limit
   DOUBLES_EQUAL(0.5, tilt_approach_rad(0.0F, 0.5F, 0.01F, 0.5F), 1e-6);
   DOUBLES_EQUAL(-0.2, tilt_approach_rad(-0.5F, -0.2F, 0.0F, 0.5F), 1e-6);  // none asked
+}
+
+// The aimed pair holds the target midway between its two tilts; a target below the tilt range
+// (low and near) is aimed at the lowest first tilt whose second frame is still in range, one
+// above it at the highest tilt; nothing is aimed beyond the range or outside the pan range.
+TEST(LookScan, APairAimedAtATargetHoldsItMidwayBetweenItsTiltsWithinThePtusRange) {
+  boticelli::hal::PanTiltLimits lim;
+  lim.pan_min_rad = -2.0F;
+  lim.pan_max_rad = 2.0F;
+  lim.tilt_min_rad = -0.5F;
+  lim.tilt_max_rad = 0.4F;
+  const float step = 0.134F;
+  const float h = 0.9F;  // the PTU's height
+  AimedPair a =
+      aim_pair_at({2.0F, 2.0F, h + 2.0F * std::sqrt(2.0F) * std::tan(0.1F)}, h, step, 5.0F, lim);
+  CHECK(a.aimed);
+  DOUBLES_EQUAL(std::atan2(2.0, 2.0), a.pan_rad, 1e-6);
+  DOUBLES_EQUAL(0.1 + 0.5 * static_cast<double>(step), a.tilt_rad,
+                1e-5);                                      // the target at 0.1 rad of elevation
+  a = aim_pair_at({0.4F, 0.0F, 0.1F}, h, step, 5.0F, lim);  // 63° below: under the range
+  CHECK(a.aimed);
+  DOUBLES_EQUAL(lim.tilt_min_rad + step, a.tilt_rad, 1e-6);
+  a = aim_pair_at({0.5F, 0.0F, h + 2.0F}, h, step, 5.0F, lim);  // far above
+  DOUBLES_EQUAL(lim.tilt_max_rad, a.tilt_rad, 1e-6);
+  CHECK_FALSE(aim_pair_at({5.5F, 0.0F, h}, h, step, 5.0F, lim).aimed);   // beyond the range
+  CHECK_FALSE(aim_pair_at({-2.0F, 0.1F, h}, h, step, 5.0F, lim).aimed);  // behind: pan 3.09
+  CHECK_FALSE(aim_pair_at({-2.0F, -0.1F, h}, h, step, 5.0F, lim).aimed);
 }

@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <Eigen/Core>
+
 #include "algo/image/low_res_frame.h"
 #include "algo/stereo/stereo_processor.h"
 #include "firmware/mission/params/mission_params.h"
@@ -29,6 +31,15 @@ struct AimedPair {
   float pan_rad = 0.0F;
   float tilt_rad = 0.0F;
 };
+
+// The pair aimed at a target at `target_m` (robot frame, its height above the floor) from a
+// PTU at `ptu_height_m`: its pan, and a first tilt that puts the target midway between the
+// pair's two tilts (tilt_step_rad apart), held so that both stay within `limits` (the first at
+// least tilt_min + Φ, as the second is Φ below it). Not aimed beyond max_range_m or outside
+// the pan range.
+[[nodiscard]] AimedPair aim_pair_at(const Eigen::Vector3f& target_m, float ptu_height_m,
+                                    float tilt_step_rad, float max_range_m,
+                                    const hal::PanTiltLimits& limits);
 
 // Where the PTU goes first to reach a stereo pair's first tilt `to_rad` from `from_rad` moving
 // down, so that its gear play is taken up as for the pair's second frame: `to_rad` itself when
