@@ -248,9 +248,9 @@ TEST(MissionSeeds, FindsItWithTwoPercentOdometryNoiseAndTheTraceShowsTheTruePose
   CHECK_TEXT(drift > 0.001 && drift > 20.0 * clean_drift, drift_text.c_str());
 }
 
-// With seeds 1 and 3 below: five seeds.
-TEST(MissionSeeds, FindsItForThreeMoreSeeds) {
-  for (const char* seed : {"2", "4", "5"}) {
+// With seed 2 above and seeds 1 and 3 below: five seeds.
+TEST(MissionSeeds, FindsItForTwoMoreSeeds) {
+  for (const char* seed : {"4", "5"}) {
     const MissionRun r = run_mission("thesis_room", seed);
     check_found_safely(r);
   }
@@ -589,6 +589,34 @@ TEST(MissionRooms, AFarTargetBehindARowOfCratesIsReachedRoundItWithoutDrivingBac
   const std::size_t back = sim::count_reversals(r.trace);
   const std::string what = r.mission_line + ", " + std::to_string(back) + " reversals";
   CHECK_TEXT(back <= 3, what.c_str());
+}
+
+// A cluttered room of tests/worlds (low boxes, a table) at seed 1: at cycle 12 the robot finds
+// no safe step a second time in a row and backs off along the step that brought it there.
+// The back-off ends its cycle, and the robot looks again before it steps on: every cycle is
+// one look (a step planned on the look from before the back-off would start from where that
+// look no longer holds).
+TEST(MissionRooms, AfterBackingOffTheRobotLooksAgainBeforeItStepsOn) {
+  char dir_template[] = "/tmp/boticelli-backoff-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  const MissionRun r =
+      run_mission(BOTICELLI_UNSEEN_WORLDS_DIR "/cluttered_low_boxes_table.sdf", "1", 0.0F, nullptr,
+                  {"--state", dir.c_str(), "--max-cycles", "13"});
+  static boticelli::firmware::MissionState state;
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  const bool loaded =
+      store.open(dir.c_str(), error, sizeof error) &&
+      store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  remove_state_dir(dir);
+  CHECK_TEXT(loaded, error);
+  bool backed_off = false;
+  for (const boticelli::firmware::MissionLogEntry& e : state.log) {
+    backed_off = backed_off || std::strstr(e.text.data(), "backed off") != nullptr;
+  }
+  CHECK_TEXT(backed_off, "a back-off to check (the scenario needs one)");
+  UNSIGNED_LONGS_EQUAL_TEXT(0, r.check.collisions, r.mission_line.c_str());
+  LONGS_EQUAL_TEXT(cycles_of(r), look_starts(r).size(), r.mission_line.c_str());
 }
 
 // A closed 3 x 3 m room whose target hangs outside it: the robot explores the room and gives
