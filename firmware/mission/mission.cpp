@@ -804,12 +804,8 @@ void Mission::check_calibration() {
 void Mission::localize() {
   const worldmap::Registration& r = map_.registration();
   if (!r.matched) return;
-  const core::Pose2 seen_from = look_pose_;
   look_pose_ = pose_.correct(look_pose_, r);
   ++registered_looks_;
-  // The look's target fixes were placed with its pose before the correction: moved with it.
-  const auto first_view = static_cast<std::uint32_t>(state_.cycle * 256U);
-  tracker_.re_place(first_view, first_view + 255U, seen_from, look_pose_);
 }
 
 void Mission::after_think() {

@@ -35,21 +35,6 @@ bool TargetTracker::missed() {
   return true;
 }
 
-void TargetTracker::re_place(std::uint32_t first_view, std::uint32_t last_view,
-                             const core::Pose2& seen_from, const core::Pose2& corrected) {
-  bool moved = false;
-  for (std::size_t i = 0; i < count_; ++i) {
-    Sighting& s = sightings_[i];
-    if (s.view < first_view || s.view > last_view) continue;
-    const core::Point2 p =
-        core::to_world(corrected, core::to_robot(seen_from, {s.point.x(), s.point.y()}));
-    s.point = {p.x_m, p.y_m, s.point.z()};
-    s.from = core::to_world(corrected, core::to_robot(seen_from, s.from));
-    moved = true;
-  }
-  if (moved) update_estimate();
-}
-
 bool TargetTracker::has_baseline(const Eigen::Vector3f& centre, float r2) const {
   if (params_.min_baseline_m <= 0.0F) return true;
   for (std::size_t j = 0; j < count_; ++j) {

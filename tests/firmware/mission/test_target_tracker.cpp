@@ -356,27 +356,3 @@ TEST(TargetTracker, ARevocationThatForgetsEverySightingLeavesNoEstimateNorCandid
   check_near(Eigen::Vector3f::Zero(), tracker.estimate_m(), 0.0F);
   check_near(Eigen::Vector3f::Zero(), tracker.candidate_m(), 0.0F);
 }
-
-// A look's registration moves its sightings with the robot: those of its views go where the
-// corrected pose puts them (seen from there too), the others stay, and the estimate follows.
-TEST(TargetTracker, ALooksSightingsMoveWithItsCorrectedPoseAndTheOthersStay) {
-  const boticelli::core::Pose2 first_look{0.0F, 0.0F, 0.0F};
-  const boticelli::core::Pose2 second_look{1.0F, -1.0F, 0.5F};  // as odometry had it
-  tracker.add(kTarget, 0.9F, 256 + 3, 0.1F, {first_look.x_m, first_look.y_m});
-  // The second look saw the target 0.1 m and a little off: its pose was off by as much.
-  const boticelli::core::Pose2 corrected{1.05F, -0.92F, 0.47F};
-  const boticelli::core::Point2 seen = boticelli::core::to_world(
-      second_look, boticelli::core::to_robot(corrected, {kTarget.x(), kTarget.y()}));
-  tracker.add({seen.x_m, seen.y_m, kTarget.z()}, 0.9F, 512 + 7, 0.1F,
-              {second_look.x_m, second_look.y_m});
-  tracker.add({seen.x_m, seen.y_m, kTarget.z()}, 0.9F, 512 + 8, 0.1F,
-              {second_look.x_m, second_look.y_m});
-  // A third look, its pose right, sees the target where it is.
-  tracker.add(kTarget, 0.9F, 768 + 2, 0.1F, {corrected.x_m, corrected.y_m});
-  CHECK(tracker.confirmed());
-  CHECK((tracker.estimate_m() - kTarget).norm() > 0.02F);
-  tracker.re_place(512, 512 + 255, second_look, corrected);
-  CHECK(tracker.confirmed());
-  check_near(kTarget, tracker.estimate_m(), 1e-4F);
-  UNSIGNED_LONGS_EQUAL(4, tracker.supporting_views());  // the first and third, unmoved, agree
-}

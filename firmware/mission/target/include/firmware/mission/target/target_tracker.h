@@ -55,12 +55,6 @@ class TargetTracker {
   static constexpr float kMinRangeError_m = 0.01F;
   void add(const Eigen::Vector3f& point_world_m, float confidence, std::uint32_t view,
            float range_error_m = 0.1F, core::Point2 from = {});
-  // A look's pose corrected after its sightings were added (its registration): the sightings
-  // of views first_view … last_view, seen from `seen_from`, are moved with the robot to where
-  // `corrected` puts them (points and the places they were seen from; heights unchanged),
-  // and the estimate follows. Other sightings stay.
-  void re_place(std::uint32_t first_view, std::uint32_t last_view, const core::Pose2& seen_from,
-                const core::Pose2& corrected);
   // Whether `p` is the confirmed target (within agree_radius_m of the estimate).
   [[nodiscard]] bool is_target(const Eigen::Vector3f& p) const {
     return confirmed_ &&
