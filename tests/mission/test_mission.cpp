@@ -945,6 +945,60 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   rmdir(dir.c_str());
 }
 
+namespace {
+// Types `shutdown` once the robot drives at speed 0.15 m from where it started.
+struct ShutdownScript {
+  int console_fd = -1;
+  bool typed = false;
+  bool started = false;
+  boticelli::core::Pose2 start{};
+};
+void on_frame_shutdown(void* context) {
+  auto* script = static_cast<ShutdownScript*>(context);
+  const boticelli::core::Pose2 p = g_board.sim().true_pose();
+  if (!script->started) script->start = p;
+  script->started = true;
+  if (script->typed || g_board.sim().odometry().v_m_s < 0.2F ||
+      std::hypot(p.x_m - script->start.x_m, p.y_m - script->start.y_m) < 0.15F) {
+    return;
+  }
+  const char* text = "shutdown\r";
+  CHECK(write(script->console_fd, text, std::strlen(text)) ==
+        static_cast<ssize_t>(std::strlen(text)));
+  script->typed = true;
+}
+}  // namespace
+
+// An orderly stop typed mid-drive: the base stops, and the state's pose is where it came to
+// rest (taken at the stop, after the base stood still), not where the last save while driving
+// or the last cycle left it.
+TEST(MissionResume, AShutdownMidDriveSavesWhereTheRobotCameToRest) {
+  char dir_template[] = "/tmp/boticelli-shutdown-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  ShutdownScript script;
+  const MissionRun r = run_mission_typing(script, on_frame_shutdown, {"--state", dir.c_str()});
+  static boticelli::firmware::MissionState saved;
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  const bool loaded =
+      store.open(dir.c_str(), error, sizeof error) &&
+      store.load(saved, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  remove_state_dir(dir);
+  CHECK(script.typed);
+  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(saved.cycle <= 1, r.mission_line.c_str());  // stopped in its first cycle's step
+  // Perfect odometry: the mission frame is the start pose's.
+  const sim::TraceRow& s0 = r.trace.front();
+  const boticelli::core::Pose2 rest = boticelli::core::compose(
+      boticelli::core::inverse(
+          {static_cast<float>(s0.x_m), static_cast<float>(s0.y_m), static_cast<float>(s0.yaw_rad)}),
+      r.final_pose);
+  const double off_m = std::hypot(static_cast<double>(saved.pose.x_m - rest.x_m),
+                                  static_cast<double>(saved.pose.y_m - rest.y_m));
+  CHECK_TEXT(std::hypot(rest.x_m, rest.y_m) > 0.15F, "it drove before the stop");
+  CHECK_TEXT(off_m < 0.001, (std::to_string(off_m) + " m from where it came to rest").c_str());
+}
+
 // qemu-user cannot be trusted to fork a process it emulates: native only.
 #ifndef BOTICELLI_TESTS_UNDER_EMULATOR
 namespace {
