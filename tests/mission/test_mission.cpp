@@ -145,6 +145,17 @@ MissionRun run_mission_typing(Script& script, void (*after_frame)(void*),
   return r;
 }
 
+// Loads the mission state a run saved in `dir` into `into` (large: the caller's static); false
+// with the reason in `why`.
+bool load_state(const std::string& dir, boticelli::firmware::MissionState& into, std::string& why) {
+  static boticelli::firmware::StateStore store;
+  char error[256] = "";
+  const bool ok = store.open(dir.c_str(), error, sizeof error) &&
+                  store.load(into, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  why = error;
+  return ok;
+}
+
 // Removes a mission's state directory: its two state copies and the sim world's truth file.
 void remove_state_dir(const std::string& dir) {
   for (const char* name : {"/mission.state.a", "/mission.state.b", "/sim-world.truth"}) {
@@ -468,15 +479,12 @@ TEST(MissionThesisRoom, APanTiltUnitRefusingEveryMoveEndsTheMissionForARestartWi
                                    {"--faults", plan.c_str(), "--config", conf.c_str(), "--state",
                                     dir.c_str(), "--max-cycles", "3"});
   static boticelli::firmware::MissionState state;
-  static boticelli::firmware::StateStore store;
-  char error[256] = "";
-  const bool loaded =
-      store.open(dir.c_str(), error, sizeof error) &&
-      store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  std::string error;
+  const bool loaded = load_state(dir, state, error);
   std::remove(plan.c_str());
   std::remove(conf.c_str());
   remove_state_dir(dir);
-  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(loaded, error.c_str());
   CHECK_EQUAL_TEXT(boticelli::firmware::kExitFailure, r.exit_code, r.mission_line.c_str());
   STRCMP_CONTAINS("MISSION result=aborted", r.mission_line.c_str());
   const std::size_t q = r.mission_line.find("reason=\"");
@@ -532,13 +540,10 @@ TEST(MissionThesisRoom, AConfirmedTargetGoneWhenTheRobotArrivesIsMissedThenRevok
   const MissionRun r =
       run_mission("thesis_room", "1", 0.0F, &hooks, {"--state", dir.c_str(), "--max-cycles", "20"});
   static boticelli::firmware::MissionState state;
-  static boticelli::firmware::StateStore store;
-  char error[256] = "";
-  const bool loaded =
-      store.open(dir.c_str(), error, sizeof error) &&
-      store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  std::string error;
+  const bool loaded = load_state(dir, state, error);
   remove_state_dir(dir);
-  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(loaded, error.c_str());
   // The state holds the world memory as the last cycle left it (what a resume starts from).
   DOUBLES_EQUAL(0.05, state.grid_cell_m, 1e-6);
   CHECK_TEXT(state.grid.size() > 20, std::to_string(state.grid.size()).c_str());
@@ -603,13 +608,10 @@ TEST(MissionRooms, AfterBackingOffTheRobotLooksAgainBeforeItStepsOn) {
       run_mission(BOTICELLI_UNSEEN_WORLDS_DIR "/cluttered_low_boxes_table.sdf", "1", 0.0F, nullptr,
                   {"--state", dir.c_str(), "--max-cycles", "13"});
   static boticelli::firmware::MissionState state;
-  static boticelli::firmware::StateStore store;
-  char error[256] = "";
-  const bool loaded =
-      store.open(dir.c_str(), error, sizeof error) &&
-      store.load(state, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  std::string error;
+  const bool loaded = load_state(dir, state, error);
   remove_state_dir(dir);
-  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(loaded, error.c_str());
   bool backed_off = false;
   for (const boticelli::firmware::MissionLogEntry& e : state.log) {
     backed_off = backed_off || std::strstr(e.text.data(), "backed off") != nullptr;
@@ -978,14 +980,11 @@ TEST(MissionResume, AShutdownMidDriveSavesWhereTheRobotCameToRest) {
   ShutdownScript script;
   const MissionRun r = run_mission_typing(script, on_frame_shutdown, {"--state", dir.c_str()});
   static boticelli::firmware::MissionState saved;
-  static boticelli::firmware::StateStore store;
-  char error[256] = "";
-  const bool loaded =
-      store.open(dir.c_str(), error, sizeof error) &&
-      store.load(saved, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  std::string error;
+  const bool loaded = load_state(dir, saved, error);
   remove_state_dir(dir);
   CHECK(script.typed);
-  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(loaded, error.c_str());
   CHECK_TEXT(saved.cycle <= 1, r.mission_line.c_str());  // stopped in its first cycle's step
   // Perfect odometry: the mission frame is the start pose's.
   const sim::TraceRow& s0 = r.trace.front();
@@ -1077,13 +1076,7 @@ KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir,
   out.child_status = kill_mission(when, dir, config);
   // The pose the killed firmware last saved (mission frame).
   static boticelli::firmware::MissionState saved;
-  static boticelli::firmware::StateStore store;
-  char error[256] = "";
-  if (!store.open(dir.c_str(), error, sizeof error) ||
-      store.load(saved, error, sizeof error) != boticelli::firmware::LoadResult::kLoaded) {
-    out.log = error;
-    return out;
-  }
+  if (!load_state(dir, saved, out.log)) return out;
   std::vector<const char*> args = {"--state", dir.c_str(), "--resume", "--max-cycles", "1"};
   args.insert(args.end(), config.begin(), config.end());
   const MissionRun resumed = run_mission("thesis_room", "1", 0.0F, nullptr, args);
@@ -1115,7 +1108,8 @@ KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir,
       std::remainder(f[12] - static_cast<double>(saved.pose.yaw_rad), 2.0 * std::numbers::pi);
   // The resumed run's state: its mission log says how far the wheels carried the pose.
   static boticelli::firmware::MissionState after;
-  if (store.load(after, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded) {
+  std::string why;
+  if (load_state(dir, after, why)) {
     for (const boticelli::firmware::MissionLogEntry& e : after.log) {
       const char* at = std::strstr(e.text.data(), "resumed pose moved on by the wheels: ");
       double metres = 0.0;
@@ -1157,11 +1151,8 @@ TEST(MissionResume, KilledMidLookTheStateHoldsTheLastCycleAndWhereTheRobotStands
   const std::string dir = mkdtemp(dir_template);
   const int status = kill_mission(KillWhile::kLooking, dir);
   static boticelli::firmware::MissionState saved;
-  static boticelli::firmware::StateStore store;
-  char error[256] = "";
-  const bool loaded =
-      store.open(dir.c_str(), error, sizeof error) &&
-      store.load(saved, error, sizeof error) == boticelli::firmware::LoadResult::kLoaded;
+  std::string error;
+  const bool loaded = load_state(dir, saved, error);
   // Where the killed firmware left the robot: the sim world's own file keeps it.
   static sim::World world;
   char why[256] = "";
@@ -1172,7 +1163,7 @@ TEST(MissionResume, KilledMidLookTheStateHoldsTheLastCycleAndWhereTheRobotStands
       stands, why, sizeof why);
   remove_state_dir(dir);
   CHECK_TEXT(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL, "killed mid-look");
-  CHECK_TEXT(loaded, error);
+  CHECK_TEXT(loaded, error.c_str());
   CHECK_TEXT(truth_loaded == boticelli::boards::sim::WorldTruthFile::Load::kLoaded, why);
   CHECK(saved.cycle >= 1);
   CHECK(!saved.log.empty());

@@ -219,6 +219,33 @@ TEST(WorldGeometry, ATraceWithMoreColumnsIsReadRowByRow) {
   DOUBLES_EQUAL(0.1344, rows[0].tilt_rad, 1e-12);
   STRCMP_EQUAL("drive", rows[1].state);
   DOUBLES_EQUAL(0.1, rows[1].t_s, 1e-12);
+  CHECK_FALSE(rows[0].has_pose_columns);  // odometry without the estimate: not read
+}
+
+// The firmware's odometry and estimate columns, wherever the header puts them, are read into
+// each row; a value there that is not a finite number is refused with its column's name.
+TEST(WorldGeometry, ATracesOdometryAndEstimateColumnsAreReadByName) {
+  const std::string head =
+      "t_s,x_m,y_m,yaw_rad,pan_rad,tilt_rad,state,est_x_m,est_y_m,est_yaw_rad,odo_x_m,odo_y_m,"
+      "odo_yaw_rad\n";
+  const std::string path =
+      temp_file(head + "0.000,1.0000,2.0000,0.5000,0,0,look,0.1000,0.2000,0.3000,0.4,0.5,0.6\n");
+  std::vector<TraceRow> rows;
+  std::string error;
+  CHECK_TEXT(read_trace(path.c_str(), rows, error), error.c_str());
+  unlink(path.c_str());
+  CHECK(rows[0].has_pose_columns);
+  DOUBLES_EQUAL(0.4, rows[0].odo[0], 1e-12);
+  DOUBLES_EQUAL(0.5, rows[0].odo[1], 1e-12);
+  DOUBLES_EQUAL(0.6, rows[0].odo[2], 1e-12);
+  DOUBLES_EQUAL(0.1, rows[0].est[0], 1e-12);
+  DOUBLES_EQUAL(0.2, rows[0].est[1], 1e-12);
+  DOUBLES_EQUAL(0.3, rows[0].est[2], 1e-12);
+  const std::string bad = temp_file(head + "0.000,1,2,0.5,0,0,look,0.1,nan,0.3,0.4,0.5,0.6\n");
+  CHECK_FALSE(read_trace(bad.c_str(), rows, error));
+  unlink(bad.c_str());
+  CHECK_TEXT(error.find(":2: est_y_m 'nan' is not a finite number") != std::string::npos,
+             error.c_str());
 }
 
 TEST(WorldGeometry, AMalformedTraceIsRejectedWithFileLineAndWhy) {

@@ -191,68 +191,15 @@ hal::sim::World g_world;
 
 constexpr double kObstacleOffM = 0.3;  // an occupied cell farther than this from a surface
 
-// A trace's columns by name and its rows as numbers (the state column reads as 0).
-struct TraceTable {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> rows;
-  [[nodiscard]] int column(const char* name) const {
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      if (names[i] == name) return static_cast<int>(i);
-    }
-    return -1;
-  }
-};
-
-std::vector<std::string> split_commas(const std::string& line) {
-  std::vector<std::string> out;
-  std::size_t at = 0;
-  while (at <= line.size()) {
-    const std::size_t comma = std::min(line.find(',', at), line.size());
-    out.push_back(line.substr(at, comma - at));
-    at = comma + 1;
-  }
-  return out;
-}
-
-bool read_table(const std::string& trace, TraceTable& t) {
-  const std::string text = read_file(trace);
-  std::size_t at = text.find('\n');
-  if (at == std::string::npos) return false;
-  t.names = split_commas(text.substr(0, at));
-  while (++at < text.size()) {
-    const std::size_t eol = std::min(text.find('\n', at), text.size());
-    std::vector<double> row;
-    for (const std::string& f : split_commas(text.substr(at, eol - at))) {
-      row.push_back(std::strtod(f.c_str(), nullptr));
-    }
-    if (row.size() == t.names.size()) t.rows.push_back(std::move(row));
-    at = eol;
-  }
-  return !t.rows.empty();
-}
-
-// A pose of a row: the columns PREFIXx_m, PREFIXy_m, PREFIXyaw_rad ("", "odo_", "est_").
-bool row_pose(const TraceTable& t, const std::vector<double>& row, const std::string& prefix,
-              core::Pose2& pose) {
-  const int x = t.column((prefix + "x_m").c_str());
-  const int y = t.column((prefix + "y_m").c_str());
-  const int yaw = t.column((prefix + "yaw_rad").c_str());
-  if (x < 0 || y < 0 || yaw < 0) return false;
-  pose = {static_cast<float>(row[static_cast<std::size_t>(x)]),
-          static_cast<float>(row[static_cast<std::size_t>(y)]),
-          static_cast<float>(row[static_cast<std::size_t>(yaw)])};
-  return true;
-}
-
 // The mission frame in the world: the first trace row's true pose composed with the inverse
 // of its odometry pose (the odo_* columns; the frame is the odometry's at the base's start).
-bool mission_frame(const TraceTable& t, core::Pose2& origin) {
-  core::Pose2 truth{};
-  core::Pose2 odo{};
-  if (t.rows.empty() || !row_pose(t, t.rows.front(), "", truth) ||
-      !row_pose(t, t.rows.front(), "odo_", odo)) {
-    return false;
-  }
+bool mission_frame(const std::vector<hal::sim::TraceRow>& rows, core::Pose2& origin) {
+  if (rows.empty() || !rows.front().has_pose_columns) return false;
+  const hal::sim::TraceRow& r = rows.front();
+  const core::Pose2 truth{static_cast<float>(r.x_m), static_cast<float>(r.y_m),
+                          static_cast<float>(r.yaw_rad)};
+  const core::Pose2 odo{static_cast<float>(r.odo[0]), static_cast<float>(r.odo[1]),
+                        static_cast<float>(r.odo[2])};
   origin = core::compose(truth, core::inverse(odo));
   return true;
 }
@@ -269,24 +216,21 @@ struct PoseErrors {
   double worst_deg[2] = {0.0, 0.0};
 };
 
-PoseErrors pose_errors(const TraceTable& t) {
+PoseErrors pose_errors(const std::vector<hal::sim::TraceRow>& rows) {
   PoseErrors e;
   core::Pose2 origin{};
-  if (!mission_frame(t, origin)) return e;
-  const char* prefixes[2] = {"est_", "odo_"};
-  core::Pose2 last{};
-  for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    core::Pose2 truth{};
-    if (!row_pose(t, t.rows[r], "", truth)) return e;
-    if (r > 0)
-      e.path_m += static_cast<double>(std::hypot(truth.x_m - last.x_m, truth.y_m - last.y_m));
-    last = truth;
+  if (!mission_frame(rows, origin)) return e;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const hal::sim::TraceRow& r = rows[i];
+    if (i > 0) e.path_m += std::hypot(r.x_m - rows[i - 1].x_m, r.y_m - rows[i - 1].y_m);
     for (int k = 0; k < 2; ++k) {
-      core::Pose2 p{};
-      if (!row_pose(t, t.rows[r], prefixes[k], p)) return e;
-      const core::Pose2 w = core::compose(origin, p);
-      e.final_m[k] = static_cast<double>(std::hypot(w.x_m - truth.x_m, w.y_m - truth.y_m));
-      e.final_deg[k] = static_cast<double>(std::fabs(core::wrap_pi(w.yaw_rad - truth.yaw_rad))) *
+      const double* p = k == 0 ? r.est : r.odo;
+      const core::Pose2 w = core::compose(
+          origin, {static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])});
+      e.final_m[k] =
+          std::hypot(static_cast<double>(w.x_m) - r.x_m, static_cast<double>(w.y_m) - r.y_m);
+      e.final_deg[k] = std::fabs(std::remainder(static_cast<double>(w.yaw_rad) - r.yaw_rad,
+                                                2.0 * 3.14159265358979323846)) *
                        180.0 / 3.14159265358979323846;
       e.worst_m[k] = std::max(e.worst_m[k], e.final_m[k]);
       e.worst_deg[k] = std::max(e.worst_deg[k], e.final_deg[k]);
@@ -636,12 +580,10 @@ int run(bool localization) {
     const ModelSize size = model_size(r.dir + "/state");
     core::Pose2 origin{};
     MapCheck map_check{};
-    TraceTable table;
-    const bool table_ok = read_table(r.dir + "/trace.csv", table);
-    if (table_ok && mission_frame(table, origin)) {
+    if (trace_ok && mission_frame(rows, origin)) {
       map_check = check_map(r.dir + "/map", origin, config.robot_height_m);
     }
-    const PoseErrors pose = table_ok ? pose_errors(table) : PoseErrors{};
+    const PoseErrors pose = trace_ok ? pose_errors(rows) : PoseErrors{};
     const double register_ms = m.registered > 0.0 ? 1e3 * m.register_s / m.registered
                                                   : std::numeric_limits<double>::quiet_NaN();
     const double free_m2 = field(m.map_line, "free_m2");

@@ -219,6 +219,16 @@ bool read_trace(const char* path, std::vector<TraceRow>& rows, std::string& erro
                          kColumns[i] + "' (header t_s,x_m,y_m,yaw_rad,pan_rad,tilt_rad,state,...)");
     }
   }
+  // The firmware's pose columns, wherever the header puts them (all six, or none used).
+  static constexpr std::array<const char*, 6> kPoseColumns = {"odo_x_m", "odo_y_m", "odo_yaw_rad",
+                                                              "est_x_m", "est_y_m", "est_yaw_rad"};
+  std::array<std::size_t, 6> pose_at{};
+  bool pose_columns = true;
+  for (std::size_t k = 0; k < kPoseColumns.size(); ++k) {
+    const auto it = std::find(header.begin(), header.end(), kPoseColumns[k]);
+    pose_columns = pose_columns && it != header.end();
+    if (it != header.end()) pose_at[k] = static_cast<std::size_t>(it - header.begin());
+  }
   std::size_t number = 1;
   bool blank_seen = false;
   std::size_t blank_line = 0;
@@ -241,6 +251,14 @@ bool read_trace(const char* path, std::vector<TraceRow>& rows, std::string& erro
     for (std::size_t i = 0; i < 6; ++i) {
       if (!parse_number(f[i], *values[i])) {
         return fail(number, std::string(kColumns[i]) + " '" + f[i] + "' is not a finite number");
+      }
+    }
+    row.has_pose_columns = pose_columns;
+    for (std::size_t k = 0; pose_columns && k < kPoseColumns.size(); ++k) {
+      double& v = k < 3 ? row.odo[k] : row.est[k - 3];
+      if (!parse_number(f[pose_at[k]], v)) {
+        return fail(number, std::string(kPoseColumns[k]) + " '" + f[pose_at[k]] +
+                                "' is not a finite number");
       }
     }
     if (f[6].empty()) return fail(number, "empty state");

@@ -22,7 +22,10 @@ inline constexpr float kFloorClearanceM = 0.01F;
 float disc_clearance_m(const World& world, float x_m, float y_m, float radius_m, float height_m);
 
 // One row of a mission trace (--trace FILE): header t_s,x_m,y_m,yaw_rad,pan_rad,tilt_rad,state
-// and possibly more columns; x, y, yaw are the simulator's true pose.
+// and possibly more columns; x, y, yaw are the simulator's true pose. When the header has the
+// firmware's columns odo_x_m,odo_y_m,odo_yaw_rad and est_x_m,est_y_m,est_yaw_rad (the raw
+// odometry and the mission's pose estimate, both in the mission frame), `odo` and `est` hold
+// them (x, y, yaw) and `has_pose_columns` is set.
 struct TraceRow {
   double t_s;
   double x_m;
@@ -31,11 +34,15 @@ struct TraceRow {
   double pan_rad;
   double tilt_rad;
   char state[24];
+  bool has_pose_columns;
+  double odo[3];
+  double est[3];
 };
 
 // Reads a trace and validates the header and every row (field count as in the header, finite
-// numbers, a non-empty state of at most 23 characters, time never going back, at least one row).
-// On failure returns false with "FILE:LINE: why" in `error`.
+// numbers, also in the odo_ and est_ columns, a non-empty state of at most 23 characters, time
+// never going back, at least one row). On failure returns false with "FILE:LINE: why" in
+// `error`.
 bool read_trace(const char* path, std::vector<TraceRow>& rows, std::string& error);
 
 // The simulator never lets the disc overlap (it refuses the 1 ms step that would and stops the
