@@ -116,18 +116,6 @@ MissionRun run_mission(const char* world, const char* seed, float odometry_noise
   return run;
 }
 
-// The odometry columns (odo_, from column 7) or the estimate's (est_, from column 10; the
-// mission's own pose), both in the mission frame, of a trace's first or last row.
-void trace_odometry(const std::string& text, bool last, double odo[3], int first_column = 7) {
-  const std::size_t first_row = text.find('\n') + 1;
-  const std::size_t line = last ? text.rfind('\n', text.size() - 2) + 1 : first_row;
-  std::stringstream fields(text.substr(line, text.find('\n', line) - line));
-  std::string field;
-  for (int i = 0; std::getline(fields, field, ','); ++i) {
-    if (i >= first_column && i < first_column + 3) odo[i - first_column] = std::atof(field.c_str());
-  }
-}
-
 // The thesis room at seed 1 with an operator: `after_frame` runs after every frame with
 // `script`, whose console_fd is the write end of the console's stdin (set here).
 template <class Script>
@@ -227,8 +215,8 @@ namespace {
 double odometry_drift_m(const MissionRun& r) {
   const sim::TraceRow& first = r.trace.front();
   const sim::TraceRow& last = r.trace.back();
-  double odo[3] = {0.0, 0.0, 0.0};
-  trace_odometry(r.trace_text, true, odo);
+  CHECK(last.has_pose_columns);
+  const double* odo = last.odo;  // mission frame
   const boticelli::core::Point2 odo_world =
       boticelli::core::to_world({static_cast<float>(first.x_m), static_cast<float>(first.y_m),
                                  static_cast<float>(first.yaw_rad)},
@@ -914,10 +902,9 @@ TEST(MissionResume, AResumedMissionStartsWhereTheLastRunStoppedAndFindsTheTarget
   CHECK(std::hypot(stopped.x_m - resumed.x_m, stopped.y_m - resumed.y_m) < 0.1);
   // The pose in the mission's frame (the trace's estimate columns) carries on too, from the
   // pose saved at shutdown: the map and the goal saved in that frame still fit.
-  double before[3] = {0.0, 0.0, 0.0};
-  double after[3] = {1.0, 1.0, 1.0};
-  trace_odometry(first.trace_text, true, before, 10);
-  trace_odometry(second.trace_text, false, after, 10);
+  CHECK(first.trace.back().has_pose_columns && second.trace.front().has_pose_columns);
+  const double* before = first.trace.back().est;
+  const double* after = second.trace.front().est;
   CHECK_TEXT(std::hypot(before[0], before[1]) > 0.3, "the first run's frame moved with the robot");
   CHECK(std::hypot(before[0] - saved[0], before[1] - saved[1]) < 0.05);
   // Saved where the base came to rest (perfect odometry: the true rest pose in the frame of the
@@ -1085,27 +1072,22 @@ KilledAndResumed kill_and_resume(KillWhile when, const std::string& dir,
   std::size_t row = 0;
   while (row < resumed.trace.size() && std::string(resumed.trace[row].state) == "start") ++row;
   if (row == resumed.trace.size()) return out;
-  std::istringstream lines(resumed.trace_text);
-  std::string line;
-  for (std::size_t i = 0; i <= row + 1 && std::getline(lines, line);) ++i;  // header + rows
-  std::vector<double> f;
-  std::stringstream fields(line);
-  std::string field;
-  while (std::getline(fields, field, ',')) f.push_back(std::atof(field.c_str()));
-  const boticelli::core::Pose2 start = g_board.world().start;
   const sim::TraceRow& t = resumed.trace[row];
+  if (!t.has_pose_columns) return out;
+  const double* f = t.est;  // the firmware's estimate, mission frame
+  const boticelli::core::Pose2 start = g_board.world().start;
   const boticelli::core::Pose2 truth = boticelli::core::compose(
       boticelli::core::inverse(start),
       {static_cast<float>(t.x_m), static_cast<float>(t.y_m), static_cast<float>(t.yaw_rad)});
   const double tx = truth.x_m, ty = truth.y_m, tyaw = truth.yaw_rad;
-  out.estimate_off_m = std::hypot(f[10] - tx, f[11] - ty);
-  out.estimate_off_rad = std::fabs(std::remainder(f[12] - tyaw, 2.0 * std::numbers::pi));
+  out.estimate_off_m = std::hypot(f[0] - tx, f[1] - ty);
+  out.estimate_off_rad = std::fabs(std::remainder(f[2] - tyaw, 2.0 * std::numbers::pi));
   out.saved_off_m = std::hypot(static_cast<double>(saved.pose.x_m) - tx,
                                static_cast<double>(saved.pose.y_m) - ty);
   out.saved_off_rad = std::fabs(
       std::remainder(static_cast<double>(saved.pose.yaw_rad) - tyaw, 2.0 * std::numbers::pi));
   out.moved_rad =
-      std::remainder(f[12] - static_cast<double>(saved.pose.yaw_rad), 2.0 * std::numbers::pi);
+      std::remainder(f[2] - static_cast<double>(saved.pose.yaw_rad), 2.0 * std::numbers::pi);
   // The resumed run's state: its mission log says how far the wheels carried the pose.
   static boticelli::firmware::MissionState after;
   std::string why;
