@@ -20,7 +20,8 @@ void DriveController::start(const core::Pose2& from, core::Point2 end, std::uint
   deadline_us_ = now_us + static_cast<std::uint64_t>(nominal_s * params_.timeout_factor * 1e6F);
   failure_ = "";
   after_stop_ = DriveStatus::kDone;
-  status_ = distance < params_.position_tolerance_m ? DriveStatus::kDone : DriveStatus::kTurning;
+  // Within the tolerance it is done, as the leg is (`update`): at exactly the tolerance too.
+  status_ = distance <= params_.position_tolerance_m ? DriveStatus::kDone : DriveStatus::kTurning;
 }
 
 void DriveController::start_turn(const core::Pose2& from, float heading_rad, std::uint64_t now_us) {

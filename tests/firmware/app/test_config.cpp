@@ -175,42 +175,48 @@ TEST(ConfigFile, EachKindOfBadValueIsReportedAsFileLineWhyAndChangesNothing) {
   }
 }
 
-// Every range-checked key of the board and the rpi4 devices: its maximum is accepted and the
-// next value above it refused, with the range in the message and the value not set.
-TEST(ConfigFile, EveryNumberKeyRefusesAValueAboveItsMaximumAndAcceptsTheMaximum) {
+// Every range-checked key of the board and the rpi4 devices: its minimum and maximum are
+// accepted, and the next value below the minimum or above the maximum refused, with the range
+// in the message and the value not set.
+TEST(ConfigFile, EveryNumberKeyAcceptsItsBoundsAndRefusesTheNextValueOutsideThem) {
   const Rpi4Keys keys;
   std::size_t checked = 0;
   for (std::size_t i = 0; i < keys.schema.size(); ++i) {
     const ConfigKey& key = keys.schema[i];
     if (key.kind != ConfigKind::kWhole && key.kind != ConfigKind::kNumber) continue;
-    char at_max[64];
-    char above[64];
-    if (key.kind == ConfigKind::kWhole) {
-      const auto max = static_cast<long long>(key.max);
-      std::snprintf(at_max, sizeof at_max, "%lld", max);
-      std::snprintf(above, sizeof above, "%lld", max + key.multiple_of);
-    } else {
-      std::snprintf(at_max, sizeof at_max, "%.17g", key.max);
-      std::snprintf(above, sizeof above, "%.17g", key.max + 0.5);
+    for (const bool upper : {false, true}) {
+      const double bound = upper ? key.max : key.min;
+      char at[64];
+      char beyond[64];
+      if (key.kind == ConfigKind::kWhole) {
+        const auto whole = static_cast<long long>(bound);
+        const long long step = upper ? key.multiple_of : -static_cast<long long>(key.multiple_of);
+        std::snprintf(at, sizeof at, "%lld", whole);
+        std::snprintf(beyond, sizeof beyond, "%lld", whole + step);
+      } else {
+        std::snprintf(at, sizeof at, "%.17g", bound);
+        std::snprintf(beyond, sizeof beyond, "%.17g", upper ? bound + 0.5 : bound - 0.5);
+      }
+      const std::string head = std::string("[") + key.table + "]\n" + key.name + " = ";
+      Rpi4Keys k;
+      char error[320] = "";
+      const bool accepted =
+          apply_config_text(head + at + "\n", "bound.conf", k.schema, error, sizeof error);
+      CHECK_TRUE_TEXT(accepted, (head + at + ": " + error).c_str());
+      Rpi4Keys fresh;
+      const BoardConfig before = fresh.config;
+      CHECK_FALSE_TEXT(
+          apply_config_text(head + beyond + "\n", "bound.conf", fresh.schema, error, sizeof error),
+          (head + beyond).c_str());
+      const std::string message = error;
+      const std::string said = std::string(key.table) + "." + key.name + " = ";
+      CHECK_TEXT(message.rfind("bound.conf:2: " + said, 0) == 0, message.c_str());
+      STRCMP_CONTAINS(" is out of range (", error);
+      CHECK_TEXT(same_config(before, fresh.config), (head + beyond).c_str());
+      ++checked;
     }
-    const std::string head = std::string("[") + key.table + "]\n" + key.name + " = ";
-    Rpi4Keys k;
-    char error[320] = "";
-    CHECK_TRUE_TEXT(
-        apply_config_text(head + at_max + "\n", "max.conf", k.schema, error, sizeof error), error);
-    Rpi4Keys fresh;
-    const BoardConfig before = fresh.config;
-    CHECK_FALSE_TEXT(
-        apply_config_text(head + above + "\n", "max.conf", fresh.schema, error, sizeof error),
-        (head + above).c_str());
-    const std::string message = error;
-    const std::string said = std::string(key.table) + "." + key.name + " = ";
-    CHECK_TEXT(message.rfind("max.conf:2: " + said, 0) == 0, message.c_str());
-    STRCMP_CONTAINS(" is out of range (", error);
-    CHECK_TEXT(same_config(before, fresh.config), (head + above).c_str());
-    ++checked;
   }
-  CHECK(checked >= 20);
+  CHECK(checked >= 40);
 }
 
 // The camera's height has its own limit: the low-resolution frame's 240 rows times 4, less

@@ -452,6 +452,32 @@ TEST(DriveController, AtExactlyThePositionToleranceFromTheEndTheStepIsDone) {
   DOUBLES_EQUAL(0.0, static_cast<double>(c.v_m_s), 0.0);
 }
 
+TEST(DriveController, AStepOfExactlyThePositionToleranceIsDoneAtOnceAndALongerOneTurnsFirst) {
+  DriveParams p{};
+  p.position_tolerance_m = 0.25F;  // exact in binary, as are the ends below
+  for (const float length_m : {0.25F, 0.25F + 1.0F / 1024.0F}) {
+    DriveController controller;
+    controller.configure(p);
+    controller.start({0.0F, 0.0F, 1.0F}, {length_m, 0.0F}, 0);
+    CHECK(controller.status() == (length_m <= 0.25F ? DriveStatus::kDone : DriveStatus::kTurning));
+  }
+}
+
+TEST(DriveController, ATurnEndsAtExactlyTheHeadingToleranceAndNotBeyondIt) {
+  DriveParams p{};
+  p.heading_tolerance_rad = 0.0625F;  // exact in binary, as are the yaws below
+  for (const float off_rad : {0.0625F, 0.0625F + 1.0F / 1024.0F}) {
+    for (const float side : {-1.0F, 1.0F}) {
+      DriveController controller;
+      controller.configure(p);
+      controller.start({0.0F, 0.0F, side * off_rad}, {1.0F, 0.0F}, 0);
+      (void)controller.update({0.0F, 0.0F, side * off_rad}, 0.0F, 0.0F, kDt_us);
+      CHECK(controller.status() ==
+            (off_rad <= 0.0625F ? DriveStatus::kDriving : DriveStatus::kTurning));
+    }
+  }
+}
+
 TEST(DriveController, ThePeriodThatEndsTheTurnCommandsRestSoTheLegStartsFromIt) {
   DriveController controller;
   controller.configure(DriveParams{});
