@@ -225,6 +225,22 @@ TEST(MissionState, TextIsCutToItsCapacityAndOnlyPrintableAsciiIsKept) {
   STRCMP_EQUAL("a?b", g_a.end_reason.data());
 }
 
+// At the capacity's edges: a text of exactly the capacity is kept whole, one byte more is cut
+// to the capacity, in the log and in the end's reason alike.
+TEST(MissionState, ATextOfExactlyItsCapacityIsKeptWholeAndOneByteMoreIsCutToIt) {
+  g_a.clear();
+  const std::string exact(MissionLogEntry::kMaxTextBytes, 'e');
+  const std::string one_more(MissionLogEntry::kMaxTextBytes + 1, 'm');
+  g_a.add_log(1, one_more);
+  g_a.add_log(2, exact);
+  CHECK_EQUAL(std::string(MissionLogEntry::kMaxTextBytes, 'm'), std::string(g_a.log[0].view()));
+  CHECK_EQUAL(exact, std::string(g_a.log[1].view()));
+  g_a.set_end(MissionEnd::kAborted, one_more);
+  CHECK_EQUAL(std::string(MissionLogEntry::kMaxTextBytes, 'm'), std::string(g_a.end_reason_text()));
+  g_a.set_end(MissionEnd::kAborted, exact);
+  CHECK_EQUAL(exact, std::string(g_a.end_reason_text()));
+}
+
 TEST(Persistence, ComputesTheStandardCrc32) {
   CHECK_EQUAL(0xCBF43926U, crc32("123456789", 9));
   CHECK_EQUAL(0U, crc32("", 0));
