@@ -801,10 +801,10 @@ Reading reading_past(const mapping::GuardPoint& c, const std::array<float, 3>& v
 }  // namespace
 
 // Candidates on steep lines of sight, 70° to 89.9° above and below the horizon, where a cone
-// about the line of sight spans wide pans and, once it holds the vertical, every pan; readings
-// lie beyond them (some within both range errors) within up to 2.5 times the angle, turned any way
-// about the line of sight, seen from the PTU centre or from views on a short lever: both scans drop
-// exactly the candidates the definition drops.
+// about the line of sight spans wide pans and, once it holds the vertical, every pan. Readings
+// lie 1.1 to 2 times as far out (some not beyond both range errors), up to 2.5 times the angle
+// off, turned any way about the line of sight, seen from the PTU centre or from views on a short
+// lever: both scans drop exactly the candidates the definition drops.
 TEST(FeatureGuard, BothScansDropTheCandidatesTheDefinitionDropsAlsoOnLinesOfSightNearTheVertical) {
   for (const float lever : {0.0F, 0.05F}) {
     static FixedVector<Reading, 1200> readings;
