@@ -269,6 +269,96 @@ TEST(FeatureGuard, NeighboursAreFoundWithinTheSummedRangeErrorOfThePair) {
   CHECK_TRUE(mapping::are_neighbours({2.0F, 0.49F, 0.0F, 3.0F}, a, g));
 }
 
+namespace {
+// The neighbour rule (FeatureGuardParams) computed in double apart from the guard's code: the
+// pair's radius from its summed range error, and with a lateral radius its offset split along
+// and across a + b (the pair's mean line of sight from the PTU centre). Returns the smaller
+// margin by which the pair meets its bounds [m]; negative: not neighbours.
+double neighbour_margin(const mapping::GuardPoint& a, const mapping::GuardPoint& b,
+                        const mapping::FeatureGuardParams& g) {
+  const auto wide = [](float v) { return static_cast<double>(v); };
+  const double radius = std::max(wide(g.neighbour_radius_m),
+                                 wide(g.neighbour_delta_r_factor) * wide(g.delta_r_fraction) *
+                                     (std::fabs(wide(a.r_m)) + std::fabs(wide(b.r_m))));
+  const std::array<double, 3> d = {wide(b.x_m) - wide(a.x_m), wide(b.y_m) - wide(a.y_m),
+                                   wide(b.h_m) - wide(a.h_m)};
+  const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(g.lateral_radius_m > 0.0F)) return radius - dist;
+  const std::array<double, 3> s = {wide(a.x_m) + wide(b.x_m), wide(a.y_m) + wide(b.y_m),
+                                   wide(a.h_m) + wide(b.h_m)};
+  const double along = (d[0] * s[0] + d[1] * s[1] + d[2] * s[2]) /
+                       std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  const double across = std::sqrt(std::max(dist * dist - along * along, 0.0));
+  const double lateral = std::min(wide(g.lateral_radius_m), radius);
+  return std::min(radius - std::fabs(along), lateral - across);
+}
+}  // namespace
+
+// Pairs about lines of sight in every direction, up to 80° above and below the horizon, 0.3 to
+// 5 m out, offset along and across their line of sight by up to 1.3 times what the rule allows:
+// are_neighbours decides as the rule computed independently does, with each parameter set
+// (ranges known or not), leaving out only pairs within 0.1 mm of a bound.
+TEST(FeatureGuard, NeighboursAlongAndAcrossTheirMeanLineOfSightAreThoseTheRuleComputedApartGives) {
+  boticelli::test::Random rng(47);
+  std::array<mapping::FeatureGuardParams, 5> rules{};
+  rules[1].lateral_radius_m = 0.0F;          // a ball of the pair's radius
+  rules[2].neighbour_delta_r_factor = 0.0F;  // the fixed radius, narrower across
+  rules[3].lateral_radius_m = 0.6F;          // wider across than many pairs' radius
+  rules[4].delta_r_fraction = 0.05F;
+  int near = 0;
+  int apart = 0;
+  int oblique_beyond_lateral = 0;  // neighbours only along a steep line of sight
+  for (const mapping::FeatureGuardParams& g : rules) {
+    for (int k = 0; k < 2000; ++k) {
+      const float pan = rng.uniform(-3.14159F, 3.14159F);
+      const float el = rng.uniform(-1.4F, 1.4F);
+      const float range = rng.uniform(0.3F, 5.0F);
+      const std::array<float, 3> los = {std::cos(el) * std::cos(pan), std::cos(el) * std::sin(pan),
+                                        std::sin(el)};
+      // A unit vector across the line of sight, at a random angle about it.
+      const float turn = rng.uniform(-3.14159F, 3.14159F);
+      const std::array<float, 3> e1 = {-std::sin(pan), std::cos(pan), 0.0F};
+      const std::array<float, 3> e2 = {-std::sin(el) * std::cos(pan), -std::sin(el) * std::sin(pan),
+                                       std::cos(el)};
+      const bool known = k % 10 != 0;  // a tenth with unknown ranges: the fixed radius
+      const float bound =
+          std::fmax(g.neighbour_radius_m,
+                    known ? g.neighbour_delta_r_factor * g.delta_r_fraction * 2.0F * range : 0.0F);
+      const float along = bound * rng.uniform(-1.3F, 1.3F);
+      const float across =
+          std::fmin(g.lateral_radius_m > 0.0F ? g.lateral_radius_m : bound, bound) *
+          rng.uniform(0.0F, 1.3F);
+      std::array<float, 3> pa{};
+      std::array<float, 3> pb{};
+      for (std::size_t i = 0; i < 3; ++i) {
+        const float mid = range * los[i];
+        const float half =
+            0.5F * (along * los[i] + across * (std::cos(turn) * e1[i] + std::sin(turn) * e2[i]));
+        pa[i] = mid - half;
+        pb[i] = mid + half;
+      }
+      const mapping::GuardPoint a{
+          pa[0], pa[1], pa[2],
+          known ? std::sqrt(pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2]) : 0.0F};
+      const mapping::GuardPoint b{
+          pb[0], pb[1], pb[2],
+          known ? std::sqrt(pb[0] * pb[0] + pb[1] * pb[1] + pb[2] * pb[2]) : 0.0F};
+      const double margin = neighbour_margin(a, b, g);
+      if (std::fabs(margin) < 1e-4) continue;
+      CHECK_EQUAL(margin > 0.0, mapping::are_neighbours(a, b, g));
+      CHECK_EQUAL(margin > 0.0, mapping::are_neighbours(b, a, g));
+      (margin > 0.0 ? near : apart) += 1;
+      const float dist = std::hypot(pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]);
+      if (margin > 0.0 && g.lateral_radius_m > 0.0F && std::fabs(el) > 0.5F &&
+          dist > 1.1F * g.lateral_radius_m) {
+        ++oblique_beyond_lateral;
+      }
+    }
+  }
+  CHECK(near > 2500 && apart > 2500);  // both kinds, well spread
+  CHECK(oblique_beyond_lateral > 100);
+}
+
 TEST(FeatureGuard, AWeakFeatureNeedsMoreCorroborationThanAStrongOne) {
   GuardCandidatesFor<32> candidates;
   for (int i = 0; i < 6; ++i) {  // six weak features within 5 cm: five neighbours each
@@ -678,4 +768,118 @@ TEST(FeatureGuard, TheLinesOfSightThatSeePastACandidateStartAtTheReadingsViews) 
   (void)candidates.push_back(c);
   LONGS_EQUAL(0, mapping::drop_seen_through(readings, g, candidates));
   LONGS_EQUAL(1, candidates.size());
+}
+
+namespace {
+// A reading of the point view + t û, seen from view, where û lies `off` radians from the
+// direction view → c, turned `turn` about it; t is `beyond` times the distance to c.
+Reading reading_past(const mapping::GuardPoint& c, const std::array<float, 3>& view, float off,
+                     float turn, float beyond) {
+  const std::array<float, 3> w = {c.x_m - view[0], c.y_m - view[1], c.h_m - view[2]};
+  const float wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  // Two unit vectors across w.
+  const float wh = std::hypot(w[0], w[1]);
+  const std::array<float, 3> e1 = wh > 1e-6F ? std::array<float, 3>{-w[1] / wh, w[0] / wh, 0.0F}
+                                             : std::array<float, 3>{1, 0, 0};
+  const std::array<float, 3> e2 = {(w[1] * e1[2] - w[2] * e1[1]) / wn,
+                                   (w[2] * e1[0] - w[0] * e1[2]) / wn,
+                                   (w[0] * e1[1] - w[1] * e1[0]) / wn};
+  std::array<float, 3> p{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const float u = std::cos(off) * w[i] / wn +
+                    std::sin(off) * (std::cos(turn) * e1[i] + std::sin(turn) * e2[i]);
+    p[i] = view[i] + beyond * wn * u;
+  }
+  float a = std::atan2(p[1], p[0]);
+  if (a < 0.0F) a += 6.2831853F;
+  Reading q = at(a, std::hypot(p[0], p[1]), p[2]);
+  q.view_x_m = view[0];
+  q.view_y_m = view[1];
+  q.view_z_m = view[2];
+  return q;
+}
+}  // namespace
+
+// Candidates on steep lines of sight, 70° to 89.9° above and below the horizon, where a cone
+// about the line of sight spans wide pans and, once it holds the vertical, every pan. Readings
+// lie 1.1 to 2 times as far out (some not beyond both range errors), up to 2.5 times the angle
+// off, turned any way about the line of sight, seen from the PTU centre or from views on a short
+// lever: both scans drop exactly the candidates the definition drops.
+TEST(FeatureGuard, BothScansDropTheCandidatesTheDefinitionDropsAlsoOnLinesOfSightNearTheVertical) {
+  for (const float lever : {0.0F, 0.05F}) {
+    static FixedVector<Reading, 1200> readings;
+    static GuardCandidatesFor<400> plain;
+    static GuardCandidatesFor<400> ordered;
+    readings.clear();
+    plain.clear();
+    ordered.clear();
+    boticelli::test::Random rng(lever > 0.0F ? 53U : 59U);
+    for (int k = 0; k < 400; ++k) {
+      const float el = (k % 2 == 0 ? 1.0F : -1.0F) * rng.uniform(1.22F, 1.5690F);
+      const float range = rng.uniform(0.5F, 4.0F);
+      const mapping::GuardPoint c = candidate_at(rng.uniform(-3.14159F, 3.14159F),
+                                                 range * std::cos(el), range * std::sin(el));
+      (void)plain.push_back(c);
+      (void)ordered.push_back(c);
+      for (int j = 0; j < 3; ++j) {
+        const float view_pan = rng.uniform(0.0F, 6.2831853F);
+        const std::array<float, 3> view = {lever * std::cos(view_pan), lever * std::sin(view_pan),
+                                           rng.uniform(-0.5F, 0.5F) * lever};
+        (void)readings.push_back(reading_past(c, view, rng.uniform(0.0F, 0.05F),
+                                              rng.uniform(-3.14159F, 3.14159F),
+                                              rng.uniform(1.1F, 2.0F)));
+      }
+    }
+    mapping::FeatureGuardParams g;
+    g.see_through_readings = 2;  // the test's angle: 0.02 rad
+    std::size_t expected = 0;
+    for (const mapping::GuardPoint& c : plain) {
+      expected += seen_through_by_definition(readings, c, g) ? 1U : 0U;
+    }
+    CHECK(expected > 40 && expected < 360);  // the test has both kinds
+    static std::array<std::uint32_t, 1200> scratch;
+    LONGS_EQUAL(expected, mapping::drop_seen_through(readings, g, plain));
+    LONGS_EQUAL(expected, mapping::drop_seen_through(readings, g, ordered, scratch));
+    for (const mapping::GuardPoint& c : plain) {
+      CHECK_FALSE(seen_through_by_definition(readings, c, g));
+    }
+    LONGS_EQUAL(plain.size(), ordered.size());
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+      CHECK_EQUAL(plain[i].x_m, ordered[i].x_m);
+    }
+  }
+}
+
+// A scratch shorter than the readings cannot hold their pan order: nothing is written past its
+// end, and the candidates dropped are the plain scan's.
+TEST(FeatureGuard, AScratchShorterThanTheReadingsIsNotWrittenPastItsEndAndThePlainScanDecides) {
+  FixedVector<Reading, 64> readings;
+  boticelli::test::Random rng(61);
+  GuardCandidatesFor<16> plain;
+  for (int k = 0; k < 16; ++k) {
+    const mapping::GuardPoint c =
+        candidate_at(rng.uniform(-3.0F, 3.0F), rng.uniform(0.5F, 2.5F), rng.uniform(-0.5F, 0.2F));
+    (void)plain.push_back(c);
+    for (int j = 0; j < (k % 2 == 0 ? 3 : 1); ++j) {
+      (void)readings.push_back(reading_past(c, {0.0F, 0.0F, 0.0F}, 0.005F, 0.0F, 1.5F));
+    }
+  }
+  mapping::FeatureGuardParams g;
+  g.see_through_readings = 2;
+  for (const std::size_t size : {std::size_t{0}, readings.size() / 2, readings.size() - 1}) {
+    GuardCandidatesFor<16> ordered;
+    GuardCandidatesFor<16> candidates = plain;
+    for (const mapping::GuardPoint& c : plain) (void)ordered.push_back(c);
+    std::array<std::uint32_t, 64> buffer{};
+    buffer.fill(0xDEADBEEFU);
+    const std::size_t dropped = mapping::drop_seen_through(readings, g, candidates);
+    LONGS_EQUAL(8, dropped);
+    LONGS_EQUAL(dropped,
+                mapping::drop_seen_through(readings, g, ordered, std::span(buffer).first(size)));
+    for (const std::uint32_t v : buffer) CHECK_EQUAL(0xDEADBEEFU, v);
+    LONGS_EQUAL(candidates.size(), ordered.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      CHECK_EQUAL(candidates[i].x_m, ordered[i].x_m);
+    }
+  }
 }

@@ -65,9 +65,9 @@ SeeThrough see_through_of(std::span<const evidence::Reading> readings,
 
 // One candidate's test. A reading seen past the candidate lies on a line of sight within the
 // angle of it, from a view at most `lever` away: seen from the PTU centre its direction is
-// within angle + asin(lever / r) of the candidate's. So pans farther apart than pan_reach (the
-// cone's width in pan grows as 1 / cos(elevation); 5% more for the small-angle
-// approximation), or ranges short of near_limit even with the lever, are not looked at.
+// within spread = angle + asin(lever / r) of the candidate's. So pans farther apart than
+// pan_reach (1.05 spread / (cos(elevation) − spread), 5% for the small-angle approximation;
+// every pan once the cone may hold the vertical) or ranges short of near_limit are skipped.
 struct CandidateCone {
   bool testable = false;  // farther than the lever
   float alpha = 0.0F;     // pan of the candidate, (−π, π]
@@ -83,7 +83,7 @@ CandidateCone cone_of(const GuardPoint& c, const SeeThrough& st, const FeatureGu
   cone.alpha = std::atan2(c.y_m, c.x_m);
   const float cos_el = std::sqrt(c.x_m * c.x_m + c.y_m * c.y_m) / r;
   const float spread = g.see_through_angle_rad + std::asin(std::fmin(st.lever / r, 1.0F));
-  cone.pan_reach = 1.05F * spread / std::fmax(cos_el - spread, 0.05F);
+  cone.pan_reach = cos_el > spread ? 1.05F * spread / (cos_el - spread) : HUGE_VALF;
   cone.near_limit = (r - st.lever) * st.far_factor - st.lever;
   return cone;
 }
