@@ -18,6 +18,10 @@ endif()
 
 if(BOTICELLI_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  # libstdc++'s own checks (std::array and std::vector indices, std::span, …): an index past
+  # an array that is a member of an object stays inside the object, where AddressSanitizer
+  # sees nothing.
+  add_compile_definitions(_GLIBCXX_ASSERTIONS)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
