@@ -635,3 +635,30 @@ TEST(ThesisPlannerTargetByPath, TheFinalApproachToATargetThatIsAnObstacleEndsAtI
   DOUBLES_EQUAL(g.x_m, t.x_m, 0.051);
   DOUBLES_EQUAL(g.y_m, t.y_m, 0.051);
 }
+
+// A robot standing at a cell's centre within an occupied cell's clearance (its own cell and the
+// three ahead along the path are not passable) steps along the path to the target: the part of
+// the step nearer than half the robot's radius is the place it stands on; from there on, the
+// step's straight way crosses passable cells only.
+TEST(ThesisPlannerTargetByPath, ARobotWithinAnObstaclesClearanceStepsOnlyAcrossPassableCells) {
+  params.final_approach_m = 0.0F;  // the path's step alone
+  (void)g_grid.add({-5, 0}, 20);
+  const float cell = g_grid.cell_m();
+  const Pose2 here{-2.5F * cell, 0.5F * cell, 0.0F};
+  const Point2 target{1.4F, 0.5F * cell};
+  const StarPolygon wide = disc(1.5F);
+  CHECK(plan_from(here, &target, wide, here) == StepOutcome::kMove);
+  const Point2 at{here.x_m, here.y_m};
+  CHECK_FALSE(planner.nav().passable(at));
+  CHECK_FALSE(planner.nav().passable({0.5F * cell, at.y_m}));
+  CHECK_TRUE(planner.nav().passable({1.5F * cell, at.y_m}));
+  const Point2 t = planner.target();
+  CHECK(boticelli::core::distance_m(at, t) >= params.step.min_step_m);
+  const float own = 0.5F * params.nav.robot_radius_m;
+  for (int i = 1; i <= 100; ++i) {
+    const float s = static_cast<float>(i) / 100.0F;
+    const Point2 p{at.x_m + s * (t.x_m - at.x_m), at.y_m + s * (t.y_m - at.y_m)};
+    if (boticelli::core::distance_m(p, at) < own) continue;
+    CHECK_TEXT(planner.nav().passable(p), "the step crosses a cell within the clearance");
+  }
+}
