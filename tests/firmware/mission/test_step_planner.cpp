@@ -259,6 +259,75 @@ TEST(StepPlanner, AnotherStepOnTheSameLookIsNoSafeStepWhenThePolygonLeavesNoRoom
   CHECK(planner.end_next_on_look() == StepOutcome::kNoSafeStep);
 }
 
+// The step is valued on the global map's obstacle points too: a short wall across
+// the straight way to an exploration point turns the step aside, clear of the wall.
+TEST(StepPlanner, AWallAcrossTheWayToAnExplorationPointTurnsTheStepAsideClearOfIt) {
+  (void)map.exploration().push_back({1.6F, 0.0F});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  CHECK(safe_cycle() == StepOutcome::kMove);
+  const Point2 straight = planner.target();
+  for (int i = -3; i <= 3; ++i)
+    (void)map.obstacles().push_back({0.5F, 0.05F * static_cast<float>(i)});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  CHECK(safe_cycle() == StepOutcome::kMove);
+  const Point2 aside = planner.target();
+  float straight_clear = 10.0F;
+  float aside_clear = 10.0F;
+  for (const Point2& o : map.obstacles().span()) {
+    straight_clear = std::fmin(straight_clear, boticelli::core::distance_m(straight, o));
+    aside_clear = std::fmin(aside_clear, boticelli::core::distance_m(aside, o));
+  }
+  // The straight step would end within the robot's radius of the wall; the step taken ends
+  // beyond it, still on towards the exploration point.
+  CHECK(straight_clear < params.value.robot_radius_m);
+  CHECK(aside_clear > params.value.robot_radius_m);
+  CHECK(aside.x_m > 0.1F);
+}
+
+// The consistency check covers the whole step, to its end: from places along the look's x axis
+// near its edge, the step drawn outward by an exploration point beyond the polygon is a move
+// exactly when its end lies in the look's (convex) polygon, and no safe step otherwise.
+TEST(StepPlanner, AStepDrawnOutOfTheLooksPolygonIsAMoveExactlyWhenItsEndLiesInside) {
+  (void)map.exploration().push_back({1.6F, 0.0F});
+  planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+  int moves = 0;
+  int refused = 0;
+  for (int k = 0; k <= 10; ++k) {
+    planner.clear();
+    const Pose2 here{0.555F + 0.01F * static_cast<float>(k), 0.0F, 0.0F};
+    const StepOutcome outcome = cycle(here, origin);
+    CHECK(planner.decision().kind == StepKind::kMove);
+    const bool end_inside = look_disc.contains(to_robot(origin, planner.target()));
+    CHECK_EQUAL(end_inside, outcome == StepOutcome::kMove);
+    if (outcome == StepOutcome::kMove) ++moves;
+    if (outcome == StepOutcome::kNoSafeStep) ++refused;
+  }
+  CHECK(moves > 0);
+  CHECK(refused > 0);
+}
+
+// Seen from wherever the robot stands near the look's edge, off its axes and whatever the
+// robot's heading, another step drawn outward stays inside the look's polygon all along.
+TEST(StepPlanner, AnotherStepOnTheSameLookDrawnOutwardStaysInsideItsPolygonFromAnywhere) {
+  for (int k = 0; k < 8; ++k) {
+    const float b = 0.25F * boticelli::core::kPi<float> * static_cast<float>(k) + 0.3F;
+    map.exploration().clear();
+    (void)map.exploration().push_back({1.6F * std::cos(b), 1.6F * std::sin(b)});
+    planner.start_value(map, g_grid, nullptr, {0.0F, 0.0F}, 1);
+    const Pose2 here{0.75F * std::cos(b), 0.75F * std::sin(b), 1.1F * static_cast<float>(k)};
+    CHECK_TRUE(planner.begin_next_on_look(here, origin, look_disc));
+    choose();
+    CHECK(planner.end_next_on_look() == StepOutcome::kMove);
+    const Point2 target = planner.target();
+    for (int i = 1; i <= 100; ++i) {
+      const float t = static_cast<float>(i) / 100.0F;
+      const Point2 p{here.x_m + t * (target.x_m - here.x_m),
+                     here.y_m + t * (target.y_m - here.y_m)};
+      CHECK_TEXT(look_disc.contains(p), "the step leaves the look's polygon");
+    }
+  }
+}
+
 namespace {
 
 // A free square 3 m a side round the origin in the grid, unknown beyond: frontiers all round.
@@ -355,6 +424,33 @@ TEST(FrontierStepPlanner, AStepAlongThePathIsAtMostNavStepLongEvenInAWidePolygon
   const float d = boticelli::core::distance_m({0.0F, 0.0F}, planner.target());
   CHECK(d > 0.5F);
   CHECK(d <= params.nav_step_m + 1e-5F);
+}
+
+// Wherever the robot stands in its cell, a move along the path is at least the minimum step:
+// the path runs from the robot's cell down its column (0.05 m cells), and the look's polygon
+// (0.06 m round the robot) reaches the path's next cell, nearer than the minimum step from the
+// cell's lower half, just far enough from its middle, and not at all from its upper part.
+TEST(FrontierStepPlanner, AMoveAlongThePathIsNeverShorterThanTheMinimumStep) {
+  const StarPolygon navigable = disc(0.06F);
+  int moves = 0;
+  int refused = 0;
+  for (const float dy : {-0.02F, -0.01F, 0.0F, 0.01F}) {
+    for (const float dx : {-0.012F, 0.003F, 0.017F}) {
+      planner.clear();
+      const Pose2 here{0.025F + dx, 0.025F + dy, 0.0F};
+      const StepOutcome outcome = plan(here, navigable, nullptr);
+      if (outcome == StepOutcome::kMove) {
+        ++moves;
+        CHECK(boticelli::core::distance_m({here.x_m, here.y_m}, planner.target()) >=
+              params.step.min_step_m);
+      } else {
+        CHECK(outcome == StepOutcome::kNoSafeStep);
+        ++refused;
+      }
+    }
+  }
+  CHECK(moves > 0);
+  CHECK(refused > 0);
 }
 
 TEST(FrontierStepPlanner, AGridWithNothingReachableTurnsRoundThenEnds) {
@@ -538,4 +634,31 @@ TEST(ThesisPlannerTargetByPath, TheFinalApproachToATargetThatIsAnObstacleEndsAtI
   CHECK(boticelli::core::distance_m({0.0F, 0.0F}, t) > 0.6F + 0.05F);
   DOUBLES_EQUAL(g.x_m, t.x_m, 0.051);
   DOUBLES_EQUAL(g.y_m, t.y_m, 0.051);
+}
+
+// A robot standing at a cell's centre within an occupied cell's clearance (its own cell and the
+// three ahead along the path are not passable) steps along the path to the target: the part of
+// the step nearer than half the robot's radius is the place it stands on; from there on, the
+// step's straight way crosses passable cells only.
+TEST(ThesisPlannerTargetByPath, ARobotWithinAnObstaclesClearanceStepsOnlyAcrossPassableCells) {
+  params.final_approach_m = 0.0F;  // the path's step alone
+  (void)g_grid.add({-5, 0}, 20);
+  const float cell = g_grid.cell_m();
+  const Pose2 here{-2.5F * cell, 0.5F * cell, 0.0F};
+  const Point2 target{1.4F, 0.5F * cell};
+  const StarPolygon wide = disc(1.5F);
+  CHECK(plan_from(here, &target, wide, here) == StepOutcome::kMove);
+  const Point2 at{here.x_m, here.y_m};
+  CHECK_FALSE(planner.nav().passable(at));
+  CHECK_FALSE(planner.nav().passable({0.5F * cell, at.y_m}));
+  CHECK_TRUE(planner.nav().passable({1.5F * cell, at.y_m}));
+  const Point2 t = planner.target();
+  CHECK(boticelli::core::distance_m(at, t) >= params.step.min_step_m);
+  const float own = 0.5F * params.nav.robot_radius_m;
+  for (int i = 1; i <= 100; ++i) {
+    const float s = static_cast<float>(i) / 100.0F;
+    const Point2 p{at.x_m + s * (t.x_m - at.x_m), at.y_m + s * (t.y_m - at.y_m)};
+    if (boticelli::core::distance_m(p, at) < own) continue;
+    CHECK_TEXT(planner.nav().passable(p), "the step crosses a cell within the clearance");
+  }
 }
