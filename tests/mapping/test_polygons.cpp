@@ -305,6 +305,39 @@ TEST(ExcludePoints, APointOnAVertexRayCutsBothSectorsBesideIt) {
   CHECK_TRUE(free.rho_m(89) < d && free.rho_m(90) < d && free.rho_m(91) < d);
 }
 
+TEST(ExcludePoints, APointWithinRoundingOfARayCutsBothSectorsBesideItAndOneJustBeyondOnlyItsOwn) {
+  // Within 1e-5 rad of a vertex ray (the rounding allowance of the point's bearing) a point
+  // counts as lying in both sectors beside the ray, whichever side of the ray it is on: the
+  // ray's vertex and both its neighbours are cut. At 1.5e-5 rad it lies in one sector, and only
+  // that sector's two vertices move. On ray 100 and on ray 0, across the seam.
+  constexpr std::size_t kN = 360;
+  for (const std::size_t ray : {std::size_t{100}, std::size_t{0}}) {
+    for (const double da : {-1.5e-5, -0.5e-5, 0.0, 0.5e-5, 1.5e-5}) {
+      StarPolygon free(kN);
+      free.fill(2.0F);
+      const double a = 2.0 * 3.14159265358979323846 * static_cast<double>(ray) / kN + da;
+      const Point2 q{static_cast<float>(1.2 * std::cos(a)), static_cast<float>(1.2 * std::sin(a))};
+      boticelli::mapping::exclude_points(std::span<const Point2>(&q, 1), free);
+      CHECK_FALSE(free.contains(q));
+      const float d = std::hypot(q.x_m, q.y_m);
+      // By offset from the ray: the vertices in [lo, hi] are cut, none outside it move (within
+      // rounding, one more on either side may).
+      const bool within = std::fabs(da) < 1e-5;
+      const int lo = within || da < 0.0 ? -1 : 0;
+      const int hi = within || da > 0.0 ? 1 : 0;
+      for (int off = -5; off <= 5; ++off) {
+        const float rho =
+            free.rho_m(static_cast<std::size_t>(static_cast<int>(ray + kN) + off) % kN);
+        if (off >= lo && off <= hi) {
+          CHECK_TRUE(rho < d && rho > d - 1e-5F);
+        } else if (!within || off < lo - 1 || off > hi + 1) {
+          DOUBLES_EQUAL(2.0, rho, 0.0);
+        }
+      }
+    }
+  }
+}
+
 TEST(ExcludePoints, PointsAcrossTheSeamAndAtTheCentreAreHandled) {
   StarPolygon free(360);
   free.fill(2.0F);
