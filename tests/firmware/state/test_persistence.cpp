@@ -715,6 +715,49 @@ TEST(Persistence, ANewMissionKeepsTheNewestValidCopyAndClearsBoth) {
   STRCMP_CONTAINS("sequence 1\n", read_file(dir + "/mission.state.a").c_str());
 }
 
+// The mission's own order: the previous mission kept, then the new one's first save at once
+// (no load between them to survey the emptied directory again).
+TEST(Persistence, TheFirstSaveRightAfterANewMissionKeptThePreviousHasSequenceOne) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  for (std::uint64_t c = 1; c <= 3; ++c) {
+    make_state(c, g_a);
+    CHECK(g_store.save(g_a, error, sizeof error));
+  }
+  char kept[600] = "";
+  CHECK(g_store.keep_previous(kept, sizeof kept, error, sizeof error) == LoadResult::kLoaded);
+  make_state(1, g_a);
+  CHECK(g_store.save(g_a, error, sizeof error));
+  std::uint64_t sequence = 0;
+  const char* why = "";
+  const std::string a = read_file(dir + "/mission.state.a");
+  CHECK_TRUE_TEXT(peek_state(a, sequence, &why), why);
+  CHECK_EQUAL(1U, sequence);
+}
+
+// Two valid files with one sequence number (an operator's copy, or a restore from a backup):
+// the first of them wins, and the two copies win against the single file.
+TEST(Persistence, OfTwoFilesWithTheSameSequenceTheFirstCopyLoadsAndACopyBeatsTheSingleFile) {
+  const auto file_of = [](std::uint64_t cycle, std::uint64_t sequence) {
+    make_state(cycle, g_a);
+    const std::size_t n = encode_state(g_a, g_file, sizeof g_file, sequence);
+    CHECK(n > 0);
+    return std::string(g_file, n);
+  };
+  write_file(dir + "/mission.state.a", file_of(11, 7));
+  write_file(dir + "/mission.state.b", file_of(12, 7));
+  write_file(dir + "/mission.state", file_of(13, 7));
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  CHECK_TRUE_TEXT(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded, error);
+  CHECK_EQUAL(11U, g_b.cycle);
+  unlink((dir + "/mission.state.a").c_str());
+  CHECK_TRUE_TEXT(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded, error);
+  CHECK_EQUAL(12U, g_b.cycle);
+  unlink((dir + "/mission.state.b").c_str());
+  write_file(dir + "/mission.state.b", file_of(14, 6));
+  CHECK_TRUE_TEXT(g_store.load(g_b, error, sizeof error) == LoadResult::kLoaded, error);
+  CHECK_EQUAL(13U, g_b.cycle);  // the single file's 7 is newer than the copy's 6
+}
+
 TEST(Persistence, WithOnlyADamagedCopyANewMissionStillKeepsIt) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   make_state(40, g_a);
