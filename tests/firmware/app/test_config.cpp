@@ -852,6 +852,24 @@ TEST(AtomicWrite, ATemporaryPathThatJustFitsIsWrittenAndOneByteLongerIsRefused) 
   STRCMP_CONTAINS("path too long", error);
 }
 
+// A service started with its standard input closed gets descriptor 0 for the first file it
+// opens: a temporary file on descriptor 0 is written like any other.
+TEST(AtomicWrite, ATemporaryFileOnDescriptorZeroIsWrittenAndRenamed) {
+  const int saved_stdin = ::dup(0);
+  CHECK(saved_stdin >= 0);
+  ::close(0);
+  char error[320] = "";
+  const bool written =
+      write_file_atomically(dir.c_str(), "zero.txt", "on descriptor 0\n", error, sizeof error);
+  const int probe = ::open("/dev/null", O_RDONLY | O_CLOEXEC);  // 0 again if it was closed
+  ::dup2(saved_stdin, 0);
+  ::close(saved_stdin);
+  if (probe > 0) ::close(probe);
+  CHECK_EQUAL(0, probe);  // the save closed the descriptor it used
+  CHECK_TRUE_TEXT(written, error);
+  STRCMP_EQUAL("on descriptor 0\n", read_file(dir + "/zero.txt").c_str());
+}
+
 TEST(AtomicWrite, AMissingDirectoryIsAnErrorWithItsPath) {
   char error[320] = "";
   CHECK_FALSE(write_file_atomically("/nonexistent-dir", "a.txt", "x", error, sizeof error));
