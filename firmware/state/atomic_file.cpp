@@ -122,7 +122,9 @@ bool write_file_atomically(const char* dir, const char* name, std::string_view d
   if (crashed(SaveStep::kRenamed)) return false;
   // Make the rename itself durable.
   const int dfd = ::open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0 || ::fsync(dfd) != 0) {
+  const int dir_fault = injected(StorageCall::kSyncDirectory);
+  if (dir_fault != 0) errno = dir_fault;
+  if (dfd < 0 || dir_fault != 0 || ::fsync(dfd) != 0) {
     set_error(error, error_size, "cannot sync directory", dir);
     if (dfd >= 0) ::close(dfd);
     return false;

@@ -787,18 +787,37 @@ TEST(AtomicWrite, AWriteCutShortOrFailedClosesWhatItOpenedAndAFailureLeavesNoTem
         write_file_atomically(dir.c_str(), "a.txt", text, error, sizeof error, crash_at, &c));
     CHECK_EQUAL(before, open_descriptors());
   }
-  for (StorageCall call : {StorageCall::kWrite, StorageCall::kSync, StorageCall::kCreate}) {
+  for (StorageCall call : {StorageCall::kWrite, StorageCall::kSync, StorageCall::kCreate,
+                           StorageCall::kSyncDirectory}) {
     set_storage_fault_hook(fail_call, &call);
     CHECK_FALSE(write_file_atomically(dir.c_str(), "a.txt", text, error, sizeof error));
     set_storage_fault_hook(nullptr, nullptr);
-    const char* step = call == StorageCall::kCreate  ? "cannot create"
-                       : call == StorageCall::kWrite ? "cannot write"
-                                                     : "cannot sync";
-    STRCMP_CONTAINS(step, error);
-    STRCMP_CONTAINS(std::strerror(EIO), error);
+    const std::string step = call == StorageCall::kCreate  ? "cannot create " + dir + "/a.txt.tmp"
+                             : call == StorageCall::kWrite ? "cannot write " + dir + "/a.txt.tmp"
+                             : call == StorageCall::kSync  ? "cannot sync " + dir + "/a.txt.tmp"
+                                                           : "cannot sync directory " + dir;
+    STRCMP_EQUAL((step + ": " + std::strerror(EIO)).c_str(), error);
     CHECK_EQUAL(before, open_descriptors());
     CHECK(access((dir + "/a.txt.tmp").c_str(), F_OK) != 0);
   }
+}
+
+// A rename that fails (a directory where the file goes) fails the save with the path, and
+// removes the temporary file; what stood at the name is untouched.
+TEST(AtomicWrite, ARenameThatFailsFailsTheSaveAndLeavesNoTemporaryFile) {
+  const std::string target = dir + "/a.txt";
+  CHECK_EQUAL(0, ::mkdir(target.c_str(), 0750));
+  write_file(target + "/inside", "kept\n");
+  char error[320] = "";
+  const int before = open_descriptors();
+  const bool written = write_file_atomically(dir.c_str(), "a.txt", "new\n", error, sizeof error);
+  CHECK_FALSE(written);
+  STRCMP_CONTAINS(("cannot rename onto " + target + ": ").c_str(), error);
+  CHECK_EQUAL(before, open_descriptors());
+  CHECK(access((target + ".tmp").c_str(), F_OK) != 0);
+  STRCMP_EQUAL("kept\n", read_file(target + "/inside").c_str());
+  ::unlink((target + "/inside").c_str());
+  ::rmdir(target.c_str());
 }
 
 TEST(AtomicWrite, TheFileIsReadableAndWritableByItsOwnerAndReadableByItsGroup) {
@@ -853,21 +872,28 @@ TEST(AtomicWrite, ATemporaryPathThatJustFitsIsWrittenAndOneByteLongerIsRefused) 
 }
 
 // A service started with its standard input closed gets descriptor 0 for the first file it
-// opens: a temporary file on descriptor 0 is written like any other.
-TEST(AtomicWrite, ATemporaryFileOnDescriptorZeroIsWrittenAndRenamed) {
-  const int saved_stdin = ::dup(0);
-  CHECK(saved_stdin >= 0);
-  ::close(0);
-  char error[320] = "";
-  const bool written =
-      write_file_atomically(dir.c_str(), "zero.txt", "on descriptor 0\n", error, sizeof error);
-  const int probe = ::open("/dev/null", O_RDONLY | O_CLOEXEC);  // 0 again if it was closed
-  ::dup2(saved_stdin, 0);
-  ::close(saved_stdin);
-  if (probe > 0) ::close(probe);
-  CHECK_EQUAL(0, probe);  // the save closed the descriptor it used
-  CHECK_TRUE_TEXT(written, error);
-  STRCMP_EQUAL("on descriptor 0\n", read_file(dir + "/zero.txt").c_str());
+// opens: a temporary file on descriptor 0 is written like any other, and a directory opened on
+// descriptor 0 to sync the rename is closed also when its sync fails.
+TEST(AtomicWrite, WorkOnDescriptorZeroIsWrittenAndClosedLikeAnyOther) {
+  for (const bool dir_sync_fails : {false, true}) {
+    StorageCall call = StorageCall::kSyncDirectory;
+    if (dir_sync_fails) set_storage_fault_hook(fail_call, &call);
+    const int saved_stdin = ::dup(0);
+    CHECK(saved_stdin >= 0);
+    ::close(0);
+    char error[320] = "";
+    const bool written =
+        write_file_atomically(dir.c_str(), "zero.txt", "on descriptor 0\n", error, sizeof error);
+    const int probe = ::open("/dev/null", O_RDONLY | O_CLOEXEC);  // 0 again if it was closed
+    ::dup2(saved_stdin, 0);
+    ::close(saved_stdin);
+    if (probe > 0) ::close(probe);
+    set_storage_fault_hook(nullptr, nullptr);
+    CHECK_EQUAL(0, probe);  // the save closed every descriptor it used
+    CHECK_EQUAL(!dir_sync_fails, written);
+    if (dir_sync_fails) STRCMP_CONTAINS("cannot sync directory", error);
+    STRCMP_EQUAL("on descriptor 0\n", read_file(dir + "/zero.txt").c_str());
+  }
 }
 
 TEST(AtomicWrite, AMissingDirectoryIsAnErrorWithItsPath) {

@@ -20,8 +20,10 @@ using SaveCrashHook = bool (*)(SaveStep step, void* context);
 
 // The system calls a board's fault injection can make fail (the sim board's storage faults:
 // a full or unwritable state directory, docs/reliability.md; kSync, the temporary file's
-// fsync before the rename, lets tests see that the data is synced before it replaces the file).
-enum class StorageCall : std::uint8_t { kCreate, kWrite, kSync };
+// fsync before the rename, lets tests see that the data is synced before it replaces the file;
+// kSyncDirectory, the directory's fsync after it, that a failure there is reported and closes
+// what it opened).
+enum class StorageCall : std::uint8_t { kCreate, kWrite, kSync, kSyncDirectory };
 // Returns 0 to let the call run, or the errno it fails with instead (EACCES, ENOSPC, EIO).
 using StorageFaultHook = int (*)(StorageCall call, void* context);
 // Installs the process-wide hook (nullptr: none, the default). Set by a board at init,
