@@ -1454,7 +1454,9 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
   static boticelli::stereo::RangeCheck check{g_rig};
   // The frames drawn through the true camera (its focal length scaled, k1 moved) and with the
   // second frame's tilt off by `phi_error`; the stereo and the floor cue use g_rig's.
-  const auto look_ratio = [&](float focal_scale, float k1_error, float phi_error) {
+  // With `bias`, also the look's inverse-range bias (RangeCheck::inverse_bias).
+  const auto look_ratio = [&](float focal_scale, float k1_error, float phi_error,
+                              float* bias = nullptr) {
     boticelli::stereo::CameraIntrinsics truth = g_rig.camera();
     truth.focal_px *= focal_scale;
     truth.k1 += k1_error;
@@ -1494,21 +1496,21 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
         static_cast<double>(focal_scale), static_cast<double>(k1_error),
         static_cast<double>(phi_error), static_cast<double>(ratio), n);
     CHECK(n >= 5U);
+    if (bias != nullptr) CHECK(check.inverse_bias(*bias, n));
     return ratio;
   };
+  float bias_long = 0.0F;
+  float bias_short = 0.0F;
+  float bias_step = 0.0F;
+  stereo_processor.set_inverse_range_bias(0.0F);
   DOUBLES_EQUAL(1.0, look_ratio(1.0F, 0.0F, 0.0F), 0.02);
-  CHECK(look_ratio(1.01F, 0.0F, 0.0F) < 0.97F);                      // focal length 1 % long
-  CHECK(look_ratio(0.99F, 0.0F, 0.0F) > 1.03F);                      // 1 % short
-  CHECK(std::fabs(look_ratio(1.0F, -0.15F, 0.0F) - 1.0F) > 0.03F);   // a lens nobody calibrated
-  CHECK(std::fabs(look_ratio(1.0F, 0.0F, 0.0035F) - 1.0F) > 0.03F);  // the step 0.2° off
+  CHECK(look_ratio(1.01F, 0.0F, 0.0F, &bias_long) < 0.97F);         // focal length 1 % long
+  CHECK(look_ratio(0.99F, 0.0F, 0.0F, &bias_short) > 1.03F);        // 1 % short
+  CHECK(std::fabs(look_ratio(1.0F, -0.15F, 0.0F) - 1.0F) > 0.03F);  // a lens nobody calibrated
+  CHECK(std::fabs(look_ratio(1.0F, 0.0F, 0.0035F, &bias_step) - 1.0F) > 0.03F);  // step 0.2° off
   // Self-calibration: the bias the look measured removed, the look is drawn and read again.
   // The bias each error leaves is that error's own (bias_as_focal_scale, …_tilt_step_error_rad).
-  const auto calibrated_ratio = [&](float focal_scale, float phi_error) {
-    stereo_processor.set_inverse_range_bias(0.0F);
-    (void)look_ratio(focal_scale, 0.0F, phi_error);
-    float bias = 0.0F;
-    std::size_t n = 0;
-    CHECK(check.inverse_bias(bias, n));
+  const auto calibrated_ratio = [&](float focal_scale, float phi_error, float bias) {
     if (phi_error == 0.0F) {
       DOUBLES_EQUAL(focal_scale, boticelli::stereo::bias_as_focal_scale(bias, g_rig.params()),
                     0.004);
@@ -1522,9 +1524,9 @@ TEST(FloorCue, TheRangeCheckFindsStereoAndFloorAgreeingAndAFocalLengthOffDisagre
     stereo_processor.set_inverse_range_bias(0.0F);
     return ratio;
   };
-  DOUBLES_EQUAL(1.0, calibrated_ratio(1.01F, 0.0F), 0.01);
-  DOUBLES_EQUAL(1.0, calibrated_ratio(0.99F, 0.0F), 0.01);
-  DOUBLES_EQUAL(1.0, calibrated_ratio(1.0F, 0.0035F), 0.01);
+  DOUBLES_EQUAL(1.0, calibrated_ratio(1.01F, 0.0F, bias_long), 0.01);
+  DOUBLES_EQUAL(1.0, calibrated_ratio(0.99F, 0.0F, bias_short), 0.01);
+  DOUBLES_EQUAL(1.0, calibrated_ratio(1.0F, 0.0035F, bias_step), 0.01);
 }
 
 // One walk of a learned flat floor up to a painted wall, the column in the middle of the frame
