@@ -1099,6 +1099,61 @@ TEST(Persistence, TheWriterThreadEndsWithTheNewestSubmittedState) {
   CHECK(g_a == g_b);
 }
 
+// A state directory with a long path: a failed save's reason, path and all, is kept whole
+// (up to its 255 bytes), saved at once or by the writer thread.
+TEST(Persistence, AFailedSavesReasonIsKeptWholeForALongStateDirectory) {
+  const std::string deep = dir + "/" + std::string(150, 'd');
+  CHECK_EQUAL(0, mkdir(deep.c_str(), 0750));
+  CHECK_TRUE_TEXT(g_store.open(deep.c_str(), error, sizeof error), error);
+  const std::string expected =
+      "cannot create " + deep + "/mission.state.a.tmp: " + std::strerror(EIO);
+  CHECK(expected.size() > 180U && expected.size() < 256U);
+  static FailingCreates failing;
+  for (const bool threaded : {false, true}) {
+    failing.failures = 1;
+    set_storage_fault_hook(fail_creates, &failing);
+    char reason[256] = "";
+    {
+      StateSaver saver(g_store);
+      if (threaded) saver.start();
+      make_state(3, g_a);
+      CHECK(saver.submit(g_a));
+      for (int i = 0; i < 500 && saver.failures() == 0; ++i) {
+        timespec pause{0, 10000000L};
+        nanosleep(&pause, nullptr);
+      }
+      CHECK_EQUAL(1U, saver.failures());
+      saver.last_error(reason, sizeof reason);
+    }
+    set_storage_fault_hook(nullptr, nullptr);
+    STRCMP_EQUAL(expected.c_str(), reason);
+  }
+  remove_dir(deep);
+}
+
+// A disk that fails every save must not hold up the end: a saver stopped with its save failing
+// stops at once, without another try (the state is as it was saved last).
+TEST(Persistence, ASaverStoppedWhileItsSavesFailStopsWithoutTryingAgain) {
+  CHECK(g_store.open(dir.c_str(), error, sizeof error));
+  static FailingCreates failing;
+  failing.failures = 1000;
+  set_storage_fault_hook(fail_creates, &failing);
+  {
+    StateSaver saver(g_store);
+    saver.set_retry_interval_ms(60000);  // no retry falls due while the test runs
+    saver.start();
+    make_state(5, g_a);
+    CHECK(saver.submit(g_a));
+    for (int i = 0; i < 500 && saver.failures() == 0; ++i) {
+      timespec pause{0, 10000000L};
+      nanosleep(&pause, nullptr);
+    }
+    CHECK_EQUAL(1U, saver.failures());
+  }
+  set_storage_fault_hook(nullptr, nullptr);
+  CHECK_EQUAL(999, failing.failures.load());  // one creation tried, none after the stop
+}
+
 TEST(Persistence, TheWriterThreadRetriesAFailedSaveWithoutANewSubmission) {
   CHECK(g_store.open(dir.c_str(), error, sizeof error));
   static FailingCreates failing;
