@@ -190,6 +190,32 @@ TEST(TargetTracker, ARestoredGoalIsConfirmedAtOnceAndIsTheTarget) {
   CHECK_FALSE(tracker.is_target(kTarget + Eigen::Vector3f(0.3F, 0.0F, 0.0F)));
 }
 
+// A resume restores the goal into the tracker the mission already used: what it counted
+// before (misses, revocations, sightings) is gone, as in a fresh one.
+TEST(TargetTracker, ARestoreOnAUsedTrackerStartsAfreshWithTheGoalAlone) {
+  TargetTrackerParams p;
+  p.revoke_after_misses = 3;
+  tracker.configure(p);
+  tracker.add(kTarget + Eigen::Vector3f(1.0F, 0.0F, 0.0F), 0.9F, 1);
+  tracker.add(kTarget + Eigen::Vector3f(1.0F, 0.0F, 0.0F), 0.9F, 2);
+  tracker.restore(kTarget);
+  for (int i = 0; i < 3; ++i) (void)tracker.missed();  // revoked once
+  UNSIGNED_LONGS_EQUAL(1, tracker.revocations());
+  tracker.restore(kTarget);
+  CHECK_FALSE(tracker.missed());
+  CHECK_FALSE(tracker.missed());
+  UNSIGNED_LONGS_EQUAL(2, tracker.misses());
+  tracker.restore(kTarget);
+  UNSIGNED_LONGS_EQUAL(0, tracker.misses());
+  UNSIGNED_LONGS_EQUAL(0, tracker.revocations());
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  check_near(kTarget, tracker.estimate_m(), 1e-6F);
+  CHECK_FALSE(tracker.missed());
+  CHECK_FALSE(tracker.missed());
+  CHECK(tracker.confirmed());
+  CHECK(tracker.missed());  // the third miss since the restore revokes it
+}
+
 TEST(TargetTracker, ARestoredGoalIsOneSightingOfWeightOneThatLaterSightingsRefine) {
   tracker.restore(kTarget);
   UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
