@@ -201,6 +201,10 @@ TEST(TargetTracker, ARestoreOnAUsedTrackerStartsAfreshWithTheGoalAlone) {
   tracker.restore(kTarget);
   for (int i = 0; i < 3; ++i) (void)tracker.missed();  // revoked once
   UNSIGNED_LONGS_EQUAL(1, tracker.revocations());
+  // The revocation forgot the one sighting it had: nothing supports a target any more.
+  CHECK_FALSE(tracker.confirmed());
+  UNSIGNED_LONGS_EQUAL(0, tracker.sightings());
+  UNSIGNED_LONGS_EQUAL(0, tracker.supporting_views());
   tracker.restore(kTarget);
   CHECK_FALSE(tracker.missed());
   CHECK_FALSE(tracker.missed());
