@@ -190,6 +190,21 @@ TEST(TargetTracker, ARestoredGoalIsConfirmedAtOnceAndIsTheTarget) {
   CHECK_FALSE(tracker.is_target(kTarget + Eigen::Vector3f(0.3F, 0.0F, 0.0F)));
 }
 
+// "Within agree_radius_m of their mean" includes the radius itself, for the mean and for the
+// count of views alike: sightings exactly the radius from the group's centre are views of it.
+TEST(TargetTracker, SightingsExactlyTheAgreeRadiusFromTheGroupsCentreAreViewsOfIt) {
+  TargetTrackerParams p;
+  p.agree_radius_m = 0.5F;  // exact in binary, as are the points and their mean
+  p.min_views = 3;
+  tracker.configure(p);
+  tracker.add(Eigen::Vector3f(-0.5F, 0.0F, 0.0F), 0.9F, 1, 1.0F);
+  tracker.add(Eigen::Vector3f(0.0F, 0.0F, 0.0F), 0.9F, 2, 1.0F);
+  tracker.add(Eigen::Vector3f(0.5F, 0.0F, 0.0F), 0.9F, 3, 1.0F);
+  UNSIGNED_LONGS_EQUAL(3, tracker.supporting_views());
+  CHECK(tracker.confirmed());
+  check_near(Eigen::Vector3f::Zero(), tracker.estimate_m(), 1e-6F);
+}
+
 // A resume restores the goal into the tracker the mission already used: what it counted
 // before (misses, revocations, sightings) is gone, as in a fresh one.
 TEST(TargetTracker, ARestoreOnAUsedTrackerStartsAfreshWithTheGoalAlone) {
