@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstddef>
 #include <span>
 #include <type_traits>
@@ -60,10 +61,24 @@ class FixedVectorBase {
     return push_back(value);
   }
 
-  T& operator[](std::size_t i) { return data_[i]; }
-  const T& operator[](std::size_t i) const { return data_[i]; }
-  T& back() { return data_[size_ - 1]; }
-  const T& back() const { return data_[size_ - 1]; }
+  // Indices are checked where assertions are on (the asan preset, a Debug build): an element
+  // past size() is no element of the vector, even though its storage exists.
+  T& operator[](std::size_t i) {
+    assert(i < size_);
+    return data_[i];
+  }
+  const T& operator[](std::size_t i) const {
+    assert(i < size_);
+    return data_[i];
+  }
+  T& back() {
+    assert(size_ > 0);
+    return data_[size_ - 1];
+  }
+  const T& back() const {
+    assert(size_ > 0);
+    return data_[size_ - 1];
+  }
   T* begin() { return data_; }
   T* end() { return data_ + size_; }
   const T* begin() const { return data_; }
