@@ -651,6 +651,15 @@ TEST(FloorCue, CoverageOfTheLookTiltsAndTheirStereoPartners) {
   float far0 = 0.0F;
   CHECK(cue.floor_coverage(0.0F, near0, far0));
   CHECK(std::isinf(far0));  // level: the top rows see the horizon
+  // The outputs are the tilt's alone, whatever they held before the call.
+  float near_m = 0.0F;
+  float far_m = 0.0F;
+  CHECK(cue.floor_coverage(-0.5F, near_m, far_m));
+  float near_junk = -1.0F;
+  float far_junk = 1000.0F;
+  CHECK(cue.floor_coverage(-0.5F, near_junk, far_junk));
+  DOUBLES_EQUAL(near_m, near_junk, 0.0);
+  DOUBLES_EQUAL(far_m, far_junk, 0.0);
 }
 
 // A cluttered place can show unlike regions in turn before two agree: the floor at one pan,
