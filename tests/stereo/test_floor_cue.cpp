@@ -1664,3 +1664,200 @@ TEST(FloorCue, TheRangeCheckCountsLowPointsInTheWalksPlaneAndTakesTheirMedian) {
   CHECK_FALSE(check.median(ratio, n));
   CHECK_EQUAL(0U, n);
 }
+
+// The floor test's public query says no without a model (nothing is floor before it is known)
+// and for a pixel outside the frame; with a model, a pixel of the floor's colour is floor.
+TEST(FloorCue, WithoutAModelOrOutsideTheFrameNoPixelLooksLikeFloor) {
+  const FloorCueParams flat = flat_trusting();
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  float contrast = 0.0F;
+  CHECK_FALSE(fresh.looks_like_floor(g_frame, g_frame.width / 2, g_frame.height / 2, contrast));
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.looks_like_floor(g_frame, g_frame.width / 2, g_frame.height / 2, contrast));
+  CHECK_FALSE(fresh.looks_like_floor(g_frame, g_frame.width, g_frame.height / 2, contrast));
+  CHECK_FALSE(fresh.looks_like_floor(g_frame, g_frame.width / 2, g_frame.height, contrast));
+}
+
+// A plain floor's model from two agreeing regions is their mean: the median and the tolerance
+// of every channel half way between the two regions' own, here of unlike spreads (luma 120 ± 2
+// and 126 ± 4, Cb 0 and 0 ± 1: robust spreads of 2 and 4, and of 0 and 1, levels).
+TEST(FloorCue, TwoPlainRegionsConfirmAModelWithTheMeanOfTheirMediansAndTolerances) {
+  const FloorCueParams flat = flat_trusting();
+  const auto spread = [](LowResFrame& frame, float y, float dy, float dcb) {
+    paint(frame, [=](std::uint32_t u, std::uint32_t v) {
+      const auto k = static_cast<float>((u + v) % 3) - 1.0F;  // −1, 0, +1 in thirds
+      return std::array<float, 3>{y + k * dy, k * dcb, 0.0F};
+    });
+  };
+  spread(g_frame, 120.0F, 2.0F, 0.0F);
+  spread(g_frame2, 126.0F, 4.0F, 1.0F);
+  static FloorCue one{g_rig, flat};
+  static FloorCue other{g_rig, flat};
+  one.reset();
+  other.reset();
+  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
+  FloorCueParams confirming = flat;
+  confirming.confirm_separation_rad = 1.0F;
+  static FloorCue both{g_rig, confirming};
+  both.reset();
+  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+  CHECK_FALSE(both.model().textured);
+  CHECK(other.model().tolerance[0] > one.model().tolerance[0] + 5.0F);  // the spreads differ
+  CHECK(other.model().tolerance[1] > one.model().tolerance[1] + 0.5F);
+  for (std::size_t c = 0; c < 3; ++c) {
+    DOUBLES_EQUAL(0.5F * (one.model().median[c] + other.model().median[c]), both.model().median[c],
+                  1e-4);
+    DOUBLES_EQUAL(0.5F * (one.model().tolerance[c] + other.model().tolerance[c]),
+                  both.model().tolerance[c], 1e-4);
+  }
+}
+
+// A textured model from two agreeing regions has the mean of their longest runs: a region of
+// fine stripes of three tones and one of the same stripes with a band of one of them.
+TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheMeanOfTheirLongestRuns) {
+  FloorCueParams p = flat_trusting();
+  p.texture_run_min_m = 0.0F;  // no clamp: the regions' own
+  p.texture_run_max_m = 10.0F;
+  const std::uint32_t band = g_rig.low_res_camera().width_px * 3 / 4;
+  const auto stripes = [](std::uint32_t u) {
+    return 60.0F + 60.0F * static_cast<float>((u / 2) % 3);
+  };
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t) {
+    return std::array<float, 3>{stripes(u), 0.0F, 0.0F};
+  });
+  paint(g_frame2, [&](std::uint32_t u, std::uint32_t) {
+    return std::array<float, 3>{u >= band ? 180.0F : stripes(u), 0.0F, 0.0F};
+  });
+  static FloorCue one{g_rig, p};
+  static FloorCue other{g_rig, p};
+  one.reset();
+  other.reset();
+  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
+  CHECK(one.model().textured);
+  CHECK(other.model().textured);
+  CHECK(other.model().max_run_m > one.model().max_run_m + 0.1F);  // the band's runs
+  FloorCueParams confirming = p;
+  confirming.confirm_separation_rad = 1.0F;
+  static FloorCue both{g_rig, confirming};
+  both.reset();
+  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+  CHECK(both.model().textured);
+  DOUBLES_EQUAL(0.5F * (one.model().max_run_m + other.model().max_run_m), both.model().max_run_m,
+                1e-5);
+  for (std::size_t c = 0; c < 3; ++c) {
+    DOUBLES_EQUAL(0.5F * (one.model().tolerance[c] + other.model().tolerance[c]),
+                  both.model().tolerance[c], 1e-5);
+  }
+}
+
+// A pixel exactly one tolerance from the region's median is within it: a region of luma 120
+// on more than half of it (no spread: the luma minimum applies) and 130 elsewhere is one plain
+// surface, learned without textures, and its 130 is floor.
+TEST(FloorCue, PixelsExactlyOneToleranceFromARegionsMedianAreItsOwnFloor) {
+  FloorCueParams p = flat_trusting();
+  p.textured = false;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t) {
+    return std::array<float, 3>{u % 5 < 3 ? 120.0F : 120.0F + p.min_tolerance_luma, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  DOUBLES_EQUAL(120.0, fresh.model().median[0], 1e-6);
+  DOUBLES_EQUAL(p.min_tolerance_luma, fresh.model().tolerance[0], 1e-6);
+  float contrast = 0.0F;
+  CHECK(fresh.looks_like_floor(g_frame, 4, g_frame.height - 1, contrast));
+  DOUBLES_EQUAL(1.0, contrast, 1e-6);
+}
+
+// A waiting region confirms the floor when the needed share of a later region agrees with it,
+// that share included: with consistency_min = 1, two plain regions alike in every pixel.
+TEST(FloorCue, AWaitingRegionAgreeingInExactlyTheNeededShareConfirmsTheFloor) {
+  FloorCueParams p = flat_trusting();
+  p.confirm_separation_rad = 1.0F;
+  p.consistency_min = 1.0F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kPending == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 1.8F, kLookTilt));
+  CHECK(fresh.model().valid);
+}
+
+namespace {
+
+// The longest stretch of floor [m] that columns first..last of a row of the reference region
+// (all of them within it) see at `tilt`.
+float longest_band_m(const FloorCueParams& p, std::uint32_t first, std::uint32_t last) {
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  float longest = 0.0F;
+  for (std::uint32_t v = 0; v < g_rig.low_res_camera().height_px; ++v) {
+    Eigen::Vector3f a;
+    Eigen::Vector3f b;
+    if (!floor_seen_at(pose, static_cast<float>(first), static_cast<float>(v), a) ||
+        !floor_seen_at(pose, static_cast<float>(last), static_cast<float>(v), b)) {
+      continue;
+    }
+    const float rho_a = std::hypot(a.x(), a.y());
+    const float rho_b = std::hypot(b.x(), b.y());
+    if (std::min(rho_a, rho_b) < p.reference_min_m || std::max(rho_a, rho_b) > p.reference_max_m) {
+      continue;
+    }
+    longest = std::max(longest, (b - a).norm());
+  }
+  return longest;
+}
+
+}  // namespace
+
+// A row's first run counts from the row's first pixel like any other: a band of one tone along
+// the image's left edge, where the region's rows begin, gives the texture's longest run.
+TEST(FloorCue, ARunAtTheStartOfTheRegionsRowsIsMeasuredLikeAnyOther) {
+  FloorCueParams p = flat_trusting();
+  p.texture_run_min_m = 0.0F;  // no clamp: the percentile itself
+  p.texture_run_max_m = 10.0F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const std::uint32_t band = g_rig.low_res_camera().width_px / 4;  // the band: columns 0..band − 1
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t) {
+    const float y = u < band ? 180.0F : ((u / 2) % 2 == 0 ? 60.0F : 120.0F);
+    return std::array<float, 3>{y, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  const float longest = longest_band_m(p, 0, band - 1);
+  CHECK(longest > 0.08F);  // the stripes' runs are a pixel's step, under 0.02 m
+  const float max_run = fresh.model().max_run_m;
+  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
+  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+}
+
+// In the region, as along a walk, shades exactly the luma change apart are one colour: a band
+// alternating pixel by pixel between 180 and 190 (stripes of 60 and 80 make the change 10) is
+// one run, and gives the texture's longest run.
+TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneRunInTheRegion) {
+  FloorCueParams p = flat_trusting();
+  p.texture_run_min_m = 0.0F;
+  p.texture_run_max_m = 10.0F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const std::uint32_t width = g_rig.low_res_camera().width_px;
+  const std::uint32_t band = width * 3 / 4;  // the band: columns band..width − 1
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t) {
+    const float y = u >= band ? (u % 2 == 0 ? 180.0F : 190.0F) : ((u / 2) % 2 == 0 ? 60.0F : 80.0F);
+    return std::array<float, 3>{y, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(fresh.model().textured);
+  DOUBLES_EQUAL(10.0, fresh.model().tolerance[0], 1e-6);  // half the stripes' 20-level step
+  const float longest = longest_band_m(p, band, width - 1);
+  CHECK(longest > 0.08F);
+  const float max_run = fresh.model().max_run_m;
+  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
+  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+}
