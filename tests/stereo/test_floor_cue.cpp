@@ -1155,6 +1155,44 @@ TEST(FloorCue, UpdatingATexturedFloorWithARegionLikeItLeavesItAsItWas) {
   }
 }
 
+namespace {
+
+// The longest stretch of floor [m] that columns first..last of a row of the reference region
+// (all of them within it) see at `tilt`.
+float longest_band_m(const FloorCueParams& p, std::uint32_t first, std::uint32_t last) {
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  float longest = 0.0F;
+  for (std::uint32_t v = 0; v < g_rig.low_res_camera().height_px; ++v) {
+    Eigen::Vector3f a;
+    Eigen::Vector3f b;
+    if (!floor_seen_at(pose, static_cast<float>(first), static_cast<float>(v), a) ||
+        !floor_seen_at(pose, static_cast<float>(last), static_cast<float>(v), b)) {
+      continue;
+    }
+    const float rho_a = std::hypot(a.x(), a.y());
+    const float rho_b = std::hypot(b.x(), b.y());
+    if (std::min(rho_a, rho_b) < p.reference_min_m || std::max(rho_a, rho_b) > p.reference_max_m) {
+      continue;
+    }
+    longest = std::max(longest, (b - a).norm());
+  }
+  return longest;
+}
+
+// A textured model's longest run against a band of one tone over columns first..last: the
+// band's stretch on the floor is longer than the stripes' runs (a pixel's step, under 0.02 m),
+// and the model's run lies between half of it and all of it, each times texture_run_factor.
+void check_max_run_against_band(const FloorCue& cue, const FloorCueParams& p, std::uint32_t first,
+                                std::uint32_t last) {
+  const float longest = longest_band_m(p, first, last);
+  CHECK(longest > 0.08F);
+  const float max_run = cue.model().max_run_m;
+  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
+  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+}
+
+}  // namespace
+
 // The longest run of one colour a textured floor shows is texture_run_factor times the 95th
 // percentile of the region's runs weighted by their length: a region of 2 px stripes with a
 // band of one tone over a quarter of its width has its percentile within the band's runs.
@@ -1173,27 +1211,7 @@ TEST(FloorCue, ATexturesLongestRunIsThe95thPercentileOfItsRunsByLength) {
   });
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   CHECK(fresh.model().textured);
-  // The band's length on the floor along each row of the region where all of it lies there.
-  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
-  float longest = 0.0F;
-  for (std::uint32_t v = 0; v < camera.height_px; ++v) {
-    Eigen::Vector3f a;
-    Eigen::Vector3f b;
-    if (!floor_seen_at(pose, static_cast<float>(band), static_cast<float>(v), a) ||
-        !floor_seen_at(pose, static_cast<float>(camera.width_px - 1), static_cast<float>(v), b)) {
-      continue;
-    }
-    const float rho_a = std::hypot(a.x(), a.y());
-    const float rho_b = std::hypot(b.x(), b.y());
-    if (std::min(rho_a, rho_b) < p.reference_min_m || std::max(rho_a, rho_b) > p.reference_max_m) {
-      continue;
-    }
-    longest = std::max(longest, (b - a).norm());
-  }
-  CHECK(longest > 0.08F);  // the stripes' runs are a pixel's step, under 0.02 m
-  const float max_run = fresh.model().max_run_m;
-  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
-  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+  check_max_run_against_band(fresh, p, band, camera.width_px - 1);
 }
 
 // A walk samples the two pixels either side of it, also at the image's right edge: a thing
@@ -1789,32 +1807,6 @@ TEST(FloorCue, AWaitingRegionAgreeingInExactlyTheNeededShareConfirmsTheFloor) {
   CHECK(fresh.model().valid);
 }
 
-namespace {
-
-// The longest stretch of floor [m] that columns first..last of a row of the reference region
-// (all of them within it) see at `tilt`.
-float longest_band_m(const FloorCueParams& p, std::uint32_t first, std::uint32_t last) {
-  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
-  float longest = 0.0F;
-  for (std::uint32_t v = 0; v < g_rig.low_res_camera().height_px; ++v) {
-    Eigen::Vector3f a;
-    Eigen::Vector3f b;
-    if (!floor_seen_at(pose, static_cast<float>(first), static_cast<float>(v), a) ||
-        !floor_seen_at(pose, static_cast<float>(last), static_cast<float>(v), b)) {
-      continue;
-    }
-    const float rho_a = std::hypot(a.x(), a.y());
-    const float rho_b = std::hypot(b.x(), b.y());
-    if (std::min(rho_a, rho_b) < p.reference_min_m || std::max(rho_a, rho_b) > p.reference_max_m) {
-      continue;
-    }
-    longest = std::max(longest, (b - a).norm());
-  }
-  return longest;
-}
-
-}  // namespace
-
 // A row's first run counts from the row's first pixel like any other: a band of one tone along
 // the image's left edge, where the region's rows begin, gives the texture's longest run.
 TEST(FloorCue, ARunAtTheStartOfTheRegionsRowsIsMeasuredLikeAnyOther) {
@@ -1830,11 +1822,7 @@ TEST(FloorCue, ARunAtTheStartOfTheRegionsRowsIsMeasuredLikeAnyOther) {
   });
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   CHECK(fresh.model().textured);
-  const float longest = longest_band_m(p, 0, band - 1);
-  CHECK(longest > 0.08F);  // the stripes' runs are a pixel's step, under 0.02 m
-  const float max_run = fresh.model().max_run_m;
-  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
-  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+  check_max_run_against_band(fresh, p, 0, band - 1);
 }
 
 // In the region, as along a walk, shades exactly the luma change apart are one colour: a band
@@ -1855,9 +1843,5 @@ TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneRunInTheRegion) {
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   CHECK(fresh.model().textured);
   DOUBLES_EQUAL(10.0, fresh.model().tolerance[0], 1e-6);  // half the stripes' 20-level step
-  const float longest = longest_band_m(p, band, width - 1);
-  CHECK(longest > 0.08F);
-  const float max_run = fresh.model().max_run_m;
-  CHECK(max_run >= p.texture_run_factor * 0.5F * longest);
-  CHECK(max_run <= p.texture_run_factor * (longest + 0.01F));
+  check_max_run_against_band(fresh, p, band, width - 1);
 }
