@@ -110,6 +110,15 @@ std::string with_crc(const std::string& body) {
 
 }  // namespace
 
+namespace {
+// Polls `busy` every 10 ms for up to 5 s (the writer thread's work, which a test then checks).
+template <typename Busy>
+void wait_while(Busy busy) {
+  for (int i = 0; i < 500 && busy(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+}
+}  // namespace
+
 TEST_GROUP(Persistence) {
   std::string dir;
   char error[256] = "";
@@ -1118,10 +1127,7 @@ TEST(Persistence, AFailedSavesReasonIsKeptWholeForALongStateDirectory) {
       if (threaded) saver.start();
       make_state(3, g_a);
       CHECK(saver.submit(g_a));
-      for (int i = 0; i < 500 && saver.failures() == 0; ++i) {
-        timespec pause{0, 10000000L};
-        nanosleep(&pause, nullptr);
-      }
+      wait_while([&] { return saver.failures() == 0; });
       CHECK_EQUAL(1U, saver.failures());
       saver.last_error(reason, sizeof reason);
     }
@@ -1144,10 +1150,7 @@ TEST(Persistence, ASaverStoppedWhileItsSavesFailStopsWithoutTryingAgain) {
     saver.start();
     make_state(5, g_a);
     CHECK(saver.submit(g_a));
-    for (int i = 0; i < 500 && saver.failures() == 0; ++i) {
-      timespec pause{0, 10000000L};
-      nanosleep(&pause, nullptr);
-    }
+    wait_while([&] { return saver.failures() == 0; });
     CHECK_EQUAL(1U, saver.failures());
   }
   set_storage_fault_hook(nullptr, nullptr);
@@ -1167,10 +1170,7 @@ TEST(Persistence, TheWriterThreadRetriesAFailedSaveWithoutANewSubmission) {
     make_state(12, g_a);
     CHECK(saver.submit(g_a));
     // Nothing more is submitted (a finished mission): the writer tries again by itself.
-    for (int i = 0; i < 500 && saver.saved() == 0; ++i) {
-      timespec pause{0, 10000000L};
-      nanosleep(&pause, nullptr);
-    }
+    wait_while([&] { return saver.saved() == 0; });
     CHECK_EQUAL(1U, saver.saved());
     CHECK_EQUAL(2U, saver.failures());
     CHECK_EQUAL(2U, saver.retries());
@@ -1314,9 +1314,7 @@ TEST(Persistence, AFailedSaveIsTriedAgainOnlyOnceTheRetryIntervalHasPassed) {
     owner->start();
     make_state(5, g_a);
     CHECK(owner->submit(g_a));
-    for (int i = 0; i < 500 && owner->saved() == 0; ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
+    wait_while([&] { return owner->saved() == 0; });
     CHECK_EQUAL(1U, owner->saved());
   }
   set_storage_fault_hook(nullptr, nullptr);
@@ -1339,9 +1337,7 @@ TEST(Persistence, ParametersAndAStateHandedOverTogetherAreBothSaved) {
   while (!owner->submit(g_a)) {
   }
   gate.open_after_ms(0).join();
-  for (int i = 0; i < 500 && (owner->saved() < 2 || owner->parameter_saves() < 1); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  wait_while([&] { return owner->saved() < 2 || owner->parameter_saves() < 1; });
   const std::uint64_t saved = owner->saved();
   const std::uint64_t parameters = owner->parameter_saves();
   owner.reset();
