@@ -1368,24 +1368,38 @@ TEST(FloorCue, ARegionOneAndAHalfTolerancesFromTheKnownFloorIsInconsistent) {
   CHECK(FloorLearn::kUpdated == fresh.learn(g_frame, 0.0F, kLookTilt));
 }
 
+namespace {
+
+// `params` with regions 1 rad apart confirming each other.
+FloorCueParams confirming_across_1_rad(FloorCueParams params) {
+  params.confirm_separation_rad = 1.0F;
+  return params;
+}
+
+// g_frame learned alone by `one`, g_frame2 alone by `other`, and both by `both` from pans
+// 1.8 rad apart (pending after the first, learned after the second).
+void learn_apart_and_together(FloorCue& one, FloorCue& other, FloorCue& both) {
+  one.reset();
+  other.reset();
+  both.reset();
+  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+}
+
+}  // namespace
+
 // Two textured regions of the same colours in different proportions confirm a model whose
 // histogram is their average, bin by bin.
 TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheAverageOfTheirHistograms) {
   const FloorCueParams flat = flat_trusting();
-  static FloorCue one{g_rig, flat};
-  static FloorCue other{g_rig, flat};
-  one.reset();
-  other.reset();
   fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
   fill_patches(g_frame2, {40.0F, 40.0F, 100.0F, 160.0F, 220.0F});
-  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
-  FloorCueParams confirming = flat;
-  confirming.confirm_separation_rad = 1.0F;
-  static FloorCue both{g_rig, confirming};
-  both.reset();
-  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+  static FloorCue one{g_rig, flat};
+  static FloorCue other{g_rig, flat};
+  static FloorCue both{g_rig, confirming_across_1_rad(flat)};
+  learn_apart_and_together(one, other, both);
   CHECK(both.model().textured);
   double apart = 0.0;
   for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
@@ -1713,16 +1727,8 @@ TEST(FloorCue, TwoPlainRegionsConfirmAModelWithTheMeanOfTheirMediansAndTolerance
   spread(g_frame2, 126.0F, 4.0F, 1.0F);
   static FloorCue one{g_rig, flat};
   static FloorCue other{g_rig, flat};
-  one.reset();
-  other.reset();
-  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
-  FloorCueParams confirming = flat;
-  confirming.confirm_separation_rad = 1.0F;
-  static FloorCue both{g_rig, confirming};
-  both.reset();
-  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+  static FloorCue both{g_rig, confirming_across_1_rad(flat)};
+  learn_apart_and_together(one, other, both);
   CHECK_FALSE(both.model().textured);
   CHECK(other.model().tolerance[0] > one.model().tolerance[0] + 5.0F);  // the spreads differ
   CHECK(other.model().tolerance[1] > one.model().tolerance[1] + 0.5F);
@@ -1752,19 +1758,11 @@ TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheMeanOfTheirLongestRuns) {
   });
   static FloorCue one{g_rig, p};
   static FloorCue other{g_rig, p};
-  one.reset();
-  other.reset();
-  CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
+  static FloorCue both{g_rig, confirming_across_1_rad(p)};
+  learn_apart_and_together(one, other, both);
   CHECK(one.model().textured);
   CHECK(other.model().textured);
   CHECK(other.model().max_run_m > one.model().max_run_m + 0.1F);  // the band's runs
-  FloorCueParams confirming = p;
-  confirming.confirm_separation_rad = 1.0F;
-  static FloorCue both{g_rig, confirming};
-  both.reset();
-  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
   CHECK(both.model().textured);
   DOUBLES_EQUAL(0.5F * (one.model().max_run_m + other.model().max_run_m), both.model().max_run_m,
                 1e-5);
