@@ -426,10 +426,11 @@ TEST(Target, ATriangleWithItsTopCutOffIsNotTheTarget) {
 // An equilateral triangle, vertex up at (apex_u, apex_v), `height_px` rows high, drawn with
 // each pixel mixing green and paper by the share of it the triangle covers (16 x 16 samples),
 // as the camera's 4 x 4 averaging does; `light(u, v)` scales the brightness above black of paper
-// and triangle alike.
+// and triangle alike. Its half width grows by `half_width_per_row` a row: tan 30° head-on, half
+// that seen 60° aside.
 template <typename Light>
 void draw_smooth_triangle(image::LowResFrame& f, float apex_u, float apex_v, float height_px,
-                          Light light) {
+                          Light light, float half_width_per_row = 0.57735F) {
   f.width = 160;
   f.height = 120;
   const Colour& g = kTargetGreen;
@@ -443,7 +444,9 @@ void draw_smooth_triangle(image::LowResFrame& f, float apex_u, float apex_v, flo
           const float x = static_cast<float>(u) - 0.5F + (static_cast<float>(sx) + 0.5F) / 16.0F;
           const float y = static_cast<float>(v) - 0.5F + (static_cast<float>(sy) + 0.5F) / 16.0F;
           const float t = y - apex_v;
-          inside += t >= 0.0F && t <= height_px && std::fabs(x - apex_u) <= 0.57735F * t ? 1 : 0;
+          if (t >= 0.0F && t <= height_px && std::fabs(x - apex_u) <= half_width_per_row * t) {
+            ++inside;
+          }
         }
       }
       const float c = static_cast<float>(inside) / 256.0F;
@@ -477,4 +480,224 @@ TEST(Target, UnevenLightAcrossThePaperDoesNotMoveTheVertex) {
     DOUBLES_EQUAL(80.3, d.u_px, 0.01);
     DOUBLES_EQUAL(39.6, d.v_px, 0.02);
   }
+}
+
+namespace {
+
+// A second frame, for windows cut out of the first.
+image::LowResFrame& window() {
+  static image::LowResFrame instance;
+  return instance;
+}
+
+// Copies the window [u0, u0 + w) x [v0, v0 + h) of `from` into `to`: the same scene, the frame's
+// edges elsewhere.
+void crop(const image::LowResFrame& from, std::uint32_t u0, std::uint32_t v0, std::uint32_t w,
+          std::uint32_t h, image::LowResFrame& to) {
+  to.width = w;
+  to.height = h;
+  for (std::uint32_t v = 0; v < h; ++v) {
+    for (std::uint32_t u = 0; u < w; ++u) {
+      const std::size_t i = from.index(u0 + u, v0 + v);
+      const std::size_t j = to.index(u, v);
+      to.luma[j] = from.luma[i];
+      to.chroma_u[j] = from.chroma_u[i];
+      to.chroma_v[j] = from.chroma_v[i];
+    }
+  }
+}
+
+constexpr auto kEvenLight = [](float, float) { return 1.0F; };
+
+}  // namespace
+
+// A triangle cut by the frame's edge has no trustworthy vertex. The drawn triangle (columns 66
+// to 94, rows 40 to 63) seen through windows of the frame: with a pixel of paper between it and
+// an edge it is found; with the edge across it (its top row, its left or right side or its last
+// four rows outside the window) or along it (its bottom row on the frame's last) it is not.
+TEST(Target, ATriangleCutByAnEdgeOfTheFrameIsNotTheTarget) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  struct Window {
+    std::uint32_t u0, v0, w, h;
+    bool found;
+  };
+  constexpr Window kWindows[] = {
+      {0, 39, 160, 81, true}, {0, 41, 160, 79, false},                          // top
+      {65, 0, 95, 120, true}, {70, 0, 90, 120, false},                          // left
+      {0, 0, 96, 120, true},  {0, 0, 90, 120, false},                           // right
+      {0, 0, 160, 65, true},  {0, 0, 160, 64, false},  {0, 0, 160, 60, false},  // bottom
+  };
+  for (const Window& win : kWindows) {
+    crop(frame(), win.u0, win.v0, win.w, win.h, window());
+    CHECK_EQUAL_TEXT(win.found, detector.detect(window()).found, "window");
+  }
+}
+
+// The triangle with its bottom row's first pixel in the frame's second column is found. Joined
+// there to green that runs along the frame's left edge from above the triangle to below it, the
+// two are one blob, which may go on out of the frame: no target, though the flood (in raster
+// order) starts in the edge's column and reaches the triangle only from it.
+TEST(Target, ATriangleJoinedToGreenAlongTheFramesEdgeIsNotTheTarget) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  crop(frame(), 65, 0, 95, 120, window());
+  const image::TargetDetection alone = detector.detect(window());
+  CHECK(alone.found);
+  LONGS_EQUAL(1, alone.box_u_min);
+  for (std::uint32_t v = 30; v <= 70; ++v) set_pixel(window(), 0, v, kTargetGreen);
+  CHECK_FALSE(detector.detect(window()).found);
+}
+
+// A dark rim left of the triangle (its shadow) touches it: mixed pixels, neither paper nor
+// triangle, which do not count against the paper around it, also where the rim lies in the
+// frame's first column (the triangle's bottom row starting in the second): the confidence and
+// the vertex are those without the shadow.
+TEST(Target, AShadowTouchingTheTriangleDoesNotLowerItsConfidenceAlsoAtTheFramesEdge) {
+  static image::TargetDetector detector;
+  for (const std::uint32_t u0 : {0U, 65U}) {
+    draw_triangle(frame(), 0.0F);
+    crop(frame(), u0, 0, 160 - u0, 120, window());
+    const image::TargetDetection clean = detector.detect(window());
+    CHECK(clean.found);
+    for (std::uint32_t v = 41; v < 64; ++v) {
+      for (std::uint32_t u = 1; u < window().width; ++u) {
+        if (window().cr(u, v) == kTargetGreen.cr) {
+          set_pixel(window(), u - 1, v, Colour{40.0F, 0, 0});
+          break;
+        }
+      }
+    }
+    const image::TargetDetection shadowed = detector.detect(window());
+    CHECK(shadowed.found);
+    DOUBLES_EQUAL(clean.confidence, shadowed.confidence, 1e-6);
+    DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 1e-6);
+    DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 1e-6);
+  }
+}
+
+// Far off and seen 60° aside the triangle is a few pixels across: drawn 6 rows high, 0.29 px a
+// row wider each side, no pixel of its blob has all four neighbours in it. Its colour is then
+// judged from its greenest pixel (the reference chroma, the luma and the green's share of the
+// paper's brightness), and it is found, its vertex within 0.05 px of where it is drawn.
+TEST(Target, ATriangleTooThinForAnInteriorIsJudgedByItsGreenestPixelAndFound) {
+  static image::TargetDetector detector;
+  const image::TargetParams& p = detector.params();
+  const auto grows = [&](std::uint32_t u, std::uint32_t v) {
+    const float bright = std::fmax(0.0F, frame().y(u, v) - p.black_luma);
+    const auto minus_cr = static_cast<float>(-frame().cr(u, v));
+    return minus_cr >= p.grow_min_chroma && minus_cr >= p.grow_min_cr_ratio * bright &&
+           static_cast<float>(-frame().cb(u, v)) >= p.grow_min_cb_ratio * bright;
+  };
+  for (const float apex_v : {40.25F, 40.5F}) {
+    draw_smooth_triangle(frame(), 80.5F, apex_v, 6.0F, kEvenLight, 0.29F);
+    const image::TargetDetection d = detector.detect(frame());
+    CHECK(d.found);
+    DOUBLES_EQUAL(80.5, d.u_px, 0.05);
+    DOUBLES_EQUAL(apex_v, d.v_px, 0.05);
+    for (std::uint32_t v = d.box_v_min; v <= d.box_v_max; ++v) {
+      for (std::uint32_t u = d.box_u_min; u <= d.box_u_max; ++u) {
+        CHECK_FALSE(grows(u, v) && grows(u - 1, v) && grows(u + 1, v) && grows(u, v - 1) &&
+                    grows(u, v + 1));
+      }
+    }
+  }
+}
+
+// A row's extent is measured over its run and two pixels beyond each end, within the frame's
+// row: green along the frame's left edge is nothing to a triangle one column of paper from the
+// right edge, and the vertex is where it was without it.
+TEST(Target, GreenAlongTheFramesLeftEdgeDoesNotMoveATriangleAtItsRightEdge) {
+  static image::TargetDetector detector;
+  draw_smooth_triangle(frame(), 80.0F, 40.0F, 8.0F, kEvenLight);
+  crop(frame(), 0, 0, 86, 120, window());
+  const image::TargetDetection alone = detector.detect(window());
+  CHECK(alone.found);
+  LONGS_EQUAL(84, alone.box_u_max);
+  for (std::uint32_t v = 44; v < window().height; ++v) set_pixel(window(), 0, v, kTargetGreen);
+  const image::TargetDetection beside = detector.detect(window());
+  CHECK(beside.found);
+  DOUBLES_EQUAL(alone.u_px, beside.u_px, 1e-6);
+  DOUBLES_EQUAL(alone.v_px, beside.v_px, 1e-6);
+  DOUBLES_EQUAL(80.0, beside.u_px, 0.02);
+  DOUBLES_EQUAL(40.0, beside.v_px, 0.02);
+}
+
+// The colour contrast with the paper is the distance between their mean chromas, at least 3
+// levels: under tinted light a triangle exactly 3 levels from the paper's colour in Cb alone or
+// in Cr alone is the target, and one 2 levels from it in either is not.
+TEST(Target, ATriangleThreeChromaLevelsFromThePapersColourInCbOrCrAloneIsTheTarget) {
+  static image::TargetDetector detector;
+  const Colour tinted_paper{200.0F, -15, -6};
+  struct Case {
+    int dcb;
+    int dcr;
+    bool found;
+  };
+  constexpr Case kCases[] = {{0, -3, true}, {-3, 0, true}, {0, -2, false}, {-2, 0, false}};
+  for (const Case& c : kCases) {
+    draw_triangle(frame(), 0.0F, Colour{30.0F, tinted_paper.cb + c.dcb, tinted_paper.cr + c.dcr},
+                  tinted_paper);
+    CHECK_EQUAL_TEXT(c.found, detector.detect(frame()).found, "chroma offset from the paper");
+  }
+}
+
+// The green's share of the paper's brightness must leave the paper more than 3 grey levels
+// brighter than the triangle (at the paper's mean brightness). In a dark scene, paper 8 levels
+// above black, a triangle 5 levels above black (3 darker: its share is exactly 1 − 3/8, the
+// paper's fitted plane coming out exactly flat) is not the target, and one 4 above black is.
+TEST(Target, InTheDarkATriangleOnlyThreeGreyLevelsDarkerThanThePaperIsNotTheTarget) {
+  static image::TargetDetector detector;
+  const Colour dark_paper{24.0F, 0, 0};
+  draw_triangle(frame(), 0.0F, Colour{21.0F, -3, -5}, dark_paper);
+  CHECK_FALSE(detector.detect(frame()).found);
+  draw_triangle(frame(), 0.0F, Colour{20.0F, -3, -5}, dark_paper);
+  CHECK(detector.detect(frame()).found);
+}
+
+namespace {
+
+// A triangle whose sides step exactly half a pixel a row, vertex up above column 80: its row k
+// (from row 40) is top_width + k pixels wide, whole green pixels and, when that width is even, a
+// pixel half green at each end; the paper twice as bright above black as the green. The paper's
+// fitted plane comes out exactly flat, and each row's extent is exact, and so are the lines
+// fitted to them.
+void draw_stepped_triangle(image::LowResFrame& f, int top_width, int rows) {
+  const Colour paper{144.0F, 0, 0};
+  const Colour green{80.0F, -20, -40};
+  const Colour half{112.0F, -10, -20};
+  f.width = 160;
+  f.height = 120;
+  for (std::uint32_t v = 0; v < f.height; ++v) {
+    for (std::uint32_t u = 0; u < f.width; ++u) set_pixel(f, u, v, paper);
+  }
+  for (int k = 0; k < rows; ++k) {
+    const int width = top_width + k;
+    const auto v = static_cast<std::uint32_t>(40 + k);
+    const int whole_half = (width - 1) / 2;  // whole pixels 80 ± this
+    for (int j = -whole_half; j <= whole_half; ++j) {
+      set_pixel(f, static_cast<std::uint32_t>(80 + j), v, green);
+    }
+    if (width % 2 == 0) {
+      set_pixel(f, static_cast<std::uint32_t>(80 - width / 2), v, half);
+      set_pixel(f, static_cast<std::uint32_t>(80 + width / 2), v, half);
+    }
+  }
+}
+
+}  // namespace
+
+// The vertex may lie up to two rows above the blob's top row (a tip too thin to be seen): the
+// triangle whose top row is 2 px wide, its edges meeting exactly two rows above it, is the
+// target with its vertex there; with a top row 3 px wide, three rows above it, it is not.
+TEST(Target, ATriangleWhoseEdgesMeetExactlyTwoRowsAboveItsTopRowIsTheTarget) {
+  static image::TargetDetector detector;
+  draw_stepped_triangle(frame(), 2, 16);
+  const image::TargetDetection d = detector.detect(frame());
+  CHECK(d.found);
+  LONGS_EQUAL(40, d.box_v_min);
+  DOUBLES_EQUAL(80.0, d.u_px, 1e-9);
+  DOUBLES_EQUAL(38.0, d.v_px, 1e-9);
+  draw_stepped_triangle(frame(), 3, 16);
+  CHECK_FALSE(detector.detect(frame()).found);
 }
