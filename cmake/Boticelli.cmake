@@ -69,8 +69,8 @@ endfunction()
 # measured in each kind of preset. Called where TEST is added (a directory's own tests).
 function(boticelli_test_cost test)
   if(BOTICELLI_SANITIZE OR CMAKE_CROSSCOMPILING)
-    set(costs test_sim 180 test_floor_cue 75 test_mapping 40 test_aln 20 test_stereo 20
-        test_sdf 18 test_firmware 11)
+    set(costs test_sim_target_frames 130 test_floor_cue 75 test_mapping 40 test_sim 25 test_aln 20
+        test_stereo 20 test_sdf 18 test_firmware 11)
   else()
     set(costs test_mission_MissionRooms 117 test_mission_MissionSeeds 100
         test_mission_MissionThesisRoom 86 test_mission_MissionResume 41 test_localization 26
