@@ -2,11 +2,13 @@
 // parameters' round trip and the atomic write both stores share.
 #include <dirent.h>
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -818,6 +820,34 @@ TEST(AtomicWrite, ARenameThatFailsFailsTheSaveAndLeavesNoTemporaryFile) {
   STRCMP_EQUAL("kept\n", read_file(target + "/inside").c_str());
   ::unlink((target + "/inside").c_str());
   ::rmdir(target.c_str());
+}
+
+// write() itself failing partway through the data (the storage-fault hook fails the call before
+// it runs): here past the process's file size limit (EFBIG), as a full disk refuses with
+// ENOSPC. The first chunk is written whole, the second cut short and the rest refused; the save
+// fails with the reason, the old file stays whole and no temporary file is left.
+TEST(AtomicWrite, AWriteTheFileSystemRefusesPartwayFailsTheSaveAndKeepsTheOldFile) {
+  char error[320] = "";
+  const std::string old_text(100, 'o');
+  const std::string new_text(3 * kAtomicWriteChunkBytes, 'n');
+  CHECK(write_file_atomically(dir.c_str(), "a.txt", old_text, error, sizeof error));
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  struct sigaction old_action {};
+  CHECK_EQUAL(0, ::sigaction(SIGXFSZ, &ignore, &old_action));
+  rlimit saved{};
+  CHECK_EQUAL(0, ::getrlimit(RLIMIT_FSIZE, &saved));
+  rlimit small = saved;
+  small.rlim_cur = kAtomicWriteChunkBytes + 100;
+  CHECK_EQUAL(0, ::setrlimit(RLIMIT_FSIZE, &small));
+  const bool written = write_file_atomically(dir.c_str(), "a.txt", new_text, error, sizeof error);
+  ::setrlimit(RLIMIT_FSIZE, &saved);
+  ::sigaction(SIGXFSZ, &old_action, nullptr);
+  CHECK_FALSE(written);
+  STRCMP_EQUAL(("cannot write " + dir + "/a.txt.tmp: " + std::strerror(EFBIG)).c_str(), error);
+  CHECK(read_file(dir + "/a.txt") == old_text);
+  CHECK(access((dir + "/a.txt.tmp").c_str(), F_OK) != 0);
 }
 
 TEST(AtomicWrite, TheFileIsReadableAndWritableByItsOwnerAndReadableByItsGroup) {
