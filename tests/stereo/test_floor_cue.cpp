@@ -1843,3 +1843,170 @@ TEST(FloorCue, ShadesExactlyTheLumaChangeApartAreOneRunInTheRegion) {
   DOUBLES_EQUAL(10.0, fresh.model().tolerance[0], 1e-6);  // half the stripes' 20-level step
   check_max_run_against_band(fresh, p, band, width - 1);
 }
+
+// A column step of 0 configured is taken as 1: every column of the frame is walked, once.
+TEST(FloorCue, AColumnStepOfZeroWalksEveryColumnOnce) {
+  FloorCueParams p = flat_trusting();
+  p.column_step = 0;
+  static FloorCue fresh{g_rig, p};
+  CHECK_EQUAL(1U, fresh.params().column_step);
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(std::size_t{g_frame.width}, fresh.column_count());
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    CHECK_EQUAL(i, std::size_t{fresh.column(i).u_px});
+  }
+}
+
+// A full obstacle list is reported like any other full output: a wall across the frame, room
+// for every free reading and for two obstacle readings only.
+TEST(FloorCue, AnObstacleListTooShortForTheBoundariesFoundIsReportedTruncated) {
+  const FloorCueParams flat = flat_trusting();
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  paint_wall(g_frame2);
+  FixedVector<Reading, 2> obstacles;
+  FixedVector<Reading, 256> free;
+  const FloorCueResult r = fresh.process(g_frame2, 0.0F, kLookTilt, obstacles, free);
+  CHECK(r.boundaries >= 60U);
+  CHECK(free.size() < free.capacity());  // the free list had room
+  CHECK_EQUAL(2U, obstacles.size());
+  CHECK(r.truncated);
+}
+
+// A frame kept while the model waits keeps luma beyond white as white (255), not wrapped round
+// to black: kept at luma 256, it is walked as free floor of luma 250, as the frame itself is.
+TEST(FloorCue, AKeptFramesLumaBeyondWhiteIsKeptAsWhite) {
+  const FloorCueParams flat = flat_trusting();
+  static FloorCue fresh{g_rig, flat};
+  fresh.reset();
+  fill_patches(g_frame2, {256.0F});
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK(out.result.deferred);
+  fill_patches(g_frame, {250.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.free.clear();
+  const FloorCueResult with_kept =
+      fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(1U, with_kept.deferred_walked);
+  out.free.clear();
+  const FloorCueResult alone = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, alone.deferred_walked);
+  CHECK_EQUAL(alone.columns, alone.free_readings);  // every walk of the frame is free floor
+  CHECK_EQUAL(2 * alone.free_readings, with_kept.free_readings);
+}
+
+// The smallest frame a region is learned from is two pixels a side: a frame two pixels wide
+// (the image's left edge) or two pixels high (its top rows, tilted down to see the floor 0.7 m
+// away there) is learned from, its region as few pixels as the minimum asks; one pixel wide or
+// high is not.
+TEST(FloorCue, AFrameTwoPixelsWideOrHighIsLearnedFromAndOnePixelIsNot) {
+  FloorCueParams p = flat_trusting();
+  p.reference_min_pixels = 1;
+  static FloorCue fresh{g_rig, p};
+  constexpr float kSteep = -1.0F;  // [rad]
+  float near_m = 0.0F;
+  float far_m = 0.0F;
+  CHECK(fresh.floor_coverage(kSteep, near_m, far_m));
+  CHECK(far_m > p.reference_min_m && far_m < p.reference_max_m);  // the top row's floor
+  for (const std::uint32_t size : {2U, 1U}) {
+    const FloorLearn expected = size == 2 ? FloorLearn::kLearned : FloorLearn::kNoRegion;
+    fill_patches(g_frame, {120.0F});
+    g_frame.width = size;
+    fresh.reset();
+    CHECK(expected == fresh.learn(g_frame, 0.0F, kLookTilt));
+    fill_patches(g_frame, {120.0F});
+    g_frame.height = size;
+    fresh.reset();
+    CHECK(expected == fresh.learn(g_frame, 0.0F, kSteep));
+  }
+}
+
+namespace {
+
+// A frame of luma tone(ρ) (no chroma), ρ where each pixel sees the floor (the look's lower tilt,
+// pan 0), far_tone at or above the horizon.
+template <typename Tone>
+void paint_by_floor_distance(LowResFrame& frame, Tone tone, float far_tone) {
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  paint(frame, [&](std::uint32_t u, std::uint32_t v) {
+    Eigen::Vector3f point;
+    const bool seen = floor_seen_at(pose, static_cast<float>(u), static_cast<float>(v), point);
+    return std::array<float, 3>{seen ? tone(std::hypot(point.x(), point.y())) : far_tone, 0.0F,
+                                0.0F};
+  });
+}
+
+// A textured floor of 14 greys 16 apart (luma change the minimum, 10; every grey from 16 to 240
+// its colour) learned by `cue`.
+void learn_fine_greys(FloorCue& cue) {
+  cue.reset();
+  fill_patches(g_frame, {24.0F, 40.0F, 56.0F, 72.0F, 88.0F, 104.0F, 120.0F, 136.0F, 152.0F, 168.0F,
+                         184.0F, 200.0F, 216.0F, 232.0F});
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  CHECK(cue.model().textured);
+  DOUBLES_EQUAL(cue.params().min_tolerance_luma, cue.model().tolerance[0], 1e-6);
+}
+
+}  // namespace
+
+// Along a walk on a textured floor, one colour stays within twice the change tolerances of its
+// stretch's first sample: a floor of one grey whose shade rises by the luma change three times,
+// at 0.7, 0.8 and 0.9 m (the walks begin at about 0.6 m), is one stretch to 0.9 m and another
+// from there, a plain thing (one colour for longer than the floor's longest run, here 1 m) which
+// ends the free floor at 0.9 m.
+TEST(FloorCue, AShadeRisingThreeLumaChangesBeginsANewStretchWhereItRisesTheThirdTime) {
+  FloorCueParams p = flat_trusting();
+  p.texture_run_min_m = 1.0F;  // the longest run: 1 m
+  p.texture_run_max_m = 1.0F;
+  static FloorCue fresh{g_rig, p};
+  learn_fine_greys(fresh);
+  const float change = fresh.model().tolerance[0];
+  const auto rises = [](float rho) {
+    return rho < 0.7F ? 0.0F : (rho < 0.8F ? 1.0F : (rho < 0.9F ? 2.0F : 3.0F));
+  };
+  paint_by_floor_distance(
+      g_frame2, [&](float rho) { return 100.0F + change * rises(rho); }, 100.0F + 3.0F * change);
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, out.result.obstacle_readings);  // texture_obstacles off
+  CHECK_EQUAL(out.result.columns, out.free.size());
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    CHECK(fresh.column(i).end == FloorColumn::End::kBoundary);
+    DOUBLES_EQUAL(0.9, fresh.column(i).base_rho_m, 0.05);
+    DOUBLES_EQUAL(0.9, fresh.column(i).free_rho_m, 0.05);
+  }
+}
+
+// On a textured floor, a walk in one of its colours from its bottom row to max range, for more
+// than half the floor's longest run, says nothing free: the colour may be a plain thing standing
+// there, and no floor was seen before it.
+TEST(FloorCue, AWalkInOneColourFromItsBottomRowToMaxRangeSaysNothingFree) {
+  FloorCueParams p = flat_trusting();
+  p.texture_run_min_m = 1.0F;  // the longest run: 1 m
+  p.texture_run_max_m = 1.0F;
+  p.max_range_m = 1.2F;
+  static FloorCue fresh{g_rig, p};
+  learn_fine_greys(fresh);
+  fill_patches(g_frame2, {104.0F});
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK(out.result.columns > 0U);
+  CHECK_EQUAL(0U, out.result.free_readings);
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    const FloorColumn& col = fresh.column(i);
+    CHECK(col.end == FloorColumn::End::kMaxRange);
+    CHECK(p.max_range_m - col.near_rho_m > 0.55F);  // more than half the longest run
+    CHECK(p.max_range_m - col.near_rho_m < 0.95F);  // and less than all of it
+  }
+}
