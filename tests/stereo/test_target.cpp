@@ -393,6 +393,28 @@ TEST(Target, AShadowBesideTheTriangleDoesNotMoveItsVertex) {
   DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
 }
 
+// The same on tinted paper (a cream sheet): a shadow is the paper's own colour, darker, and
+// no greener than the paper, so it is no part of the triangle's rows.
+TEST(Target, AShadowBesideTheTriangleOnTintedPaperDoesNotMoveItsVertex) {
+  static image::TargetDetector detector;
+  const Colour tinted_paper{200.0F, -15, -6};
+  draw_triangle(frame(), 0.0F, kTargetGreen, tinted_paper);
+  const image::TargetDetection clean = detector.detect(frame());
+  CHECK(clean.found);
+  for (std::uint32_t v = 41; v < 64; ++v) {
+    for (std::uint32_t u = 0; u < frame().width; ++u) {
+      if (frame().chroma_v[frame().index(u, v)] == 128 + kTargetGreen.cr) {
+        set_pixel(frame(), u - 1, v, Colour{40.0F, tinted_paper.cb, tinted_paper.cr});
+        break;
+      }
+    }
+  }
+  const image::TargetDetection shadowed = detector.detect(frame());
+  CHECK(shadowed.found);
+  DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 0.05);
+  DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
+}
+
 // The confidence's factors: white paper all round scales it, and straight edges, half the box
 // filled and symmetry each take it from 0.4 to 1 of that (the product of the three).
 TEST(Target, ConfidenceIsThePapersShareTimesHowStraightFilledAndSymmetricTheTriangleIs) {
@@ -507,6 +529,21 @@ void crop(const image::LowResFrame& from, std::uint32_t u0, std::uint32_t v0, st
   }
 }
 
+// Copies `from` into `to` mirrored left to right.
+void mirror(const image::LowResFrame& from, image::LowResFrame& to) {
+  to.width = from.width;
+  to.height = from.height;
+  for (std::uint32_t v = 0; v < from.height; ++v) {
+    for (std::uint32_t u = 0; u < from.width; ++u) {
+      const std::size_t i = from.index(u, v);
+      const std::size_t j = to.index(from.width - 1 - u, v);
+      to.luma[j] = from.luma[i];
+      to.chroma_u[j] = from.chroma_u[i];
+      to.chroma_v[j] = from.chroma_v[i];
+    }
+  }
+}
+
 constexpr auto kEvenLight = [](float, float) { return 1.0F; };
 
 }  // namespace
@@ -547,6 +584,49 @@ TEST(Target, ATriangleJoinedToGreenAlongTheFramesEdgeIsNotTheTarget) {
   LONGS_EQUAL(1, alone.box_u_min);
   for (std::uint32_t v = 30; v <= 70; ++v) set_pixel(window(), 0, v, kTargetGreen);
   CHECK_FALSE(detector.detect(window()).found);
+}
+
+// The same along the frame's top edge: the triangle's top row in the frame's second row, and
+// green along the first row above it, which the flood reaches first (raster order). One blob
+// touching the edge, refused; never a blob of the triangle alone, cut off from the green by a
+// flood that does not go down from the first row.
+TEST(Target, ATriangleJoinedToGreenAlongTheFramesTopEdgeIsNotTheTarget) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  const image::TargetDetection drawn = detector.detect(frame());
+  CHECK(drawn.found);
+  const std::uint32_t v0 = drawn.box_v_min - 1;
+  crop(frame(), 0, v0, 160, 120 - v0, window());
+  const image::TargetDetection alone = detector.detect(window());
+  CHECK(alone.found);
+  LONGS_EQUAL(1, alone.box_v_min);
+  for (std::uint32_t u = alone.box_u_min; u <= alone.box_u_max; ++u) {
+    set_pixel(window(), u, 0, kTargetGreen);
+  }
+  CHECK_FALSE(detector.detect(window()).found);
+}
+
+// The detector has no side: a dark patch on the paper left of the triangle lowers its
+// confidence as much as the same patch does right of it, in the frame mirrored (the paper
+// around the triangle is looked at on every side alike).
+TEST(Target, AFrameAndItsMirrorImageGiveTheSameConfidence) {
+  static image::TargetDetector detector;
+  draw_triangle(frame(), 0.0F);
+  const image::TargetDetection clean = detector.detect(frame());
+  CHECK(clean.found);
+  for (std::uint32_t v = clean.box_v_min; v <= clean.box_v_max; ++v) {
+    for (std::uint32_t u = clean.box_u_min - 4; u < clean.box_u_min - 1; ++u) {
+      set_pixel(frame(), u, v, Colour{40.0F, 0, 0});
+    }
+  }
+  const image::TargetDetection left = detector.detect(frame());
+  CHECK(left.found);
+  CHECK(left.confidence < clean.confidence - 0.01F);
+  mirror(frame(), window());
+  const image::TargetDetection right = detector.detect(window());
+  CHECK(right.found);
+  DOUBLES_EQUAL(left.confidence, right.confidence, 1e-5);
+  LONGS_EQUAL(frame().width - 1 - left.box_u_max, right.box_u_min);
 }
 
 // A dark rim left of the triangle (its shadow) touches it: mixed pixels, neither paper nor
