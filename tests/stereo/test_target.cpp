@@ -372,47 +372,28 @@ TEST(Target, ATriangleOfTheTintedPapersOwnColourIsNotTheTarget) {
   CHECK(detector.detect(frame()).found);
 }
 
-// A dark grey rim beside the triangle (its shadow on the paper) is not greener than the paper:
-// it adds nothing to the rows' widths, and the vertex stays where the green puts it.
+// A dark rim beside the triangle (its shadow on the paper, in the paper's own chroma) is not
+// greener than the paper: it adds nothing to the rows' widths, and the vertex stays where the
+// green puts it, on white paper and on tinted paper (a cream sheet).
 TEST(Target, AShadowBesideTheTriangleDoesNotMoveItsVertex) {
   static image::TargetDetector detector;
-  draw_triangle(frame(), 0.0F);
-  const image::TargetDetection clean = detector.detect(frame());
-  CHECK(clean.found);
-  for (std::uint32_t v = 41; v < 64; ++v) {
-    for (std::uint32_t u = 0; u < frame().width; ++u) {
-      if (frame().chroma_v[frame().index(u, v)] == 128 + kTargetGreen.cr) {
-        set_pixel(frame(), u - 1, v, Colour{40.0F, 0, 0});
-        break;
+  for (const Colour& paper : {kWhitePaper, Colour{200.0F, -15, -6}}) {
+    draw_triangle(frame(), 0.0F, kTargetGreen, paper);
+    const image::TargetDetection clean = detector.detect(frame());
+    CHECK(clean.found);
+    for (std::uint32_t v = 41; v < 64; ++v) {
+      for (std::uint32_t u = 0; u < frame().width; ++u) {
+        if (frame().chroma_v[frame().index(u, v)] == 128 + kTargetGreen.cr) {
+          set_pixel(frame(), u - 1, v, Colour{40.0F, paper.cb, paper.cr});
+          break;
+        }
       }
     }
+    const image::TargetDetection shadowed = detector.detect(frame());
+    CHECK(shadowed.found);
+    DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 0.05);
+    DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
   }
-  const image::TargetDetection shadowed = detector.detect(frame());
-  CHECK(shadowed.found);
-  DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 0.05);
-  DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
-}
-
-// The same on tinted paper (a cream sheet): a shadow is the paper's own colour, darker, and
-// no greener than the paper, so it is no part of the triangle's rows.
-TEST(Target, AShadowBesideTheTriangleOnTintedPaperDoesNotMoveItsVertex) {
-  static image::TargetDetector detector;
-  const Colour tinted_paper{200.0F, -15, -6};
-  draw_triangle(frame(), 0.0F, kTargetGreen, tinted_paper);
-  const image::TargetDetection clean = detector.detect(frame());
-  CHECK(clean.found);
-  for (std::uint32_t v = 41; v < 64; ++v) {
-    for (std::uint32_t u = 0; u < frame().width; ++u) {
-      if (frame().chroma_v[frame().index(u, v)] == 128 + kTargetGreen.cr) {
-        set_pixel(frame(), u - 1, v, Colour{40.0F, tinted_paper.cb, tinted_paper.cr});
-        break;
-      }
-    }
-  }
-  const image::TargetDetection shadowed = detector.detect(frame());
-  CHECK(shadowed.found);
-  DOUBLES_EQUAL(clean.u_px, shadowed.u_px, 0.05);
-  DOUBLES_EQUAL(clean.v_px, shadowed.v_px, 0.05);
 }
 
 // The confidence's factors: white paper all round scales it, and straight edges, half the box
