@@ -1035,6 +1035,15 @@ void paint_wall(LowResFrame& frame) {
   });
 }
 
+// `cue` (trusting its first region) reset and learned on a plain floor of luma 120 filling
+// g_frame; g_frame2 that floor with a wall across it (paint_wall).
+void learned_on_flat_floor(FloorCue& cue) {
+  cue.reset();
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == cue.learn(g_frame, 0.0F, kLookTilt));
+  paint_wall(g_frame2);
+}
+
 // Where pixel (u, v) of the low-resolution image sees the floor, in the PTU frame; false at or
 // above the horizon.
 bool floor_seen_at(const boticelli::stereo::CameraPose& pose, float u, float v,
@@ -1358,9 +1367,7 @@ TEST(FloorCue, CoverageIsWhatTheCentreColumnsBottomAndTopRowsSeeOfTheFloor) {
 TEST(FloorCue, ARegionOneAndAHalfTolerancesFromTheKnownFloorIsInconsistent) {
   const FloorCueParams flat = flat_trusting();
   static FloorCue fresh{g_rig, flat};
-  fresh.reset();
-  fill_patches(g_frame, {120.0F});
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  learned_on_flat_floor(fresh);
   fill_patches(g_frame, {120.0F + 1.5F * flat.min_tolerance_luma});
   CHECK(FloorLearn::kInconsistent == fresh.learn(g_frame, 0.0F, kLookTilt));
   DOUBLES_EQUAL(120.0, fresh.model().median[0], 1e-6);
@@ -1376,16 +1383,27 @@ FloorCueParams confirming_across_1_rad(FloorCueParams params) {
   return params;
 }
 
+// `params` trusting its first region, with updates moving the model a quarter of the way.
+FloorCueParams updating_by_a_quarter(FloorCueParams params) {
+  params.confirm_separation_rad = 0.0F;
+  params.learn_rate = 0.25F;
+  return params;
+}
+
 // g_frame learned alone by `one`, g_frame2 alone by `other`, and both by `both` from pans
-// 1.8 rad apart (pending after the first, learned after the second).
+// 1.8 rad apart: pending after the first and learned after the second if `both` waits for a
+// second direction, else learned from the first and updated by the second.
 void learn_apart_and_together(FloorCue& one, FloorCue& other, FloorCue& both) {
   one.reset();
   other.reset();
   both.reset();
   CHECK(FloorLearn::kLearned == one.learn(g_frame, 0.0F, kLookTilt));
   CHECK(FloorLearn::kLearned == other.learn(g_frame2, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kPending == both.learn(g_frame, 0.0F, kLookTilt));
-  CHECK(FloorLearn::kLearned == both.learn(g_frame2, 1.8F, kLookTilt));
+  const bool confirms = both.params().confirm_separation_rad > 0.0F;
+  CHECK((confirms ? FloorLearn::kPending : FloorLearn::kLearned) ==
+        both.learn(g_frame, 0.0F, kLookTilt));
+  CHECK((confirms ? FloorLearn::kLearned : FloorLearn::kUpdated) ==
+        both.learn(g_frame2, 1.8F, kLookTilt));
 }
 
 }  // namespace
@@ -1412,11 +1430,8 @@ TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheAverageOfTheirHistograms) {
 // A plain floor's update moves its tolerances by the learning rate too: a region of the
 // model's own colour and spread leaves them as they were.
 TEST(FloorCue, AnUpdateByARegionLikeThePlainFloorKeepsItsTolerances) {
-  const FloorCueParams flat = flat_trusting();
-  static FloorCue fresh{g_rig, flat};
-  fresh.reset();
-  fill_patches(g_frame, {120.0F});
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  static FloorCue fresh{g_rig, flat_trusting()};
+  learned_on_flat_floor(fresh);
   const std::array<float, 3> tolerance = fresh.model().tolerance;
   CHECK(FloorLearn::kUpdated == fresh.learn(g_frame, 0.0F, kLookTilt));
   for (std::size_t c = 0; c < 3; ++c) {
@@ -1427,12 +1442,8 @@ TEST(FloorCue, AnUpdateByARegionLikeThePlainFloorKeepsItsTolerances) {
 // Every process() call's columns are its own: a walk to max range says nothing of a base seen
 // by the same column in the frame before.
 TEST(FloorCue, AColumnKeepsNothingFromTheFrameBefore) {
-  const FloorCueParams flat = flat_trusting();
-  static FloorCue fresh{g_rig, flat};
-  fresh.reset();
-  fill_patches(g_frame, {120.0F});
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
-  paint_wall(g_frame2);
+  static FloorCue fresh{g_rig, flat_trusting()};
+  learned_on_flat_floor(fresh);
   out.obstacles.clear();
   out.free.clear();
   out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
@@ -1712,11 +1723,12 @@ TEST(FloorCue, WithoutAModelOrOutsideTheFrameNoPixelLooksLikeFloor) {
   CHECK_FALSE(fresh.looks_like_floor(g_frame, g_frame.width / 2, g_frame.height, contrast));
 }
 
-// A plain floor's model from two agreeing regions is their mean: the median and the tolerance
-// of every channel half way between the two regions' own, here of unlike spreads (luma 120 ± 2
-// and 126 ± 4, Cb 0 and 0 ± 1: robust spreads of 2 and 4, and of 0 and 1, levels).
-TEST(FloorCue, TwoPlainRegionsConfirmAModelWithTheMeanOfTheirMediansAndTolerances) {
-  const FloorCueParams flat = flat_trusting();
+namespace {
+
+// Two plain floors of unlike spreads: luma 120 ± 2 and Cb 0 in g_frame, luma 126 ± 4 and
+// Cb 0 ± 1 in g_frame2 (−1, 0 and +1 times the spread on a third of the pixels each: robust
+// spreads of 2 and 4, and of 0 and 1, levels).
+void paint_unlike_spreads() {
   const auto spread = [](LowResFrame& frame, float y, float dy, float dcb) {
     paint(frame, [=](std::uint32_t u, std::uint32_t v) {
       const auto k = static_cast<float>((u + v) % 3) - 1.0F;  // −1, 0, +1 in thirds
@@ -1725,6 +1737,16 @@ TEST(FloorCue, TwoPlainRegionsConfirmAModelWithTheMeanOfTheirMediansAndTolerance
   };
   spread(g_frame, 120.0F, 2.0F, 0.0F);
   spread(g_frame2, 126.0F, 4.0F, 1.0F);
+}
+
+}  // namespace
+
+// A plain floor's model from two agreeing regions is their mean: the median and the tolerance
+// of every channel half way between the two regions' own, here of unlike spreads (luma 120 ± 2
+// and 126 ± 4, Cb 0 and 0 ± 1: robust spreads of 2 and 4, and of 0 and 1, levels).
+TEST(FloorCue, TwoPlainRegionsConfirmAModelWithTheMeanOfTheirMediansAndTolerances) {
+  const FloorCueParams flat = flat_trusting();
+  paint_unlike_spreads();
   static FloorCue one{g_rig, flat};
   static FloorCue other{g_rig, flat};
   static FloorCue both{g_rig, confirming_across_1_rad(flat)};
@@ -1865,12 +1887,8 @@ TEST(FloorCue, AColumnStepOfZeroWalksEveryColumnOnce) {
 // A full obstacle list is reported like any other full output: a wall across the frame, room
 // for every free reading and for two obstacle readings only.
 TEST(FloorCue, AnObstacleListTooShortForTheBoundariesFoundIsReportedTruncated) {
-  const FloorCueParams flat = flat_trusting();
-  static FloorCue fresh{g_rig, flat};
-  fresh.reset();
-  fill_patches(g_frame, {120.0F});
-  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
-  paint_wall(g_frame2);
+  static FloorCue fresh{g_rig, flat_trusting()};
+  learned_on_flat_floor(fresh);
   FixedVector<Reading, 2> obstacles;
   FixedVector<Reading, 256> free;
   const FloorCueResult r = fresh.process(g_frame2, 0.0F, kLookTilt, obstacles, free);
@@ -2009,4 +2027,200 @@ TEST(FloorCue, AWalkInOneColourFromItsBottomRowToMaxRangeSaysNothingFree) {
     CHECK(p.max_range_m - col.near_rho_m > 0.55F);  // more than half the longest run
     CHECK(p.max_range_m - col.near_rho_m < 0.95F);  // and less than all of it
   }
+}
+
+// An update moves a plain floor's model by the learning rate towards the region's, its median
+// and its tolerance in every channel: a quarter of the way with learn_rate 0.25, from luma
+// 120 ± 2 towards 126 ± 4 (the two floors of unlike spreads).
+TEST(FloorCue, AnUpdateMovesAPlainFloorsMediansAndTolerancesByTheLearningRate) {
+  const FloorCueParams flat = flat_trusting();
+  paint_unlike_spreads();
+  static FloorCue one{g_rig, flat};
+  static FloorCue other{g_rig, flat};
+  static FloorCue updated{g_rig, updating_by_a_quarter(flat)};
+  learn_apart_and_together(one, other, updated);
+  CHECK_FALSE(updated.model().textured);
+  CHECK(other.model().tolerance[0] > one.model().tolerance[0] + 5.0F);  // the spreads differ
+  CHECK(other.model().tolerance[1] > one.model().tolerance[1] + 0.5F);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const auto quarter_way = [](float from, float to) { return from + 0.25F * (to - from); };
+    DOUBLES_EQUAL(quarter_way(one.model().median[c], other.model().median[c]),
+                  updated.model().median[c], 1e-4);
+    DOUBLES_EQUAL(quarter_way(one.model().tolerance[c], other.model().tolerance[c]),
+                  updated.model().tolerance[c], 1e-4);
+  }
+}
+
+// An update moves a textured floor's histogram by the learning rate towards the region's, bin
+// by bin, and its shares with it: a quarter of the way with learn_rate 0.25, between two
+// regions of the same colours in different proportions.
+TEST(FloorCue, AnUpdateMovesATexturedFloorsHistogramByTheLearningRate) {
+  const FloorCueParams flat = flat_trusting();
+  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
+  fill_patches(g_frame2, {40.0F, 40.0F, 100.0F, 160.0F, 220.0F});
+  static FloorCue one{g_rig, flat};
+  static FloorCue other{g_rig, flat};
+  static FloorCue updated{g_rig, updating_by_a_quarter(flat)};
+  learn_apart_and_together(one, other, updated);
+  CHECK(updated.model().textured);
+  double apart = 0.0;
+  for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
+    const float from = one.model().mass[b];
+    const float to = other.model().mass[b];
+    apart += std::fabs(static_cast<double>(to - from));
+    DOUBLES_EQUAL(from + 0.25F * (to - from), updated.model().mass[b], 1e-6);
+    const float from_share = one.model().share[b];
+    DOUBLES_EQUAL(from_share + 0.25F * (other.model().share[b] - from_share),
+                  updated.model().share[b], 1e-5);
+  }
+  CHECK(apart > 0.1);  // the two regions' histograms differ
+}
+
+// Vignetting dims a pixel's chroma as it dims its luma (the offsets from 128 shrink with it),
+// and is undone in both chroma channels: a plain floor of Cb +20 and Cr −20 drawn with the
+// fall-off is learned as that colour, and looks like floor in every corner.
+TEST(FloorCue, VignettingIsUndoneInBothChromaChannels) {
+  FloorCueParams p = trusting();
+  p.vignetting = 0.3F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const float cx = 0.5F * static_cast<float>(camera.width_px - 1);
+  const float cy = 0.5F * static_cast<float>(camera.height_px - 1);
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t v) {
+    const float dx = static_cast<float>(u) - cx;
+    const float dy = static_cast<float>(v) - cy;
+    const float fall = 1.0F - p.vignetting * (dx * dx + dy * dy) / (cx * cx + cy * cy);
+    return std::array<float, 3>{16.0F + (120.0F - 16.0F) * fall, 20.0F * fall, -20.0F * fall};
+  });
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(fresh.model().textured);
+  // The frame's chroma levels are whole (truncated): a level at most, divided by the fall-off.
+  DOUBLES_EQUAL(20.0, fresh.model().median[1], 1.5);
+  DOUBLES_EQUAL(-20.0, fresh.model().median[2], 1.5);
+  const std::uint32_t right = camera.width_px - 1;
+  const std::uint32_t bottom = camera.height_px - 1;
+  for (const auto& [u, v] :
+       {std::pair{0U, 0U}, std::pair{right, 0U}, std::pair{0U, bottom}, std::pair{right, bottom}}) {
+    float contrast = 0.0F;
+    CHECK(fresh.looks_like_floor(g_frame, u, v, contrast));
+  }
+}
+
+// Only pixels next to each other on a row of the region are neighbours, not the last of one
+// row and the first of the next: rows of one tone each, alternating between luma 60 and 200,
+// change colour nowhere along a row, so the region is no texture however few changes a texture
+// needs (here one pair in a million), and, two colours, not one plain surface either.
+TEST(FloorCue, RowsOfOneToneEachAreNoTextureHoweverFewChangesOneNeeds) {
+  FloorCueParams p = flat_trusting();
+  p.texture_min_edges = 1e-6F;
+  static FloorCue fresh{g_rig, p};
+  fresh.reset();
+  paint(g_frame, [](std::uint32_t, std::uint32_t v) {
+    return std::array<float, 3>{v % 2 == 0 ? 60.0F : 200.0F, 0.0F, 0.0F};
+  });
+  CHECK(FloorLearn::kNotUniform == fresh.learn(g_frame, 0.0F, kLookTilt));
+  CHECK_FALSE(fresh.model().valid);
+}
+
+// A frame of no pixels seen before the model is neither kept nor dropped: there is nothing to
+// keep, no slot is taken, and once the model comes no kept frame is walked.
+TEST(FloorCue, AnEmptyFrameSeenBeforeTheModelIsNeitherKeptNorDropped) {
+  static FloorCue fresh{g_rig, flat_trusting()};
+  fresh.reset();
+  for (const bool no_width : {true, false}) {
+    fill_patches(g_frame2, {120.0F});
+    (no_width ? g_frame2.width : g_frame2.height) = 0;
+    out.obstacles.clear();
+    out.free.clear();
+    out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+    CHECK_FALSE(out.result.model_valid);
+    CHECK_FALSE(out.result.deferred);
+    CHECK_FALSE(out.result.deferred_dropped);
+  }
+  fill_patches(g_frame, {120.0F});
+  CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
+  out.result = fresh.process(g_frame, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(0U, out.result.deferred_walked);
+  CHECK_EQUAL(out.result.columns, out.result.free_readings);  // the frame itself, all free
+}
+
+// A boundary is boundary_run non-floor samples in a row, at least 1 (and at most 8): a line one
+// pixel high across the floor (the image's middle row) ends nearly every walk with a run of 1,
+// and none with the default run of 3 (one sample of it, and the floor goes on).
+TEST(FloorCue, ABoundaryRunOfOneEndsAWalkAtItsFirstSampleNotLikeTheFloor) {
+  FloorCueParams p = flat_trusting();
+  static std::optional<FloorCue> configured_cue;  // large: not on the stack
+  for (const auto& [configured, taken] :
+       {std::pair{0U, 1U}, std::pair{1U, 1U}, std::pair{8U, 8U}, std::pair{9U, 8U}}) {
+    p.boundary_run = configured;
+    configured_cue.emplace(g_rig, p);
+    CHECK_EQUAL(taken, configured_cue->params().boundary_run);
+  }
+  p.boundary_run = 1;
+  static FloorCue one{g_rig, p};
+  static FloorCue three{g_rig, flat_trusting()};
+  const std::uint32_t middle = g_rig.low_res_camera().height_px / 2;
+  for (FloorCue* run_of : {&one, &three}) {
+    learned_on_flat_floor(*run_of);
+    paint(g_frame2, [&](std::uint32_t, std::uint32_t v) {
+      return std::array<float, 3>{v == middle ? 220.0F : 120.0F, 0.0F, 0.0F};
+    });
+    out.obstacles.clear();
+    out.free.clear();
+    out.result = run_of->process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+    CHECK(out.result.columns >= 60U);
+    if (run_of == &one) {
+      CHECK(10 * out.result.boundaries >= 9 * out.result.columns);
+    } else {
+      CHECK_EQUAL(0U, out.result.boundaries);
+    }
+  }
+}
+
+namespace {
+
+// Where a floor point along a walk's azimuth [rad] at horizontal distance rho [m] from the PTU
+// centre lies in the image of `pose`'s camera (the walks' own geometry: the azimuth is that of the
+// vertical plane through the optical centre).
+Eigen::Vector2f pixel_of_walk_point(const boticelli::stereo::CameraPose& pose, float azimuth,
+                                    float rho) {
+  const Eigen::Vector2f c(pose.centre_m.x(), pose.centre_m.y());
+  const Eigen::Vector2f a(std::cos(azimuth), std::sin(azimuth));
+  const float along = c.dot(a);
+  const float s = -along + std::sqrt(along * along - c.squaredNorm() + rho * rho);
+  const Eigen::Vector2f on_floor = c + s * a;
+  Eigen::Vector2f pixel;
+  CHECK(RigModel::project_ptu(
+      pose, g_rig.low_res_camera(),
+      Eigen::Vector3f(on_floor.x(), on_floor.y(), -g_rig.params().ptu_height_m), pixel));
+  return pixel;
+}
+
+}  // namespace
+
+// A walk begins where its plane leaves the frame below, at a sample that rounds to a pixel of
+// the frame: in a frame of the image's 41 left columns, the planes of the columns on its right
+// lean towards the image's centre below and leave the frame by its right side, and there too the
+// walks' near ends lie within half a pixel of its last column.
+TEST(FloorCue, EveryWalkBeginsAtASampleThatRoundsToAPixelOfTheFrame) {
+  static FloorCue fresh{g_rig, flat_trusting()};
+  learned_on_flat_floor(fresh);
+  constexpr std::uint32_t kWidth = 41;
+  fill_patches(g_frame2, {120.0F});
+  g_frame2.width = kWidth;
+  out.obstacles.clear();
+  out.free.clear();
+  out.result = fresh.process(g_frame2, 0.0F, kLookTilt, out.obstacles, out.free);
+  CHECK_EQUAL(21U, out.result.columns);
+  const boticelli::stereo::CameraPose pose = g_rig.camera_pose(0.0F, kLookTilt);
+  std::size_t by_the_side = 0;
+  for (std::size_t i = 0; i < fresh.column_count(); ++i) {
+    const FloorColumn& col = fresh.column(i);
+    const Eigen::Vector2f near = pixel_of_walk_point(pose, col.azimuth_rad, col.near_rho_m);
+    CHECK(near.x() >= -0.5F && near.x() < static_cast<float>(kWidth) - 0.5F);
+    CHECK(near.y() >= -0.5F && near.y() < static_cast<float>(g_frame2.height) - 0.5F);
+    by_the_side += near.x() > static_cast<float>(kWidth) - 1.0F ? 1U : 0U;
+  }
+  CHECK(by_the_side >= 1U);
 }
