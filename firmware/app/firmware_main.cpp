@@ -446,6 +446,7 @@ int firmware_main(int argc, const char* const* argv, Board& board, const MainHoo
   hal.pan_tilt.halt();
   if (watchdog_armed) hal.watchdog.stop();
   hal.status_led.write(false);  // off: the firmware is not running
+  console.send_final_telemetry(hal.clock.now_us());
   console.log(LogLevel::kInfo, "stopping: %s", stop_reason);
   console.log(LogLevel::kInfo,
               "mission cpu look_s=%.2f think_s=%.2f plan_s=%.2f register_s=%.3f registered=%u",

@@ -816,6 +816,14 @@ void Console::send_telemetry(std::uint64_t now_us) {
   const auto period_us = static_cast<std::uint64_t>(telemetry_ms_) * 1000U;
   next_telemetry_us_ += period_us;
   if (next_telemetry_us_ <= now_us) next_telemetry_us_ = now_us + period_us;  // no bursts
+  emit_telemetry(now_us);
+}
+
+void Console::send_final_telemetry(std::uint64_t now_us) {
+  if (telemetry_ms_ > 0.0F) emit_telemetry(now_us);
+}
+
+void Console::emit_telemetry(std::uint64_t now_us) {
   const core::Pose2 p = view_.pose();
   TextBuffer<256> line;
   line.appendf(

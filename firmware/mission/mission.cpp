@@ -424,6 +424,13 @@ void Mission::at_standoff(std::uint64_t now_us, bool planner_at_goal) {
     return finish(Result::kFound, "within the stand-off of the target, seen from there",
                   Ending::kFinal);
   }
+  // A candidate gone to before it was confirmed, not seen from its stand-off: a false
+  // detection seen twice from one place; it is never a goal again unless two places agree.
+  if (!tracker_.confirmed() && tracker_.dismiss_candidate()) {
+    end_cycle("target candidate not seen from its stand-off: dismissed");
+    if (phase_ != Phase::kDone) begin_look(now_us);
+    return;
+  }
   // Not seen from its stand-off: a miss (unless the aimed pair counted it already).
   const bool revoked = !look_missed_target_ && tracker_.missed();
   end_cycle(revoked ? "target revoked: not seen from its stand-off"
@@ -476,9 +483,9 @@ void Mission::control_drive(std::uint64_t now_us) {
   // The robot's disc stood everywhere along the move: nothing stands there.
   (void)map_.swept({drive_from_.x_m, drive_from_.y_m}, {here.x_m, here.y_m},
                    config_.robot_radius_m);
-  if (tracker_.confirmed()) {
-    const Eigen::Vector3f& g = tracker_.estimate_m();
-    if (core::distance_m({here.x_m, here.y_m}, {g.x(), g.y()}) <=
+  core::Point2 g{};
+  if (target_goal(g)) {
+    if (core::distance_m({here.x_m, here.y_m}, g) <=
         params_.rewards.goal_standoff_m + params_.step.arrival_tolerance_m) {
       // Found only once it is seen again from here: a glance at it first.
       end_cycle("at the target's stand-off");
@@ -830,16 +837,26 @@ void Mission::after_think() {
 void Mission::begin_plan() {
   plan_step_ = PlanStep::kValue;
   core::Point2 goal{};
-  if (tracker_.confirmed()) goal = {tracker_.estimate_m().x(), tracker_.estimate_m().y()};
-  planner_.start_value(map_.global(), map_.grid(), tracker_.confirmed() ? &goal : nullptr,
+  const bool has_goal = target_goal(goal);
+  planner_.start_value(map_.global(), map_.grid(), has_goal ? &goal : nullptr,
                        {look_pose_.x_m, look_pose_.y_m},
-                       static_cast<std::uint32_t>(state_.seed * 7919U + state_.cycle));
+                       static_cast<std::uint32_t>(state_.seed * 7919U + state_.cycle),
+                       has_goal && !tracker_.confirmed());
+}
+
+bool Mission::target_goal(core::Point2& goal) const {
+  const bool candidate = params_.candidate_as_goal && tracker_.provisional();
+  if (!tracker_.confirmed() && !candidate) return false;
+  const Eigen::Vector3f& g = tracker_.confirmed() ? tracker_.estimate_m() : tracker_.candidate_m();
+  goal = {g.x(), g.y()};
+  return true;
 }
 
 bool Mission::start_step_choice() {
   const core::Pose2 here = pose_.pose();
+  core::Point2 goal{};
   switch (planner_.begin_choice(here, map_.local().navigable,
-                                map_.global().exploration().size() != 0, tracker_.confirmed())) {
+                                map_.global().exploration().size() != 0, target_goal(goal))) {
     case StepOutcome::kChoosing:
       return true;
     case StepOutcome::kNothingLeft:

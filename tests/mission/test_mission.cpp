@@ -557,6 +557,40 @@ TEST(MissionThesisRoom, AConfirmedTargetGoneWhenTheRobotArrivesIsMissedThenRevok
   CHECK_TEXT(revoked, entries.c_str());
 }
 
+// A candidate two views of the first look agree on is gone to before any second place has
+// seen it (MissionParams::candidate_as_goal); taken away as the robot comes near, it is not
+// seen from its stand-off and is dismissed: never confirmed, not found, nothing touched.
+TEST(MissionThesisRoom, ACandidateGoneWhenTheRobotArrivesIsDismissedNotConfirmed) {
+  char dir_template[] = "/tmp/boticelli-dismiss-XXXXXX";
+  const std::string dir = mkdtemp(dir_template);
+  TakeTarget take;
+  boticelli::firmware::MainHooks hooks;
+  hooks.after_frame = on_frame_take_target;
+  hooks.context = &take;
+  const MissionRun r = run_mission("rectangular_room", "1", 0.0F, &hooks,
+                                   {"--state", dir.c_str(), "--max-cycles", "4"});
+  static boticelli::firmware::MissionState state;
+  std::string error;
+  const bool loaded = load_state(dir, state, error);
+  remove_state_dir(dir);
+  CHECK_TEXT(loaded, error.c_str());
+  CHECK(take.removed);
+  CHECK_TEXT(!r.telemetry_confirmed, r.mission_line.c_str());
+  CHECK_TEXT(r.mission_line.find("result=found") == std::string::npos, r.mission_line.c_str());
+  UNSIGNED_LONGS_EQUAL(0, r.check.collisions);
+  std::vector<std::string> entries;
+  std::string all;
+  for (const boticelli::firmware::MissionLogEntry& e : state.log) {
+    entries.emplace_back(e.text.data());
+    all += entries.back() + " | ";
+  }
+  // The first cycle: the candidate's stand-off reached; the glance's miss dismisses it.
+  CHECK_TEXT(entries.size() >= 2, all.c_str());
+  STRCMP_CONTAINS_TEXT("at the target's stand-off", entries[0].c_str(), all.c_str());
+  STRCMP_CONTAINS_TEXT("target candidate not seen from its stand-off: dismissed",
+                       entries[1].c_str(), all.c_str());
+}
+
 TEST(MissionRooms, EveryOtherShippedRoomWithATargetIsFoundWithoutTouchingAnything) {
   for (const char* world : {"box_in_cylindrical_room", "box_in_rectangular_room", "cluttered_room",
                             "corridor", "cylindrical_room", "cylindrical_room_offcentre",

@@ -14,8 +14,10 @@ void StepPlanner::clear() {
 }
 
 void StepPlanner::start_value(const mapping::GlobalMap& map, const worldmap::GridMap& grid,
-                              const core::Point2* goal, core::Point2 centre, std::uint32_t seed) {
+                              const core::Point2* goal, core::Point2 centre, std::uint32_t seed,
+                              bool provisional) {
   has_goal_ = goal != nullptr;
+  provisional_ = has_goal_ && provisional;
   if (has_goal_) goal_ = *goal;
   path_mode_ = !params_.thesis_planner;
   // The wavefront: for the frontier planner, and for the thesis's too once the target is
@@ -28,7 +30,7 @@ void StepPlanner::start_value(const mapping::GlobalMap& map, const worldmap::Gri
   sources.obstacles = map.obstacles().span();
   sources.exploration = map.exploration().span();
   sources.visited = trail_.points();
-  sources.has_goal = goal != nullptr;
+  sources.has_goal = has_goal_ && !provisional_;
   if (sources.has_goal) sources.goal = *goal;
   planning::ValueIterationParams vp = params_.value;
   vp.seed = seed;
@@ -48,6 +50,8 @@ StepOutcome StepPlanner::begin_choice(const core::Pose2& here,
     nav_choice_ = nav_.choose_target(goal_, params_.rewards.goal_standoff_m);
     path_mode_ = nav_choice_.kind == worldmap::NavGoalKind::kTarget;
   }
+  // A candidate with no way to its stand-off is no goal: explore as without one.
+  if (params_.thesis_planner && provisional_ && !path_mode_) has_goal = false;
   if (!has_exploration && !has_goal) {
     // Turn round and look once more before giving up: the sector behind the robot is seen
     // only by the image's edges at the PTU's pan limits (or not at all, if the pans and the

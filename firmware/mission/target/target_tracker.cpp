@@ -19,20 +19,42 @@ bool TargetTracker::missed() {
   if (!confirmed_ || params_.revoke_after_misses == 0) return false;
   if (++misses_ < params_.revoke_after_misses) return false;
   // Forget the target's sightings (those its estimate was refined from) and look again.
+  forget_near(estimate_);
+  ++revocations_;
+  return true;
+}
+
+bool TargetTracker::provisional() const {
+  if (confirmed_ || count_ == 0 || support_ < params_.min_views) return false;
+  const float r2 = params_.agree_radius_m * params_.agree_radius_m;
+  for (std::size_t i = 0; i < dismissed_count_; ++i) {
+    if ((dismissed_[i] - candidate_).squaredNorm() <= r2) return false;
+  }
+  return true;
+}
+
+bool TargetTracker::dismiss_candidate() {
+  if (!provisional()) return false;
+  dismissed_[dismissed_next_] = candidate_;
+  dismissed_next_ = (dismissed_next_ + 1) % kMaxDismissed;
+  if (dismissed_count_ < kMaxDismissed) ++dismissed_count_;
+  forget_near(candidate_);
+  return true;
+}
+
+void TargetTracker::forget_near(Eigen::Vector3f centre) {
   const float q2 = params_.refine_radius_m * params_.refine_radius_m;
   std::size_t kept = 0;
   for (std::size_t i = 0; i < count_; ++i) {
-    if ((sightings_[i].point - estimate_).squaredNorm() > q2) sightings_[kept++] = sightings_[i];
+    if ((sightings_[i].point - centre).squaredNorm() > q2) sightings_[kept++] = sightings_[i];
   }
   count_ = kept;
   next_ = kept % kMaxSightings;
   confirmed_ = false;
   misses_ = 0;
-  ++revocations_;
   estimate_ = candidate_ = Eigen::Vector3f::Zero();
   support_ = 0;
   if (count_ > 0) update_estimate();
-  return true;
 }
 
 bool TargetTracker::has_baseline(const Eigen::Vector3f& centre, float r2) const {

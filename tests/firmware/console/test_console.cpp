@@ -860,6 +860,26 @@ TEST(Console, SendsTelemetryAtTheConfiguredPeriod) {
   CHECK_EQUAL(0U, port.written().size());
 }
 
+// At the orderly stop one more line, whatever the period: the state the mission ended in.
+TEST(Console, SendsOneFinalTelemetryLineAtTheStopUnlessTelemetryIsOff) {
+  CHECK_EQUAL("OK", command("set telemetry_ms 500").at(0));
+  service(1);
+  port.clear_written();
+  service(10);  // 0.1 s: the next periodic line is 0.4 s away
+  CHECK_EQUAL(0U, port.written().size());
+  console.send_final_telemetry(now_us);
+  console.drain();
+  const auto out = lines_of(port.written());
+  CHECK_EQUAL(1U, out.size());
+  STRCMP_CONTAINS("TLM t_s=", out[0].c_str());
+  STRCMP_CONTAINS("state=look cycles=4 ", out[0].c_str());
+  CHECK_EQUAL("OK", command("set telemetry_ms 0").at(0));
+  port.clear_written();
+  console.send_final_telemetry(now_us);
+  console.drain();
+  CHECK_EQUAL(0U, port.written().size());
+}
+
 TEST(Console, SurvivesAFloodOfRandomBytesAndStillAnswers) {
   std::uint32_t x = 12345;
   std::string noise;

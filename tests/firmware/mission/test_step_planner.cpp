@@ -542,6 +542,25 @@ TEST(ThesisPlannerTargetByPath, WithoutAPathToTheStandOffTheValueFunctionChooses
   CHECK(boticelli::core::distance_m({0.0F, 0.0F}, planner.target()) <= params.value.step_m + 1e-5F);
 }
 
+// A provisional goal (a candidate not yet confirmed) is approached by path as a confirmed one
+// is; one the grid shows no way to draws no cone and is no goal: with nothing to explore the
+// robot turns round, where a confirmed goal out of reach keeps it choosing by the cones.
+TEST(ThesisPlannerTargetByPath, AProvisionalGoalIsAGoalOnlyWhenTheGridShowsAWayToItsStandOff) {
+  const auto begin = [&](const Point2& goal, bool provisional) {
+    planner.start_value(map, g_grid, &goal, {0.0F, 0.0F}, 1, provisional);
+    CHECK(planner.value().sources().has_goal == !provisional);
+    while (!planner.value_done()) planner.value_unit();
+    return planner.begin_choice(origin, look, false, true);
+  };
+  params.final_approach_m = 0.0F;
+  CHECK(begin({1.3F, 0.9F}, true) == StepOutcome::kChoosing);
+  while (!planner.choice_done()) planner.choose_heading();
+  CHECK(planner.end_choice(origin, origin, look, crumbs) == StepOutcome::kMove);
+  CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kTarget);
+  CHECK(begin({20.0F, 0.0F}, true) == StepOutcome::kTurnRound);
+  CHECK(begin({20.0F, 0.0F}, false) == StepOutcome::kChoosing);
+}
+
 TEST(ThesisPlannerTargetByPath, NoTargetNoWavefront) {
   CHECK(plan(nullptr) == StepOutcome::kMove);
   CHECK(planner.nav_choice().kind == boticelli::worldmap::NavGoalKind::kNone);

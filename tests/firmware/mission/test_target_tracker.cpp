@@ -401,3 +401,89 @@ TEST(TargetTracker, ARevocationThatForgetsEverySightingLeavesNoEstimateNorCandid
   check_near(Eigen::Vector3f::Zero(), tracker.estimate_m(), 0.0F);
   check_near(Eigen::Vector3f::Zero(), tracker.candidate_m(), 0.0F);
 }
+
+// Two views of one look agree: not confirmed (one place), but a provisional goal to go and see
+// from its stand-off; one view alone, or a confirmed target, is not provisional.
+TEST(TargetTracker, TwoViewsFromOnePlaceMakeAProvisionalCandidateNotAConfirmedOne) {
+  TargetTrackerParams p;
+  p.min_baseline_m = 0.2F;
+  tracker.configure(p);
+  CHECK_FALSE(tracker.provisional());
+  tracker.add(kTarget, 0.9F, 1, 0.1F, {0.0F, 0.0F});
+  CHECK_FALSE(tracker.provisional());
+  tracker.add(kTarget + Eigen::Vector3f(0.05F, 0.0F, 0.0F), 0.9F, 2, 0.1F, {0.0F, 0.0F});
+  CHECK(tracker.provisional());
+  CHECK_FALSE(tracker.confirmed());
+  check_near(kTarget + Eigen::Vector3f(0.025F, 0.0F, 0.0F), tracker.candidate_m(), 1e-5F);
+  // Seen from its stand-off (a second place): confirmed, no longer provisional.
+  tracker.add(kTarget, 0.9F, 3, 0.1F, {1.0F, 0.0F});
+  CHECK(tracker.confirmed());
+  CHECK_FALSE(tracker.provisional());
+  CHECK_FALSE(tracker.dismiss_candidate());
+  CHECK(tracker.confirmed());
+}
+
+// Not seen from its stand-off: the candidate's sightings are forgotten (others kept), and its
+// place never makes a provisional candidate again, though two places can still confirm it.
+TEST(TargetTracker, ADismissedCandidatesPlaceIsNeverProvisionalAgainButCanBeConfirmed) {
+  TargetTrackerParams p;
+  p.min_baseline_m = 0.2F;
+  tracker.configure(p);
+  const Eigen::Vector3f other = kTarget + Eigen::Vector3f(3.0F, 0.0F, 0.0F);
+  tracker.add(other, 0.9F, 1, 0.1F, {0.0F, 0.0F});
+  tracker.add(kTarget, 0.9F, 2, 0.1F, {0.0F, 0.0F});
+  tracker.add(kTarget, 0.9F, 3, 0.1F, {0.0F, 0.0F});
+  CHECK(tracker.provisional());
+  CHECK(tracker.dismiss_candidate());
+  UNSIGNED_LONGS_EQUAL(1, tracker.dismissed());
+  UNSIGNED_LONGS_EQUAL(1, tracker.sightings());
+  check_near(other, tracker.candidate_m(), 1e-5F);
+  CHECK_FALSE(tracker.provisional());  // the lone sighting elsewhere: one view
+  CHECK_FALSE(tracker.dismiss_candidate());
+  // Two views of one look at the dismissed place again: not provisional.
+  tracker.add(kTarget, 0.9F, 4, 0.1F, {0.5F, 0.0F});
+  tracker.add(kTarget + Eigen::Vector3f(0.0F, 0.0F, p.agree_radius_m), 0.9F, 5, 0.1F, {0.5F, 0.0F});
+  CHECK_FALSE(tracker.confirmed());
+  CHECK_FALSE(tracker.provisional());
+  // Two views at the other sighting's place are: it was never dismissed.
+  tracker.add(other, 0.9F, 6, 0.1F, {0.0F, 0.0F});
+  tracker.add(other, 0.9F, 7, 0.1F, {0.0F, 0.0F});
+  CHECK(tracker.provisional());
+  check_near(other, tracker.candidate_m(), 1e-5F);
+  tracker.add(other, 0.9F, 8, 0.1F, {0.0F, 1.0F});
+  CHECK(tracker.confirmed());
+  // The dismissed place seen from a second place too: a group as large as the other one,
+  // and confirmable (here the other keeps the estimate, having more views).
+  tracker.add(kTarget, 0.9F, 9, 0.1F, {0.0F, 1.0F});
+  CHECK(tracker.confirmed());
+  check_near(other, tracker.estimate_m(), 1e-5F);
+}
+
+// The dismissed places are a ring of the last kMaxDismissed; clear() forgets them.
+TEST(TargetTracker, OnlyTheLastDismissedPlacesAreKeptAndClearForgetsThem) {
+  const auto place = [](std::size_t i) -> Eigen::Vector3f {
+    return kTarget + Eigen::Vector3f(static_cast<float>(i), 0.0F, 0.0F);
+  };
+  std::uint32_t view = 0;
+  const auto two_views = [&](const Eigen::Vector3f& at) {
+    tracker.add(at, 0.9F, ++view);
+    tracker.add(at, 0.9F, ++view);
+  };
+  TargetTrackerParams p;
+  p.min_baseline_m = 0.2F;
+  tracker.configure(p);
+  for (std::size_t i = 0; i <= TargetTracker::kMaxDismissed; ++i) {
+    two_views(place(i));
+    CHECK(tracker.dismiss_candidate());
+  }
+  UNSIGNED_LONGS_EQUAL(TargetTracker::kMaxDismissed, tracker.dismissed());
+  two_views(place(0));  // the oldest place, overwritten: provisional again
+  CHECK(tracker.provisional());
+  CHECK(tracker.dismiss_candidate());
+  two_views(place(TargetTracker::kMaxDismissed));  // a recent one: still dismissed
+  CHECK_FALSE(tracker.provisional());
+  tracker.clear();
+  UNSIGNED_LONGS_EQUAL(0, tracker.dismissed());
+  two_views(place(TargetTracker::kMaxDismissed));
+  CHECK(tracker.provisional());
+}

@@ -66,6 +66,9 @@ class Console {
   void service(std::uint64_t now_us);
   // Sends queued output only (no input, telemetry or health lines): for the shutdown drain.
   void drain() { flush(); }
+  // One TLM line now, whatever the period (unless telemetry is off): at the orderly stop, the
+  // state the mission ended in (a target confirmed in the mission's last second is shown).
+  void send_final_telemetry(std::uint64_t now_us);
   // A log line ("LOG <level> <text>") when `level` is within the console's log level.
   void log(LogLevel level, const char* format, ...) __attribute__((format(printf, 3, 4)));
 
@@ -107,6 +110,7 @@ class Console {
   void check_state_saves();
   void append_unhealthy(TextBufferBase& out) const;
   void send_telemetry(std::uint64_t now_us);
+  void emit_telemetry(std::uint64_t now_us);
 
   void cmd_help(const Words& w);
   void cmd_status(const Words& w);

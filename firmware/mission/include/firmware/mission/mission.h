@@ -256,6 +256,9 @@ class Mission final : public MissionView, public BackgroundWork, public FrameCon
   // The look's registration applied: the look's pose, and the mission's from now on.
   void localize();
   void after_think();
+  // The target's place as the plan's goal: the confirmed estimate, else a provisional
+  // candidate (MissionParams::candidate_as_goal). False when there is neither.
+  [[nodiscard]] bool target_goal(core::Point2& goal) const;
   void begin_plan();
   // After the value iteration: gives up or turns round when nothing is left to explore, else
   // starts choosing the step (true).

@@ -75,6 +75,11 @@ struct MissionParams {
   // With the thesis's planner: a confirmed target whose stand-off the grid shows a path to is
   // approached along that path (else by the cones).
   bool target_by_path = true;
+  // A candidate two views of one look agree on (TargetTracker::provisional) is a goal as a
+  // confirmed target is: the robot goes to its stand-off, where a glance confirms it (the
+  // second place) or dismisses it. false: it is only looked at again from wherever the
+  // exploration leads (an exploration point at its stand-off for the thesis's planner).
+  bool candidate_as_goal = true;
   worldmap::GridMapParams grid;
   worldmap::LookFusionParams fusion;
   // Every look registered against the grid before it is fused, its pose the mission's

@@ -42,9 +42,12 @@ class StepPlanner {
   // The plan's groundwork around `centre` (mission frame; where the robot looked from) with
   // the target's estimate as the goal (nullptr: none confirmed): the wavefront on `grid`, or
   // (thesis planner) value iteration on the global lists, the trail and the goal, its random
-  // states drawn from `seed`.
+  // states drawn from `seed`. A `provisional` goal (a candidate not yet confirmed) is a goal
+  // only by path: when the grid shows no way to its stand-off it draws no cone and counts as
+  // no goal (the thesis planner explores; the frontier planner picks a frontier).
   void start_value(const mapping::GlobalMap& map, const worldmap::GridMap& grid,
-                   const core::Point2* goal, core::Point2 centre, std::uint32_t seed);
+                   const core::Point2* goal, core::Point2 centre, std::uint32_t seed,
+                   bool provisional = false);
   [[nodiscard]] bool value_done() const {
     return (!params_.thesis_planner || value_.done()) && (!nav_needed_ || nav_.done());
   }
@@ -115,6 +118,7 @@ class StepPlanner {
   bool path_mode_ = false;       // this plan's step follows the wavefront's path
   bool final_approach_ = false;  // the step is the final approach (grid only) to the stand-off
   bool has_goal_ = false;        // the target's estimate, for the nav planner
+  bool provisional_ = false;     // ... a candidate not yet confirmed: a goal only by path
   core::Point2 goal_{};
   planning::Trail trail_;
   planning::StepChooser chooser_;

@@ -42,6 +42,7 @@ class TargetTracker {
     confirmed_ = false;
     misses_ = revocations_ = 0;
     estimate_ = candidate_ = Eigen::Vector3f::Zero();
+    dismissed_count_ = dismissed_next_ = 0;
   }
   // A goal confirmed before a restart: confirmed at once, as if seen from two places.
   void restore(const Eigen::Vector3f& goal_world_m);
@@ -74,6 +75,16 @@ class TargetTracker {
   // The largest group's mean even when too few views agree (valid when sightings() > 0): a
   // sighting to look at again from closer.
   [[nodiscard]] const Eigen::Vector3f& candidate_m() const { return candidate_; }
+  // A candidate that min_views views agree on, all seen from one place (the pans of one
+  // look), so not confirmed: worth going to, where a view from its stand-off (a second
+  // place) confirms it. Never one within agree_radius_m of a dismissed candidate.
+  [[nodiscard]] bool provisional() const;
+  // The provisional candidate was not seen from its stand-off: its sightings are forgotten
+  // and its place kept (the last kMaxDismissed), so sightings there are never provisional
+  // again; they can still be confirmed from two places. False when there is none.
+  bool dismiss_candidate();
+  static constexpr std::size_t kMaxDismissed = 8;
+  [[nodiscard]] std::size_t dismissed() const { return dismissed_count_; }
 
  private:
   struct Sighting {
@@ -86,6 +97,8 @@ class TargetTracker {
   void update_estimate();
   // Whether the group within r2 of `centre` holds two sightings seen min_baseline_m apart.
   [[nodiscard]] bool has_baseline(const Eigen::Vector3f& centre, float r2) const;
+  // Forgets the sightings within refine_radius_m of `centre`; the estimate starts afresh.
+  void forget_near(Eigen::Vector3f centre);
 
   TargetTrackerParams params_{};
   std::array<Sighting, kMaxSightings> sightings_{};
@@ -97,6 +110,9 @@ class TargetTracker {
   std::size_t support_ = 0;
   Eigen::Vector3f estimate_ = Eigen::Vector3f::Zero();
   Eigen::Vector3f candidate_ = Eigen::Vector3f::Zero();
+  std::array<Eigen::Vector3f, kMaxDismissed> dismissed_{};
+  std::size_t dismissed_count_ = 0;
+  std::size_t dismissed_next_ = 0;
 };
 
 }  // namespace boticelli::firmware::mission
