@@ -2051,6 +2051,30 @@ TEST(FloorCue, AnUpdateMovesAPlainFloorsMediansAndTolerancesByTheLearningRate) {
   }
 }
 
+// A learning rate outside [0, 1] is held to it: above 1 an update takes the region's model
+// whole (not beyond it), below 0 it leaves the model as it was (not moved away).
+TEST(FloorCue, ALearningRateOutsideZeroToOneIsHeldToIt) {
+  paint_unlike_spreads();
+  FloorCueParams too_high = updating_by_a_quarter(flat_trusting());
+  too_high.learn_rate = 3.0F;
+  FloorCueParams too_low = too_high;
+  too_low.learn_rate = -1.0F;
+  static FloorCue one{g_rig, flat_trusting()};
+  static FloorCue other{g_rig, flat_trusting()};
+  static FloorCue high{g_rig, too_high};
+  static FloorCue low{g_rig, too_low};
+  DOUBLES_EQUAL(1.0, high.params().learn_rate, 0.0);
+  DOUBLES_EQUAL(0.0, low.params().learn_rate, 0.0);
+  learn_apart_and_together(one, other, high);
+  learn_apart_and_together(one, other, low);
+  for (std::size_t c = 0; c < 3; ++c) {
+    DOUBLES_EQUAL(other.model().median[c], high.model().median[c], 1e-4);
+    DOUBLES_EQUAL(other.model().tolerance[c], high.model().tolerance[c], 1e-4);
+    DOUBLES_EQUAL(one.model().median[c], low.model().median[c], 1e-4);
+    DOUBLES_EQUAL(one.model().tolerance[c], low.model().tolerance[c], 1e-4);
+  }
+}
+
 // An update moves a textured floor's histogram by the learning rate towards the region's, bin
 // by bin, and its shares with it: a quarter of the way with learn_rate 0.25, between two
 // regions of the same colours in different proportions.

@@ -40,7 +40,7 @@ class StepPlanner {
   // A run starts: no trail, no failed cycles, not turned round anywhere, no goal kept.
   void clear();
   // The plan's groundwork around `centre` (mission frame; where the robot looked from) with
-  // the target's estimate as the goal (nullptr: none confirmed): the wavefront on `grid`, or
+  // the target's estimate as the goal (nullptr: none): the wavefront on `grid`, or
   // (thesis planner) value iteration on the global lists, the trail and the goal, its random
   // states drawn from `seed`. A `provisional` goal (a candidate not yet confirmed) is a goal
   // only by path: when the grid shows no way to its stand-off it draws no cone and counts as
