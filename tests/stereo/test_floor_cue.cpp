@@ -1113,6 +1113,34 @@ TEST(FloorCue, ATexturedFloorsShareOfABinIsTheMassOfItAndOfEveryBinNextToIt) {
   }
 }
 
+namespace {
+
+// g_frame a plain floor of `ycbcr` (luma, and Cb and Cr as offsets from 128) at the image's
+// centre, dimmed towards black (luma 16, neutral chroma) by the fall-off 1 − vignetting · r²
+// (r = 1 at the corners).
+void paint_vignetted(float vignetting, const std::array<float, 3>& ycbcr) {
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const float cx = 0.5F * static_cast<float>(camera.width_px - 1);
+  const float cy = 0.5F * static_cast<float>(camera.height_px - 1);
+  paint(g_frame, [&](std::uint32_t u, std::uint32_t v) {
+    const float dx = static_cast<float>(u) - cx;
+    const float dy = static_cast<float>(v) - cy;
+    const float fall = 1.0F - vignetting * (dx * dx + dy * dy) / (cx * cx + cy * cy);
+    return std::array<float, 3>{16.0F + (ycbcr[0] - 16.0F) * fall, ycbcr[1] * fall,
+                                ycbcr[2] * fall};
+  });
+}
+
+// The low-resolution image's four corner pixels (u, v).
+std::array<std::pair<std::uint32_t, std::uint32_t>, 4> image_corners() {
+  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
+  const std::uint32_t right = camera.width_px - 1;
+  const std::uint32_t bottom = camera.height_px - 1;
+  return {{{0U, 0U}, {right, 0U}, {0U, bottom}, {right, bottom}}};
+}
+
+}  // namespace
+
 // Vignetting is undone about the image's centre: a plain floor rendered with the configured
 // fall-off (1 − vignetting · r², r = 1 at the corners) looks the same in every corner as in
 // the middle.
@@ -1122,23 +1150,13 @@ TEST(FloorCue, VignettingIsUndoneAboutTheImageCentre) {
   static FloorCue fresh{g_rig, p};
   fresh.reset();
   const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
-  const float cx = 0.5F * static_cast<float>(camera.width_px - 1);
-  const float cy = 0.5F * static_cast<float>(camera.height_px - 1);
-  paint(g_frame, [&](std::uint32_t u, std::uint32_t v) {
-    const float dx = static_cast<float>(u) - cx;
-    const float dy = static_cast<float>(v) - cy;
-    const float fall = 1.0F - p.vignetting * (dx * dx + dy * dy) / (cx * cx + cy * cy);
-    return std::array<float, 3>{16.0F + (203.0F - 16.0F) * fall, 0.0F, 0.0F};
-  });
+  paint_vignetted(p.vignetting, {203.0F, 0.0F, 0.0F});
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   CHECK_FALSE(fresh.model().textured);
   DOUBLES_EQUAL(203.0, fresh.model().median[0], 1.0);
   float middle = 0.0F;
   CHECK(fresh.looks_like_floor(g_frame, camera.width_px / 2, camera.height_px / 2, middle));
-  const std::uint32_t right = camera.width_px - 1;
-  const std::uint32_t bottom = camera.height_px - 1;
-  for (const auto& [u, v] :
-       {std::pair{0U, 0U}, std::pair{right, 0U}, std::pair{0U, bottom}, std::pair{right, bottom}}) {
+  for (const auto& [u, v] : image_corners()) {
     float contrast = 0.0F;
     CHECK(fresh.looks_like_floor(g_frame, u, v, contrast));
     DOUBLES_EQUAL(middle, contrast, 0.02);
@@ -1739,27 +1757,35 @@ void paint_unlike_spreads() {
   spread(g_frame2, 126.0F, 4.0F, 1.0F);
 }
 
+// The two plain floors of unlike spreads learned apart by cues trusting their first region,
+// and both by `both` (learn_apart_and_together): its model is plain, and its median and
+// tolerance in every channel lie the fraction `w` of the way from the first floor's to the
+// second's.
+void check_plain_model_between(FloorCue& both, float w) {
+  paint_unlike_spreads();
+  static FloorCue one{g_rig, flat_trusting()};
+  static FloorCue other{g_rig, flat_trusting()};
+  learn_apart_and_together(one, other, both);
+  CHECK_FALSE(both.model().textured);
+  CHECK(other.model().tolerance[0] > one.model().tolerance[0] + 5.0F);  // the spreads differ
+  CHECK(other.model().tolerance[1] > one.model().tolerance[1] + 0.5F);
+  const auto between = [w](float from, float to) { return from + w * (to - from); };
+  for (std::size_t c = 0; c < 3; ++c) {
+    DOUBLES_EQUAL(between(one.model().median[c], other.model().median[c]), both.model().median[c],
+                  1e-4);
+    DOUBLES_EQUAL(between(one.model().tolerance[c], other.model().tolerance[c]),
+                  both.model().tolerance[c], 1e-4);
+  }
+}
+
 }  // namespace
 
 // A plain floor's model from two agreeing regions is their mean: the median and the tolerance
 // of every channel half way between the two regions' own, here of unlike spreads (luma 120 ± 2
 // and 126 ± 4, Cb 0 and 0 ± 1: robust spreads of 2 and 4, and of 0 and 1, levels).
 TEST(FloorCue, TwoPlainRegionsConfirmAModelWithTheMeanOfTheirMediansAndTolerances) {
-  const FloorCueParams flat = flat_trusting();
-  paint_unlike_spreads();
-  static FloorCue one{g_rig, flat};
-  static FloorCue other{g_rig, flat};
-  static FloorCue both{g_rig, confirming_across_1_rad(flat)};
-  learn_apart_and_together(one, other, both);
-  CHECK_FALSE(both.model().textured);
-  CHECK(other.model().tolerance[0] > one.model().tolerance[0] + 5.0F);  // the spreads differ
-  CHECK(other.model().tolerance[1] > one.model().tolerance[1] + 0.5F);
-  for (std::size_t c = 0; c < 3; ++c) {
-    DOUBLES_EQUAL(0.5F * (one.model().median[c] + other.model().median[c]), both.model().median[c],
-                  1e-4);
-    DOUBLES_EQUAL(0.5F * (one.model().tolerance[c] + other.model().tolerance[c]),
-                  both.model().tolerance[c], 1e-4);
-  }
+  static FloorCue both{g_rig, confirming_across_1_rad(flat_trusting())};
+  check_plain_model_between(both, 0.5F);
 }
 
 // A textured model from two agreeing regions has the mean of their longest runs: a region of
@@ -2033,46 +2059,23 @@ TEST(FloorCue, AWalkInOneColourFromItsBottomRowToMaxRangeSaysNothingFree) {
 // and its tolerance in every channel: a quarter of the way with learn_rate 0.25, from luma
 // 120 ± 2 towards 126 ± 4 (the two floors of unlike spreads).
 TEST(FloorCue, AnUpdateMovesAPlainFloorsMediansAndTolerancesByTheLearningRate) {
-  const FloorCueParams flat = flat_trusting();
-  paint_unlike_spreads();
-  static FloorCue one{g_rig, flat};
-  static FloorCue other{g_rig, flat};
-  static FloorCue updated{g_rig, updating_by_a_quarter(flat)};
-  learn_apart_and_together(one, other, updated);
-  CHECK_FALSE(updated.model().textured);
-  CHECK(other.model().tolerance[0] > one.model().tolerance[0] + 5.0F);  // the spreads differ
-  CHECK(other.model().tolerance[1] > one.model().tolerance[1] + 0.5F);
-  for (std::size_t c = 0; c < 3; ++c) {
-    const auto quarter_way = [](float from, float to) { return from + 0.25F * (to - from); };
-    DOUBLES_EQUAL(quarter_way(one.model().median[c], other.model().median[c]),
-                  updated.model().median[c], 1e-4);
-    DOUBLES_EQUAL(quarter_way(one.model().tolerance[c], other.model().tolerance[c]),
-                  updated.model().tolerance[c], 1e-4);
-  }
+  static FloorCue updated{g_rig, updating_by_a_quarter(flat_trusting())};
+  check_plain_model_between(updated, 0.25F);
 }
 
 // A learning rate outside [0, 1] is held to it: above 1 an update takes the region's model
 // whole (not beyond it), below 0 it leaves the model as it was (not moved away).
 TEST(FloorCue, ALearningRateOutsideZeroToOneIsHeldToIt) {
-  paint_unlike_spreads();
   FloorCueParams too_high = updating_by_a_quarter(flat_trusting());
   too_high.learn_rate = 3.0F;
   FloorCueParams too_low = too_high;
   too_low.learn_rate = -1.0F;
-  static FloorCue one{g_rig, flat_trusting()};
-  static FloorCue other{g_rig, flat_trusting()};
   static FloorCue high{g_rig, too_high};
   static FloorCue low{g_rig, too_low};
   DOUBLES_EQUAL(1.0, high.params().learn_rate, 0.0);
   DOUBLES_EQUAL(0.0, low.params().learn_rate, 0.0);
-  learn_apart_and_together(one, other, high);
-  learn_apart_and_together(one, other, low);
-  for (std::size_t c = 0; c < 3; ++c) {
-    DOUBLES_EQUAL(other.model().median[c], high.model().median[c], 1e-4);
-    DOUBLES_EQUAL(other.model().tolerance[c], high.model().tolerance[c], 1e-4);
-    DOUBLES_EQUAL(one.model().median[c], low.model().median[c], 1e-4);
-    DOUBLES_EQUAL(one.model().tolerance[c], low.model().tolerance[c], 1e-4);
-  }
+  check_plain_model_between(high, 1.0F);
+  check_plain_model_between(low, 0.0F);
 }
 
 // An update moves a textured floor's histogram by the learning rate towards the region's, bin
@@ -2108,24 +2111,13 @@ TEST(FloorCue, VignettingIsUndoneInBothChromaChannels) {
   p.vignetting = 0.3F;
   static FloorCue fresh{g_rig, p};
   fresh.reset();
-  const boticelli::stereo::CameraIntrinsics& camera = g_rig.low_res_camera();
-  const float cx = 0.5F * static_cast<float>(camera.width_px - 1);
-  const float cy = 0.5F * static_cast<float>(camera.height_px - 1);
-  paint(g_frame, [&](std::uint32_t u, std::uint32_t v) {
-    const float dx = static_cast<float>(u) - cx;
-    const float dy = static_cast<float>(v) - cy;
-    const float fall = 1.0F - p.vignetting * (dx * dx + dy * dy) / (cx * cx + cy * cy);
-    return std::array<float, 3>{16.0F + (120.0F - 16.0F) * fall, 20.0F * fall, -20.0F * fall};
-  });
+  paint_vignetted(p.vignetting, {120.0F, 20.0F, -20.0F});
   CHECK(FloorLearn::kLearned == fresh.learn(g_frame, 0.0F, kLookTilt));
   CHECK_FALSE(fresh.model().textured);
   // The frame's chroma levels are whole (truncated): a level at most, divided by the fall-off.
   DOUBLES_EQUAL(20.0, fresh.model().median[1], 1.5);
   DOUBLES_EQUAL(-20.0, fresh.model().median[2], 1.5);
-  const std::uint32_t right = camera.width_px - 1;
-  const std::uint32_t bottom = camera.height_px - 1;
-  for (const auto& [u, v] :
-       {std::pair{0U, 0U}, std::pair{right, 0U}, std::pair{0U, bottom}, std::pair{right, bottom}}) {
+  for (const auto& [u, v] : image_corners()) {
     float contrast = 0.0F;
     CHECK(fresh.looks_like_floor(g_frame, u, v, contrast));
   }
