@@ -1426,23 +1426,37 @@ void learn_apart_and_together(FloorCue& one, FloorCue& other, FloorCue& both) {
 
 }  // namespace
 
+namespace {
+
+// Two textured regions of the same colours in different proportions learned apart by cues
+// trusting their first region, and both by `both` (learn_apart_and_together): its model is
+// textured, and its histogram, bin by bin, and the bins' shares lie the fraction `w` of the
+// way from the first region's to the second's.
+void check_textured_model_between(FloorCue& both, float w) {
+  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
+  fill_patches(g_frame2, {40.0F, 40.0F, 100.0F, 160.0F, 220.0F});
+  static FloorCue one{g_rig, flat_trusting()};
+  static FloorCue other{g_rig, flat_trusting()};
+  learn_apart_and_together(one, other, both);
+  CHECK(both.model().textured);
+  const auto between = [w](float from, float to) { return from + w * (to - from); };
+  double apart = 0.0;
+  for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
+    apart += std::fabs(static_cast<double>(other.model().mass[b] - one.model().mass[b]));
+    DOUBLES_EQUAL(between(one.model().mass[b], other.model().mass[b]), both.model().mass[b], 1e-6);
+    DOUBLES_EQUAL(between(one.model().share[b], other.model().share[b]), both.model().share[b],
+                  1e-5);
+  }
+  CHECK(apart > 0.1);  // the two regions' histograms differ
+}
+
+}  // namespace
+
 // Two textured regions of the same colours in different proportions confirm a model whose
 // histogram is their average, bin by bin.
 TEST(FloorCue, TwoTexturedRegionsConfirmAModelWithTheAverageOfTheirHistograms) {
-  const FloorCueParams flat = flat_trusting();
-  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
-  fill_patches(g_frame2, {40.0F, 40.0F, 100.0F, 160.0F, 220.0F});
-  static FloorCue one{g_rig, flat};
-  static FloorCue other{g_rig, flat};
-  static FloorCue both{g_rig, confirming_across_1_rad(flat)};
-  learn_apart_and_together(one, other, both);
-  CHECK(both.model().textured);
-  double apart = 0.0;
-  for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
-    apart += std::fabs(static_cast<double>(one.model().mass[b] - other.model().mass[b]));
-    DOUBLES_EQUAL(0.5F * (one.model().mass[b] + other.model().mass[b]), both.model().mass[b], 1e-6);
-  }
-  CHECK(apart > 0.1);  // the two regions' histograms differ
+  static FloorCue both{g_rig, confirming_across_1_rad(flat_trusting())};
+  check_textured_model_between(both, 0.5F);
 }
 
 // A plain floor's update moves its tolerances by the learning rate too: a region of the
@@ -2082,25 +2096,8 @@ TEST(FloorCue, ALearningRateOutsideZeroToOneIsHeldToIt) {
 // by bin, and its shares with it: a quarter of the way with learn_rate 0.25, between two
 // regions of the same colours in different proportions.
 TEST(FloorCue, AnUpdateMovesATexturedFloorsHistogramByTheLearningRate) {
-  const FloorCueParams flat = flat_trusting();
-  fill_patches(g_frame, {40.0F, 100.0F, 160.0F, 220.0F});
-  fill_patches(g_frame2, {40.0F, 40.0F, 100.0F, 160.0F, 220.0F});
-  static FloorCue one{g_rig, flat};
-  static FloorCue other{g_rig, flat};
-  static FloorCue updated{g_rig, updating_by_a_quarter(flat)};
-  learn_apart_and_together(one, other, updated);
-  CHECK(updated.model().textured);
-  double apart = 0.0;
-  for (std::size_t b = 0; b < boticelli::stereo::kFloorBins; ++b) {
-    const float from = one.model().mass[b];
-    const float to = other.model().mass[b];
-    apart += std::fabs(static_cast<double>(to - from));
-    DOUBLES_EQUAL(from + 0.25F * (to - from), updated.model().mass[b], 1e-6);
-    const float from_share = one.model().share[b];
-    DOUBLES_EQUAL(from_share + 0.25F * (other.model().share[b] - from_share),
-                  updated.model().share[b], 1e-5);
-  }
-  CHECK(apart > 0.1);  // the two regions' histograms differ
+  static FloorCue updated{g_rig, updating_by_a_quarter(flat_trusting())};
+  check_textured_model_between(updated, 0.25F);
 }
 
 // Vignetting dims a pixel's chroma as it dims its luma (the offsets from 128 shrink with it),
